@@ -1,0 +1,3 @@
+"""rgraph: a declarative render-graph compiler for Vulkan."""
+
+__version__ = "0.1.0"

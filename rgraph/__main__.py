@@ -1,0 +1,3 @@
+from rgraph.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,15 @@
+"""One module per subcommand. Each exposes ``register(subparsers)`` which adds its parser
+and sets ``func`` (``args -> exit code``) as the parser default."""
+
+COMMAND_MODULES = [
+    "validate",
+    "compile",
+    "inspect",
+    "check",
+    "run",
+    "mutate",
+    "place",
+    "device_profile",
+    "graphs",
+    "schema",
+]

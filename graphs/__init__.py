@@ -1,0 +1,1 @@
+"""Bundled graphs and scenes (data)."""

@@ -1,0 +1,1 @@
+"""Built-in pass implementations (installed as rgraph.passes)."""

@@ -1,0 +1,52 @@
+"""``rgraph device-profile``: capture the device's limits and memory requirements into JSON."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser("device-profile", help="capture a device profile (limits, memory requirements)")
+    parser.add_argument("-o", "--output", type=Path, help="write the profile here (default: stdout)")
+    parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.add_argument("--name", default=None, help="profile name (default: derived from the device)")
+    parser.add_argument("--formats", default=None, help="comma-separated formats (default: all supported)")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from rgraph.vk.device import create_device
+    from rgraph.vk.errors import VulkanUnavailable
+    from rgraph.vk.instance import create_instance
+    from rgraph.vk.profile_capture import capture_profile
+
+    try:
+        instance = create_instance(validate=False)
+    except VulkanUnavailable as exc:
+        print(f"rgraph: error: {exc}", file=sys.stderr)
+        return 1
+    device = None
+    try:
+        device = create_device(instance, args.device)
+        name = args.name or ("lavapipe" if "llvmpipe" in device.name else device.name.split()[0].lower())
+        fmts = [f.strip() for f in args.formats.split(",")] if args.formats else None
+        profile = capture_profile(device, name, fmts)
+    except VulkanUnavailable as exc:
+        print(f"rgraph: error: {exc}", file=sys.stderr)
+        return 1
+    finally:
+        if device is not None:
+            device.destroy()
+        instance.destroy()
+    text = json.dumps(profile, indent=1, sort_keys=True) + "\n"
+    if args.output:
+        args.output.write_text(text)
+        ruled = sum(1 for f in profile["formats"].values() if f["rule"])
+        print(f"rgraph: wrote {args.output}: {len(profile['formats'])} formats, {ruled} with a verified rule",
+              file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return 0

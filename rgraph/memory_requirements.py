@@ -1,0 +1,149 @@
+"""Memory requirements without a device: predicted from a device profile JSON.
+
+A profile (``rgraph device-profile``) holds, per format, measured requirements for a grid of
+extents/mips/layers/samples and, when one fits every sample, a rule:
+
+    per mip m (texel extent halves, floor, min 1; blocks of the format's block extent):
+        mip_bytes  = align(align(blocks_x * block_bytes, row_align) * align(blocks_y, rows_align) * depth_m, mip_align)
+    layer_bytes = align(sum(mip_bytes), layer_align)
+    size        = align(layer_bytes * layers * samples, size_align)
+
+This module never imports ``vulkan``. ``fit_image_rule`` and ``predict_image`` are shared
+with the capture code so a rule is only kept when it reproduces every measured sample.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rgraph.errors import RGraphError
+
+Requirements = tuple[int, int, int]  # (size, alignment, memory_type_bits)
+
+#: A measured image sample: (width, height, depth, mips, layers, samples, size, alignment, bits).
+Sample = tuple[int, int, int, int, int, int, int, int, int]
+
+PROFILES_DIR = Path(__file__).parent / "profiles"
+
+
+def align_up(value: int, alignment: int) -> int:
+    return (value + alignment - 1) // alignment * alignment
+
+
+def predict_image(rule: dict[str, int], block_bytes: int, block_extent: Sequence[int],
+                  extent: Sequence[int], mips: int, layers: int, samples: int) -> int:
+    """The image size under ``rule`` (see the module docstring)."""
+    bw, bh, bd = (list(block_extent) + [1, 1, 1])[:3]
+    w, h = int(extent[0]), int(extent[1])
+    d = int(extent[2]) if len(extent) > 2 else 1
+    layer = 0
+    for m in range(int(mips)):
+        mw, mh, md = max(1, w >> m), max(1, h >> m), max(1, d >> m)
+        bx, by, bz = -(-mw // bw), -(-mh // bh), -(-md // bd)
+        row = align_up(bx * block_bytes, rule["row_align"])
+        layer += align_up(row * align_up(by, rule["rows_align"]) * bz, rule["mip_align"])
+    layer = align_up(layer, rule["layer_align"])
+    return align_up(layer * int(layers) * int(samples), rule["size_align"])
+
+
+_POW2 = [1 << i for i in range(17)]
+
+
+def fit_image_rule(samples: Sequence[Sample], block_bytes: int, block_extent: Sequence[int]) -> dict | None:
+    """The simplest rule (smallest alignments, fitted stage by stage) that predicts every sample."""
+    base = {"row_align": 1, "rows_align": 1, "mip_align": 1, "layer_align": 1, "size_align": 1}
+
+    def ok(rule: dict, subset: Sequence[Sample]) -> bool:
+        return all(
+            predict_image(rule, block_bytes, block_extent, s[0:3], s[3], s[4], s[5]) == s[6] for s in subset
+        )
+
+    simple = [s for s in samples if s[3] == 1 and s[4] == 1 and s[5] == 1]
+    mipped = [s for s in samples if s[4] == 1 and s[5] == 1]
+    for row_align in _POW2[:11]:
+        for rows_align in _POW2[:7]:
+            for size_align in _POW2:
+                rule = dict(base, row_align=row_align, rows_align=rows_align, size_align=size_align)
+                if not ok(rule, simple):
+                    continue
+                for mip_align in _POW2:
+                    r2 = dict(rule, mip_align=mip_align)
+                    if not ok(r2, mipped):
+                        continue
+                    for layer_align in _POW2:
+                        r3 = dict(r2, layer_align=layer_align)
+                        if ok(r3, samples):
+                            return r3
+    return None
+
+
+@dataclass
+class ProfileMemoryRequirements:
+    """The memory-requirements provider backed by a device profile (same API as the device one)."""
+
+    profile: dict[str, Any]
+    path: str = "<profile>"
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> ProfileMemoryRequirements:
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            raise RGraphError.in_file(path, f"cannot read device profile: {exc}") from None
+        if data.get("format") != "rgraph-device-profile/1":
+            raise RGraphError.in_file(path, "not an rgraph device profile (format != rgraph-device-profile/1)")
+        return cls(data, str(path))
+
+    @classmethod
+    def named(cls, name: str) -> ProfileMemoryRequirements:
+        """A bundled profile (``rgraph/profiles/NAME.json``) or a path."""
+        candidate = PROFILES_DIR / f"{name}.json"
+        return cls.from_file(candidate if candidate.exists() else Path(name))
+
+    @property
+    def name(self) -> str:
+        return str(self.profile.get("name", self.path))
+
+    def _error(self, message: str) -> RGraphError:
+        return RGraphError.in_file(self.path, message)
+
+    def image(self, format_vk_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
+              usage_names: Sequence[str]) -> Requirements:
+        key = format_vk_name.upper().removeprefix("VK_FORMAT_")
+        entry = self.profile["formats"].get(key)
+        if entry is None:
+            raise self._error(f"device profile {self.name!r} has no optimal-tiling image format {key}")
+        extra = sorted(set(usage_names) - set(entry["usages"]) - {"transfer_src", "transfer_dst"})
+        if extra:
+            raise self._error(f"device profile {self.name!r}: format {key} does not support usage {', '.join(extra)}")
+        ext = [int(e) for e in (list(extent) + [1, 1])[:3]]
+        if not entry.get("usage_independent", False):
+            raise self._error(
+                f"device profile {self.name!r}: requirements of {key} depend on usage; cannot predict offline"
+            )
+        for s in entry["samples"]:
+            if list(s[0:6]) == [*ext, int(mips), int(layers), int(samples)]:
+                return int(s[6]), int(s[7]), int(s[8])
+        rule = entry.get("rule")
+        if rule is None:
+            raise self._error(
+                f"device profile {self.name!r}: no verified size rule for {key} and extent {ext} "
+                f"mips {mips} layers {layers} samples {samples} was not measured"
+            )
+        if int(samples) > 1 and int(samples) not in entry.get("sample_counts", [1]):
+            raise self._error(f"device profile {self.name!r}: {key} does not support {samples} samples")
+        size = predict_image(rule, entry["block_bytes"], entry["block_extent"], ext, mips, layers, samples)
+        return size, int(entry["alignment"]), int(entry["memory_type_bits"])
+
+    def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
+        rule = self.profile["buffer"]
+        unknown = sorted(set(usage_names) - set(rule["alignment_by_usage"]))
+        if unknown:
+            raise self._error(f"device profile {self.name!r}: no buffer rule for usage {', '.join(unknown)}")
+        alignment = max([rule["alignment_by_usage"][u] for u in usage_names] + [rule["alignment"]])
+        return align_up(max(int(size), 1), rule["size_align"]), alignment, int(rule["memory_type_bits"])

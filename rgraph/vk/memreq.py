@@ -1,0 +1,56 @@
+"""Memory requirements measured on the live device (vkGetDevice*MemoryRequirements, maintenance4)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from rgraph.vk import names
+from rgraph.vk.device import Device
+from rgraph.vk.loader import vk
+
+Requirements = tuple[int, int, int]  # (size, alignment, memory_type_bits)
+
+
+def image_create_info(format_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
+                      usage_names: Sequence[str], alias: bool = False):
+    """The VkImageCreateInfo the runtime uses for a plan image (2D or 3D by extent depth)."""
+    v = vk()
+    depth = int(extent[2]) if len(extent) > 2 else 1
+    return v.VkImageCreateInfo(
+        flags=v.VK_IMAGE_CREATE_ALIAS_BIT if alias else 0,
+        imageType=v.VK_IMAGE_TYPE_3D if depth > 1 else v.VK_IMAGE_TYPE_2D,
+        format=names.format_value(format_name),
+        extent=v.VkExtent3D(width=int(extent[0]), height=int(extent[1]), depth=depth),
+        mipLevels=int(mips), arrayLayers=int(layers), samples=names.sample_count(samples),
+        tiling=v.VK_IMAGE_TILING_OPTIMAL, usage=names.image_usage(usage_names),
+        sharingMode=v.VK_SHARING_MODE_EXCLUSIVE, initialLayout=v.VK_IMAGE_LAYOUT_UNDEFINED,
+    )
+
+
+def buffer_create_info(size: int, usage_names: Sequence[str]):
+    v = vk()
+    return v.VkBufferCreateInfo(size=int(size), usage=names.buffer_usage(usage_names),
+                                sharingMode=v.VK_SHARING_MODE_EXCLUSIVE)
+
+
+class DeviceMemoryRequirements:
+    """The memory-requirements provider backed by a live device (same API as the profile one)."""
+
+    def __init__(self, device: Device) -> None:
+        self.device = device
+        self.name = device.name
+
+    def image(self, format_vk_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
+              usage_names: Sequence[str]) -> Requirements:
+        v = vk()
+        info = image_create_info(format_vk_name, extent, mips, layers, samples, usage_names)
+        query = v.VkDeviceImageMemoryRequirements(pCreateInfo=info, planeAspect=0)
+        req = v.vkGetDeviceImageMemoryRequirements(self.device.handle, query).memoryRequirements
+        return int(req.size), int(req.alignment), int(req.memoryTypeBits)
+
+    def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
+        v = vk()
+        info = buffer_create_info(size, usage_names)
+        query = v.VkDeviceBufferMemoryRequirements(pCreateInfo=info)
+        req = v.vkGetDeviceBufferMemoryRequirements(self.device.handle, query).memoryRequirements
+        return int(req.size), int(req.alignment), int(req.memoryTypeBits)

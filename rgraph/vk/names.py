@@ -1,0 +1,111 @@
+"""Plan names (sync2 without prefixes/suffixes, usage words, formats) -> Vulkan enum values."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from functools import cache
+
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.loader import vk
+
+#: Usages the runtime always adds: readback of outputs (transfer_src) and initialisation of
+#: persistent/imported resources (transfer_dst). Memory-requirement providers add them too,
+#: so the plan's sizes match what the runtime creates.
+RUNTIME_USAGES = ("transfer_src", "transfer_dst")
+
+_IMAGE_USAGE = {
+    "color_attachment": "COLOR_ATTACHMENT", "color_attachment_blend": "COLOR_ATTACHMENT",
+    "depth_attachment": "DEPTH_STENCIL_ATTACHMENT", "depth_read": "DEPTH_STENCIL_ATTACHMENT",
+    "sampled": "SAMPLED", "storage_read": "STORAGE", "storage_write": "STORAGE", "storage_rw": "STORAGE",
+    "transfer_src": "TRANSFER_SRC", "transfer_dst": "TRANSFER_DST",
+}
+_BUFFER_USAGE = {
+    "uniform": "UNIFORM_BUFFER", "vertex": "VERTEX_BUFFER", "index": "INDEX_BUFFER",
+    "indirect": "INDIRECT_BUFFER", "storage_read": "STORAGE_BUFFER", "storage_write": "STORAGE_BUFFER",
+    "storage_rw": "STORAGE_BUFFER", "transfer_src": "TRANSFER_SRC", "transfer_dst": "TRANSFER_DST",
+}
+
+
+def _const(name: str) -> int:
+    try:
+        return int(getattr(vk(), name))
+    except AttributeError:
+        raise ExecutionError(f"unknown Vulkan name {name}") from None
+
+
+@cache
+def stage(name: str) -> int:
+    if name == "NONE":
+        return 0
+    return _const(f"VK_PIPELINE_STAGE_2_{name}_BIT")
+
+
+@cache
+def access(name: str) -> int:
+    if name == "NONE":
+        return 0
+    return _const(f"VK_ACCESS_2_{name}_BIT")
+
+
+@cache
+def layout(name: str) -> int:
+    return _const(f"VK_IMAGE_LAYOUT_{name}")
+
+
+@cache
+def format_value(name: str) -> int:
+    from rgraph.formats import lookup
+
+    try:
+        return lookup(name).value
+    except KeyError:
+        raise ExecutionError(f"unknown format {name}") from None
+
+
+def stages(names: Iterable[str]) -> int:
+    out = 0
+    for n in names:
+        out |= stage(n)
+    return out
+
+
+def accesses(names: Iterable[str]) -> int:
+    out = 0
+    for n in names:
+        out |= access(n)
+    return out
+
+
+def image_usage(usages: Iterable[str]) -> int:
+    out = 0
+    for u in set(usages) | set(RUNTIME_USAGES):
+        if u not in _IMAGE_USAGE:
+            raise ExecutionError(f"usage {u!r} does not apply to images")
+        out |= _const(f"VK_IMAGE_USAGE_{_IMAGE_USAGE[u]}_BIT")
+    return out
+
+
+def buffer_usage(usages: Iterable[str]) -> int:
+    out = 0
+    for u in set(usages) | set(RUNTIME_USAGES):
+        if u not in _BUFFER_USAGE:
+            raise ExecutionError(f"usage {u!r} does not apply to buffers")
+        out |= _const(f"VK_BUFFER_USAGE_{_BUFFER_USAGE[u]}_BIT")
+    return out
+
+
+def sample_count(samples: int) -> int:
+    return _const(f"VK_SAMPLE_COUNT_{int(samples)}_BIT")
+
+
+def aspect_mask(format_name: str) -> int:
+    from rgraph.formats import lookup
+
+    info = lookup(format_name)
+    v = vk()
+    mask = 0
+    if info.has_depth:
+        mask |= v.VK_IMAGE_ASPECT_DEPTH_BIT
+    if info.has_stencil:
+        mask |= v.VK_IMAGE_ASPECT_STENCIL_BIT
+    return mask or v.VK_IMAGE_ASPECT_COLOR_BIT

@@ -1,0 +1,183 @@
+"""Capture a device profile: limits, memory types/heaps, and measured memory requirements.
+
+For each format with optimal-tiling sampled or attachment support the requirements are
+measured on a grid of extents/mips/layers/samples; a size rule is fitted and verified
+against every sample (``rgraph.memory_requirements.fit_image_rule``); raw samples are kept.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rgraph import formats
+from rgraph.memory_requirements import align_up, fit_image_rule
+from rgraph.vk.device import Device
+from rgraph.vk.loader import vk
+from rgraph.vk.memreq import DeviceMemoryRequirements
+
+LIMITS = (
+    "bufferImageGranularity", "maxImageDimension1D", "maxImageDimension2D", "maxImageDimension3D",
+    "maxImageArrayLayers", "maxStorageBufferRange", "maxUniformBufferRange", "maxMemoryAllocationCount",
+    "minStorageBufferOffsetAlignment", "minUniformBufferOffsetAlignment", "nonCoherentAtomSize",
+    "maxComputeWorkGroupInvocations", "maxColorAttachments", "maxPushConstantsSize",
+    "maxBoundDescriptorSets", "maxPerStageDescriptorSampledImages", "maxPerStageDescriptorStorageImages",
+    "maxPerStageDescriptorStorageBuffers", "maxPerStageDescriptorUniformBuffers", "timestampPeriod",
+    "framebufferColorSampleCounts", "framebufferDepthSampleCounts", "maxFramebufferWidth",
+    "maxFramebufferHeight", "maxFramebufferLayers", "optimalBufferCopyRowPitchAlignment",
+)
+
+EXTENTS = [(1, 1), (3, 5), (17, 9), (64, 64), (100, 37), (255, 257), (640, 360), (1000, 17), (1920, 1080)]
+MIPPED = [((64, 64), 7), ((100, 37), 3), ((255, 257), 4), ((17, 1000), 5)]
+LAYERED = [((64, 64), 1, 2), ((100, 37), 3, 6), ((33, 17), 2, 3)]
+BUFFER_SIZES = [1, 3, 64, 100, 255, 1000, 4096, 65537]
+BUFFER_USAGES = ["uniform", "vertex", "index", "indirect", "storage_rw", "transfer_src", "transfer_dst"]
+
+_IMAGE_USAGES = ("sampled", "color_attachment", "color_attachment_blend", "depth_attachment", "depth_read",
+                 "storage_rw")
+
+
+def _flag_names(value: int, prefix: str) -> list[str]:
+    v = vk()
+    out = []
+    for name in dir(v):
+        if name.startswith(prefix) and name.endswith("_BIT"):
+            bit = getattr(v, name)
+            if isinstance(bit, int) and bit and value & bit == bit and bin(bit).count("1") == 1:
+                out.append(name.removeprefix(prefix).removesuffix("_BIT"))
+    return sorted(set(out))
+
+
+def _supported_usages(features: int, info: formats.FormatInfo) -> list[str]:
+    v = vk()
+    out = []
+    if features & v.VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT:
+        out.append("sampled")
+    if features & v.VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT:
+        out.append("color_attachment")
+    if features & v.VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT:
+        out.append("color_attachment_blend")
+    if features & v.VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT:
+        out += ["depth_attachment", "depth_read"]
+    if features & v.VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT:
+        out += ["storage_read", "storage_write", "storage_rw"]
+    return out
+
+
+def _sample_counts(device: Device, usages: list[str]) -> list[int]:
+    limits = device.properties.limits
+    mask = 0
+    if "color_attachment" in usages:
+        mask = limits.framebufferColorSampleCounts
+    elif "depth_attachment" in usages:
+        mask = limits.framebufferDepthSampleCounts
+    return [n for n in (1, 2, 4, 8, 16) if mask & n] or [1]
+
+
+def _measure_format(req: DeviceMemoryRequirements, device: Device, info: formats.FormatInfo,
+                    usages: list[str]) -> dict[str, Any]:
+    vk_name = info.vk_name
+    counts = _sample_counts(device, usages)
+    grid: list[tuple[tuple[int, int, int], int, int, int]] = [((w, h, 1), 1, 1, 1) for w, h in EXTENTS]
+    grid += [((w, h, 1), mips, 1, 1) for (w, h), mips in MIPPED]
+    grid += [((w, h, 1), mips, layers, 1) for (w, h), mips, layers in LAYERED]
+    grid += [((w, h, 1), 1, 1, s) for s in counts if s > 1 for w, h in [(64, 64), (100, 37)]]
+    minimal = ["sampled"] if "sampled" in usages else usages[:1]
+    samples = []
+    independent = True
+    for extent, mips, layers, count in grid:
+        full_usages = [u for u in usages if count == 1 or u not in ("sampled", "storage_read", "storage_write",
+                                                                     "storage_rw")]
+        size, alignment, bits = req.image(vk_name, extent, mips, layers, count, full_usages or minimal)
+        if count == 1 and req.image(vk_name, extent, mips, layers, count, minimal) != (size, alignment, bits):
+            independent = False
+        samples.append([*extent, mips, layers, count, size, alignment, bits])
+    alignments = {s[7] for s in samples}
+    bits = {s[8] for s in samples}
+    rule = fit_image_rule([tuple(s) for s in samples], info.block_bytes, info.block_extent)
+    if len(alignments) != 1 or len(bits) != 1:
+        rule = None
+    return {
+        "usages": usages, "usage_independent": independent, "block_bytes": info.block_bytes,
+        "block_extent": list(info.block_extent), "sample_counts": counts,
+        "alignment": max(alignments), "memory_type_bits": min(bits) if len(bits) == 1 else 0,
+        "rule": rule, "samples": samples,
+    }
+
+
+def _measure_buffers(req: DeviceMemoryRequirements) -> dict[str, Any]:
+    by_usage: dict[str, int] = {}
+    bits = set()
+    measured = []
+    for usage in BUFFER_USAGES:
+        for size in BUFFER_SIZES:
+            got_size, alignment, got_bits = req.buffer(size, [usage])
+            measured.append([usage, size, got_size, alignment, got_bits])
+            by_usage[usage] = max(by_usage.get(usage, 1), alignment)
+            bits.add(got_bits)
+    size_align = next((a for a in (1 << i for i in range(17))
+                       if all(align_up(max(m[1], 1), a) == m[2] for m in measured)), 0)
+    if not size_align:
+        raise RuntimeError("buffer sizes follow no power-of-two rounding; profile cannot describe them")
+    all_alignment = max(req.buffer(64, BUFFER_USAGES)[1], 1)
+    rule = {"alignment_by_usage": by_usage, "alignment": 1, "size_align": size_align,
+            "memory_type_bits": min(bits), "samples": measured}
+    # Verify: the rule predicts every single-usage sample and the all-usage alignment.
+    for usage, size, got_size, alignment, _bits in measured:
+        predicted = -(-max(size, 1) // size_align) * size_align
+        if predicted != got_size or by_usage[usage] != alignment:
+            raise RuntimeError(f"buffer rule mispredicts {usage} size {size}: {predicted} != {got_size}")
+    if max(by_usage.values()) != all_alignment or len(bits) != 1:
+        raise RuntimeError("buffer alignment depends on usage combinations; profile cannot describe it")
+    return rule
+
+
+def capture_profile(device: Device, name: str, format_names: list[str] | None = None) -> dict[str, Any]:
+    v = vk()
+    req = DeviceMemoryRequirements(device)
+    props = device.properties
+    limits = {n: getattr(props.limits, n) for n in LIMITS}
+    limits = {k: (float(x) if isinstance(x, float) else int(x)) for k, x in limits.items()}
+    mem = device.memory_properties
+    memory_types = [
+        {"heap": int(mem.memoryTypes[i].heapIndex),
+         "flags": _flag_names(mem.memoryTypes[i].propertyFlags, "VK_MEMORY_PROPERTY_")}
+        for i in range(mem.memoryTypeCount)
+    ]
+    memory_heaps = [
+        {"bytes": int(mem.memoryHeaps[i].size), "flags": _flag_names(mem.memoryHeaps[i].flags, "VK_MEMORY_HEAP_")}
+        for i in range(mem.memoryHeapCount)
+    ]
+    format_entries: dict[str, Any] = {}
+    rejected: dict[str, str] = {}
+    infos = [formats.lookup(n) for n in format_names] if format_names else formats.all_formats()
+    for info in infos:
+        if info.is_planar or info.chroma:
+            continue
+        try:
+            fp = v.vkGetPhysicalDeviceFormatProperties(device.physical.handle, info.value)
+        except Exception:  # noqa: BLE001 -- formats unknown to this driver
+            continue
+        usages = _supported_usages(fp.optimalTilingFeatures, info)
+        if not {"sampled", "color_attachment", "depth_attachment"} & set(usages):
+            continue
+        entry = _measure_format(req, device, info, usages)
+        if entry["rule"] is None:
+            rejected[info.vk_name] = "no rule of the supported family predicts every sample; samples only"
+        format_entries[info.vk_name] = entry
+    api = props.apiVersion
+    return {
+        "format": "rgraph-device-profile/1",
+        "name": name,
+        "device": device.name,
+        "device_type": device.physical.device_type,
+        "vendor_id": int(props.vendorID), "device_id": int(props.deviceID),
+        "driver_version": int(props.driverVersion),
+        "api_version": [api >> 22, (api >> 12) & 0x3FF, api & 0xFFF],
+        "runtime_usages": ["transfer_src", "transfer_dst"],
+        "limits": limits,
+        "memory_types": memory_types,
+        "memory_heaps": memory_heaps,
+        "buffer": _measure_buffers(req),
+        "formats": format_entries,
+        "rules_rejected": rejected,
+    }

@@ -250,3 +250,33 @@ def test_big_endian_module_reflects_the_same():
     spirv = compile_shader(SHADERS / "raster.frag").spirv
     swapped = b"".join(spirv[i : i + 4][::-1] for i in range(0, len(spirv), 4))
     assert reflect(swapped) == reflect(spirv)
+
+
+def test_mesh_and_geometry_stages(tmp_path):
+    mesh = """#version 460
+#extension GL_EXT_mesh_shader : require
+layout(local_size_x = 32) in;
+layout(triangles, max_vertices = 3, max_primitives = 1) out;
+layout(location = 0) out vec3 colour[];
+void main() {
+    SetMeshOutputsEXT(3, 1);
+    gl_MeshVerticesEXT[gl_LocalInvocationIndex % 3].gl_Position = vec4(0);
+    colour[gl_LocalInvocationIndex % 3] = vec3(1);
+    gl_PrimitiveTriangleIndicesEXT[0] = uvec3(0, 1, 2);
+}
+"""
+    r = _compile_text(tmp_path, "tri.mesh", mesh).reflection
+    assert (r.stage, r.vk_stage, r.local_size) == ("mesh", "VK_SHADER_STAGE_MESH_BIT_EXT", (32, 1, 1))
+    assert [(v.location, v.name, v.type) for v in r.outputs] == [(0, "colour", "vec3")]  # per-vertex array
+    geom = """#version 460
+layout(triangles) in;
+layout(triangle_strip, max_vertices = 3) out;
+layout(location = 0) in vec2 v_uv[];
+layout(location = 0) out vec2 g_uv;
+void main() {
+    for (int i = 0; i < 3; ++i) { g_uv = v_uv[i]; gl_Position = gl_in[i].gl_Position; EmitVertex(); }
+}
+"""
+    r = _compile_text(tmp_path, "pass.geom", geom).reflection
+    assert [(v.location, v.name, v.type) for v in r.inputs] == [(0, "v_uv", "vec2")]
+    assert [(v.location, v.name, v.type) for v in r.outputs] == [(0, "g_uv", "vec2")]

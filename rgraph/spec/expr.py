@@ -314,10 +314,13 @@ class _Parser:
             self.advance()
             return Num(tok.value, tok.offset)
         if tok.kind == "name":
-            self.advance()
-            if self.at_op("("):
+            # Decide call or reference from the raw text, so that a bad token after a bad name
+            # does not hide the name's own error.
+            if self.text[tok.offset + len(tok.text):].lstrip(" \t\r\n").startswith("("):
                 return self.call(tok)
-            return self.reference(tok)
+            node = self.reference(tok)
+            self.advance()
+            return node
         if self.at_op("(", "${"):
             self.advance()
             self.enter(tok)
@@ -332,6 +335,7 @@ class _Parser:
         if func not in FUNCTIONS:
             raise ExprError(f"unknown function '{func}'{_suggest(func, FUNCTIONS)}; "
                             f"functions are {', '.join(sorted(FUNCTIONS))}", name_tok.offset)
+        self.advance()
         open_tok = self.advance()
         self.enter(open_tok)
         args: list[Node] = []

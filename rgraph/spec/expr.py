@@ -101,7 +101,7 @@ def _scan_number(text: str, start: int) -> Token:
             is_float = True
             i = k
     literal = text[start:i]
-    if literal in ("", ".") or (i < len(text) and (_is_ident_char(text[i]) or text[i] == ".")):
+    if i < len(text) and (_is_ident_char(text[i]) or text[i] == "."):
         end = i
         while end < len(text) and (_is_ident_char(text[end]) or text[end] == "."
                                    or (text[end] in "+-" and text[end - 1] in "eE")):

@@ -1,0 +1,152 @@
+"""``rgraph inspect G-or-PLAN``: human views of a plan (tables, barriers, memory, DOT, HTML).
+
+An argument ending in ``.json`` is a plan file; anything else is a graph file or bundled
+graph name, compiled first. With no view flag the summary is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any, TextIO
+
+from rgraph.errors import RGraphError
+from rgraph.report.plan_file import check_plan, load_plan
+
+COMMAND_LINE = "<command line>"
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "inspect",
+        help="human views of a plan",
+        description="Show a compiled plan: schedule, barriers, memory, a timeline PNG, DOT, HTML.",
+    )
+    parser.add_argument("target", metavar="G-or-PLAN", help="plan.json, a graph file or a bundled graph name")
+    parser.add_argument("--barriers", action="store_true", help="every barrier, release, wait and signal in order")
+    parser.add_argument("--memory", action="store_true", help="resources, placement, heaps, culling savings")
+    parser.add_argument("--timeline", metavar="OUT.png", help="draw the memory timeline into a PNG")
+    parser.add_argument(
+        "--dot", metavar="OUT", nargs="?", const="-",
+        help="the pass graph as DOT (stdout; OUT.dot for text, OUT.svg renders with graphviz)",
+    )
+    parser.add_argument("--html", metavar="OUT", help="write a self-contained HTML report")
+    parser.add_argument("--scene", metavar="S", help="scene file or name (when compiling a graph)")
+    parser.add_argument("-p", "--param", dest="params", metavar="K=V", action="append", default=[],
+                        help="override a graph parameter (when compiling a graph)")
+    parser.add_argument("--size", metavar="WxH", help="output size (when compiling a graph)")
+    parser.add_argument("--policy", metavar="P", help="memory placement policy (when compiling a graph)")
+    parser.set_defaults(func=run)
+
+
+def parse_param(text: str) -> tuple[str, Any]:
+    """``k=v`` with ``v`` read as an int, float, bool or else a string."""
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip():
+        raise RGraphError.in_file(COMMAND_LINE, f"-p expects NAME=VALUE, got {text!r}")
+    return key.strip(), parse_value(value.strip())
+
+
+def parse_value(value: str) -> Any:
+    lowered = value.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    for kind in (int, float):
+        try:
+            return kind(value)
+        except ValueError:
+            pass
+    return value
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``1920x1080`` -> (1920, 1080)."""
+    w, sep, h = text.lower().partition("x")
+    if sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0:
+        return int(w), int(h)
+    raise RGraphError.in_file(COMMAND_LINE, f"--size expects WIDTHxHEIGHT such as 1920x1080, got {text!r}")
+
+
+def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
+    """Load the plan file, or compile the graph with the given scene, params, size and policy."""
+    target: str = args.target
+    compile_flags = [f for f in ("scene", "size", "policy") if getattr(args, f)] + (["-p"] if args.params else [])
+    if target.endswith(".json"):
+        if compile_flags:
+            raise RGraphError.in_file(
+                COMMAND_LINE, f"{', '.join(compile_flags)} only apply when compiling a graph, not to a plan file"
+            )
+        return load_plan(target)
+    from rgraph.compile.pipeline import compile_graph
+
+    params = dict(parse_param(p) for p in args.params)
+    size = parse_size(args.size) if args.size else None
+    plan = compile_graph(target, scene_path=args.scene, params=params, size=size, policy=args.policy)
+    check_plan(plan, target)
+    return plan
+
+
+def _write(path: str, data: str | bytes) -> None:
+    try:
+        if isinstance(data, bytes):
+            Path(path).write_bytes(data)
+        else:
+            Path(path).write_text(data, encoding="utf-8")
+    except OSError as exc:
+        raise RGraphError.in_file(path, f"cannot write: {exc.strerror or exc}") from None
+
+
+def emit_dot(plan: dict[str, Any], dest: str, out: TextIO) -> None:
+    """DOT text to ``out`` (``-``), or to a file; ``.svg`` files are rendered by graphviz."""
+    from rgraph.report.dot import dot_available, dot_to_svg, plan_to_dot
+
+    text = plan_to_dot(plan)
+    if dest == "-":
+        out.write(text)
+    elif dest.lower().endswith(".svg"):
+        if not dot_available():
+            raise RGraphError.in_file(dest, "graphviz 'dot' is not installed; write a .dot file instead")
+        try:
+            _write(dest, dot_to_svg(text))
+        except RuntimeError as exc:
+            raise RGraphError.in_file(dest, str(exc)) from None
+    else:
+        _write(dest, text)
+
+
+def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None = None) -> int:
+    from rgraph.report import text
+    from rgraph.report.table import make_console
+
+    out = out if out is not None else sys.stdout
+    err = err if err is not None else sys.stderr
+    plan = obtain_plan(args)
+    console = make_console(out)
+    dot_to_stdout = args.dot == "-"
+    if not (args.barriers or args.memory or dot_to_stdout):
+        text.print_summary(console, plan)
+    if args.barriers:
+        text.print_barriers(console, plan)
+    if args.memory:
+        if args.barriers:
+            console.print()
+        text.print_memory(console, plan)
+    if args.dot is not None:
+        emit_dot(plan, args.dot, out)
+        if not dot_to_stdout:
+            print(f"wrote {args.dot}", file=err)
+    if args.timeline:
+        from rgraph.report.timeline import write_timeline_png
+
+        try:
+            write_timeline_png(plan, args.timeline)
+        except OSError as exc:
+            raise RGraphError.in_file(args.timeline, f"cannot write: {exc.strerror or exc}") from None
+        print(f"wrote {args.timeline}", file=err)
+    if args.html:
+        from rgraph.report.html import plan_html
+
+        _write(args.html, plan_html(plan))
+        print(f"wrote {args.html}", file=err)
+    return 0

@@ -1,0 +1,48 @@
+"""The terminal views, printed onto a rich console."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.console import Console
+from rich.text import Text
+
+from rgraph.report import barriers, memory, summary
+from rgraph.report.table import print_lines, print_table
+
+Plan = dict[str, Any]
+
+
+def _heading(console: Console, title: str) -> None:
+    console.print(Text(title, style="bold underline"))
+
+
+def print_summary(console: Console, plan: Plan) -> None:
+    """Header, schedule, culled passes, dropped reads, stats."""
+    print_lines(console, summary.header_lines(plan))
+    console.print()
+    print_table(console, summary.schedule_table(plan))
+    print_table(console, summary.culled_table(plan))
+    print_table(console, summary.dropped_table(plan))
+    _heading(console, "Stats")
+    print_lines(console, summary.stats_lines(plan))
+
+
+def print_barriers(console: Console, plan: Plan) -> None:
+    """Every wait, barrier, release and signal in execution order."""
+    _heading(console, "Barriers (execution order)")
+    print_lines(console, barriers.barrier_lines(plan))
+    print_lines(console, [barriers.barrier_totals(plan)])
+
+
+def print_memory(console: Console, plan: Plan) -> None:
+    """Resources, heaps, bytes per class and what culling saved."""
+    print_table(console, memory.resources_table(plan))
+    print_table(console, memory.heaps_table(plan))
+    _heading(console, "Bytes per memory class")
+    print_lines(console, memory.class_lines(plan) or ["  (no heaps)"])
+    console.print()
+    print_table(console, memory.culling_table(plan))
+    total = memory.culling_total_line(plan)
+    if total:
+        print_lines(console, [total])

@@ -1,0 +1,187 @@
+"""The ``--timeline`` view: the plan's memory placement drawn as a PNG.
+
+Pass index runs across, heap offset up; one rectangle per placed resource. When
+``rgraph.memory.timeline.draw_timeline(blocks, placement, path, title)`` exists it does the
+drawing from blocks converted out of the plan; otherwise this module draws it itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rgraph.report.fmt import MIB, align_up, human_bytes, percent
+
+Plan = dict[str, Any]
+
+
+@dataclass(frozen=True)
+class PlacedBlock:
+    """A placed resource over an inclusive range of pass indices."""
+
+    name: str
+    start: int
+    end: int
+    size: int
+    alignment: int
+    memory_class: str
+    heap: int
+    offset: int
+    aliasable: bool  # transient resources alias; persistent/imported/output ones hold memory all frame
+
+    @property
+    def aligned_size(self) -> int:
+        return align_up(self.size, self.alignment)
+
+
+def placed_blocks(plan: Plan) -> list[PlacedBlock]:
+    """Every resource that has a heap, an offset and a pass, in plan (name) order."""
+    last_pass = max(len(plan["passes"]) - 1, 0)
+    blocks = []
+    for r in plan.get("resources") or []:
+        if r.get("heap") is None or r.get("offset") is None or r.get("first") is None:
+            continue
+        transient = (r.get("lifetime") or "transient") == "transient"
+        start, end = (r["first"], r["last"]) if transient else (0, last_pass)
+        blocks.append(
+            PlacedBlock(
+                name=r["name"],
+                start=start,
+                end=end,
+                size=r.get("bytes") or 0,
+                alignment=r.get("alignment") or 1,
+                memory_class=r.get("memory_class") or "-",
+                heap=r["heap"],
+                offset=r["offset"],
+                aliasable=transient,
+            )
+        )
+    return blocks
+
+
+def live_bytes(blocks: list[PlacedBlock], n_passes: int) -> list[int]:
+    """Aligned bytes alive at each pass index."""
+    live = [0] * max(n_passes, 1)
+    for b in blocks:
+        for t in range(b.start, min(b.end, len(live) - 1) + 1):
+            live[t] += b.aligned_size
+    return live
+
+
+def timeline_title(plan: Plan) -> str:
+    """Graph, policy, peak, lower bound and saving against unaliased memory."""
+    stats = plan.get("stats") or {}
+    peak, lower, unaliased = stats.get("peak_bytes"), stats.get("lower_bound_bytes"), stats.get("unaliased_bytes")
+    parts = [f"{plan.get('graph') or 'plan'}: {stats.get('policy') or '?'} placement"]
+    if peak is not None:
+        parts.append(f"peak {human_bytes(peak)}")
+    if lower is not None:
+        parts.append(f"lower bound {human_bytes(lower)}")
+    if peak is not None and unaliased:
+        parts.append(f"saving {percent(unaliased - peak, unaliased)} of {human_bytes(unaliased)}")
+    return ", ".join(parts)
+
+
+def write_timeline_png(plan: Plan, path: str | Path, title: str | None = None, shared: bool = True) -> str:
+    """Draw the plan's placement into ``path``; returns which drawer did it (``memory`` or ``report``)."""
+    title = title or timeline_title(plan)
+    if shared:
+        try:
+            from rgraph.memory.timeline import draw_timeline
+        except ImportError:
+            draw_timeline = None
+        if draw_timeline is not None:
+            blocks, placement = _to_memory_model(plan)
+            draw_timeline(blocks, placement, str(path), title)
+            return "memory"
+    draw_plan_timeline(plan, path, title)
+    return "report"
+
+
+def _to_memory_model(plan: Plan) -> tuple[list[Any], Any]:
+    """The plan as ``rgraph.memory.model`` blocks and placement, for the shared drawer."""
+    from rgraph.memory.model import Block, Heap, Placement, PlacementStats
+
+    placed = placed_blocks(plan)
+    blocks = [Block(b.name, b.start, b.end, b.size, b.alignment, b.memory_class) for b in placed]
+    heaps = [
+        Heap(h["id"], h["bytes"], h.get("memory_class") or "-", h.get("alignment") or 1)
+        for h in plan.get("heaps") or []
+    ]
+    stats = plan.get("stats") or {}
+    placement = Placement(
+        offsets={b.name: (b.heap, b.offset) for b in placed},
+        heaps=heaps,
+        stats=PlacementStats(
+            policy=stats.get("policy") or "?",
+            peak_bytes=stats.get("peak_bytes") or sum(h.bytes for h in heaps),
+            lower_bound_bytes=stats.get("lower_bound_bytes") or 0,
+            unaliased_bytes=stats.get("unaliased_bytes") or sum(b.aligned_size for b in placed),
+            allocations=stats.get("allocations") or len(heaps),
+            seconds=0.0,
+        ),
+    )
+    return blocks, placement
+
+
+def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
+    """This module's own drawing: one panel per heap, rectangles in MiB over pass indices."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Rectangle
+
+    passes = plan["passes"]
+    n = max(len(passes), 1)
+    blocks = placed_blocks(plan)
+    heaps = sorted(plan.get("heaps") or [], key=lambda h: h["id"])
+    heap_ids = [h["id"] for h in heaps] or sorted({b.heap for b in blocks}) or [0]
+    heap_bytes = {h["id"]: h["bytes"] for h in heaps}
+    heap_class = {h["id"]: h.get("memory_class") or "-" for h in heaps}
+
+    biggest = max([heap_bytes.get(h, 0) for h in heap_ids] + [1])
+    ratios = [min(max((max(heap_bytes.get(h, 0), 1) / biggest) ** 0.5, 0.3), 1.0) for h in heap_ids]
+    fig = Figure(figsize=(max(9.0, 1.1 * n + 4), 2.0 + 3.2 * sum(ratios)), dpi=100)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(heap_ids), 1, sharex=True, squeeze=False, height_ratios=ratios)[:, 0]
+    palette = [
+        "#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948",
+        "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac",
+    ]
+    for ax, heap_id in zip(axes, heap_ids, strict=True):
+        members = [b for b in blocks if b.heap == heap_id]
+        live = live_bytes(members, len(passes))
+        bound = max(live, default=0)
+        size = heap_bytes.get(heap_id, max((b.offset + b.aligned_size for b in members), default=0))
+        top = max([size, bound, 1] + [b.offset + b.aligned_size for b in members])
+        scale, unit = (MIB, "MiB") if top >= MIB else (1024, "KiB") if top >= 1024 else (1, "B")
+        for k, b in enumerate(members):
+            ax.add_patch(Rectangle(
+                (b.start - 0.45, b.offset / scale), b.end - b.start + 0.9, b.aligned_size / scale,
+                facecolor=palette[k % len(palette)], edgecolor="black", linewidth=0.8, alpha=0.85,
+                hatch=None if b.aliasable else "//",
+            ))
+            tall = b.aligned_size / top > 0.08
+            ax.text(
+                (b.start + b.end) / 2, (b.offset + b.aligned_size / 2) / scale,
+                f"{b.name}\n{human_bytes(b.size)}" if tall else b.name,
+                ha="center", va="center", fontsize=7 if tall else 6, clip_on=True,
+            )
+        ax.step(range(len(live)), [v / scale for v in live], where="mid", color="#666666", linewidth=0.9,
+                linestyle=(0, (1, 1)), label="live bytes")
+        ax.axhline(bound / scale, color="#d62728", linestyle="--", linewidth=1.2,
+                   label=f"lower bound {human_bytes(bound)}")
+        ax.axhline(size / scale, color="black", linestyle=":", linewidth=1.2, label=f"heap {human_bytes(size)}")
+        ax.set_ylim(0, top / scale * 1.08)
+        ax.set_ylabel(f"offset ({unit})")
+        ax.set_title(f"heap {heap_id} ({heap_class.get(heap_id, '-')})", fontsize=9, loc="left")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, framealpha=0.8)
+        ax.grid(axis="y", alpha=0.3)
+    axes[-1].set_xlim(-0.6, n - 0.4)
+    axes[-1].set_xticks(range(len(passes)))
+    axes[-1].set_xticklabels([f"{i} {p['name']}" for i, p in enumerate(passes)], rotation=35, ha="right",
+                             fontsize=8)
+    axes[-1].set_xlabel("pass (executed order); hatched: not aliasable (persistent, imported, output)")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(str(path), format="png", metadata={"Software": None})

@@ -1,0 +1,87 @@
+"""The memory timeline PNG and the HTML report."""
+
+from __future__ import annotations
+
+import base64
+import re
+import shutil
+
+import pytest
+from report_plans.helpers import FORWARD, MINIMAL, inspect, load
+
+from rgraph.report.html import plan_html
+from rgraph.report.timeline import live_bytes, placed_blocks, timeline_title, write_timeline_png
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def png_size(data: bytes) -> tuple[int, int]:
+    assert data[:8] == PNG_MAGIC
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def test_blocks_from_the_plan():
+    plan = load(FORWARD)
+    blocks = {b.name: b for b in placed_blocks(plan)}
+    assert set(blocks) == {r["name"] for r in plan["resources"]}
+    depth = blocks["depth"]
+    assert (depth.start, depth.end, depth.heap, depth.offset, depth.aligned_size) == (2, 4, 0, 33554432, 8323072)
+    # non-transient resources hold their memory for the whole frame
+    assert (blocks["history"].start, blocks["history"].end, blocks["history"].aliasable) == (0, 7, False)
+    heap0 = [b for b in blocks.values() if b.heap == 0]
+    live = live_bytes(heap0, len(plan["passes"]))
+    assert max(live) == 58654720 == plan["heaps"][0]["bytes"]  # heap 0 is as small as it can be
+    assert live[4] == 58654720 and live[0] == 0
+
+
+def test_title():
+    assert timeline_title(load(FORWARD)) == (
+        "forward: aliased placement, peak 71.8 MiB, lower bound 71.8 MiB, saving 5.3% of 75.8 MiB"
+    )
+
+
+@pytest.mark.parametrize("fixture", [FORWARD, MINIMAL])
+def test_own_drawing_writes_a_png(tmp_path, fixture):
+    path = tmp_path / "t.png"
+    assert write_timeline_png(load(fixture), path, shared=False) == "report"
+    data = path.read_bytes()
+    width, height = png_size(data)
+    assert width >= 800 and height >= 300 and len(data) > 10_000
+
+
+def test_timeline_flag_writes_a_png(capsys, tmp_path):
+    path = tmp_path / "timeline.png"
+    code, _, err = inspect(capsys, str(FORWARD), "--timeline", str(path))
+    assert code == 0 and err.strip() == f"wrote {path}"
+    png_size(path.read_bytes())
+
+
+def test_html_is_self_contained_with_every_section(capsys, tmp_path):
+    path = tmp_path / "report.html"
+    code, _, _ = inspect(capsys, str(FORWARD), "--html", str(path))
+    assert code == 0
+    page = path.read_text()
+    assert page.startswith("<!DOCTYPE html>")
+    for section in ("summary", "schedule", "barriers", "memory", "timeline", "graph"):
+        assert f'<h2 id="{section}">' in page
+    for title in ("Schedule (8 passes)", "Culled passes (2)", "Dropped optional reads (1)", "Resources (8)",
+                  "Heaps (3)", "Saved by culling (2 culled passes)"):
+        assert f"<h3>{title}</h3>" in page
+    assert "<td>depth_prepass</td>" in page
+    assert "before bloom: bloom_tex[mips 0:1 layers 0:1] FRAGMENT_SHADER/NONE/UNDEFINED -&gt; " in page
+    png = re.search(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"', page)
+    assert png is not None
+    png_size(base64.b64decode(png.group(1)))
+    assert not re.search(r'(src|href)="(https?:)?//', page)  # nothing fetched from elsewhere
+
+
+def test_html_without_graphviz_embeds_the_dot_text():
+    page = plan_html(load(MINIMAL), with_svg=False)
+    assert "<svg" not in page
+    assert "digraph &quot;shadow_only&quot;" in page
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="graphviz is not installed")
+def test_html_with_graphviz_embeds_svg():
+    page = plan_html(load(FORWARD), with_svg=True)
+    assert page.count("<svg") == 1 and "<?xml" not in page

@@ -1,0 +1,52 @@
+"""Arguments shared by the commands that compile a graph."""
+
+from __future__ import annotations
+
+import argparse
+import re
+
+from rgraph.errors import RGraphError
+
+_SIZE = re.compile(r"^(\d+)x(\d+)$")
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    match = _SIZE.match(text.strip().lower())
+    if not match or not 0 < int(match.group(1)) <= 16384 or not 0 < int(match.group(2)) <= 16384:
+        raise RGraphError.in_file("<command line>", f"--size expects WIDTHxHEIGHT (1..16384), got '{text}'")
+    return int(match.group(1)), int(match.group(2))
+
+
+def parse_params(items: list[str] | None) -> dict[str, str]:
+    out: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise RGraphError.in_file("<command line>", f"-p expects name=value, got '{item}'")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def add_graph_arguments(parser: argparse.ArgumentParser, *, size_default: str = "1920x1080") -> None:
+    parser.add_argument("graph", help="graph file, or the name of a bundled graph (rgraph graphs)")
+    parser.add_argument("--scene", help="scene file (default: the graph's own 'scene:', else every feature present)")
+    parser.add_argument("-p", "--param", action="append", metavar="NAME=VALUE", help="override a graph param")
+    parser.add_argument("--size", default=size_default, help=f"output size WxH (default {size_default})")
+
+
+def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, blocks:SIZE, tlsf")
+    parser.add_argument("--profile", help="device profile (bundled name or JSON path) for sizes and alignments")
+
+
+def compile_from_args(args: argparse.Namespace) -> dict:
+    from rgraph.compile.pipeline import compile_graph
+
+    return compile_graph(
+        args.graph,
+        scene_path=args.scene,
+        params=parse_params(args.param),
+        size=parse_size(args.size),
+        policy=getattr(args, "policy", None),
+        profile=getattr(args, "profile", None),
+    )

@@ -1,0 +1,181 @@
+"""Resource memory: requirements from a provider, lifetimes, classes, and placement.
+
+Sizes and alignments come from the memory-requirements provider (a live device or a
+captured device profile), never from a formula here. Transient resources are placed by the
+allocator policy and may alias; persistent, imported and output resources get their own
+allocation each.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from rgraph.errors import RGraphError
+
+from rgraph.memory.model import Block, Heap, Placement, PlacementStats
+from rgraph.spec.specialize import PassSpec, ResourceSpec
+
+Requirements = tuple[int, int, int]
+
+
+class MemoryRequirementsProvider(Protocol):
+    def image(
+        self, format_vk_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
+        usage_names: Sequence[str],
+    ) -> Requirements: ...
+
+    def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements: ...
+
+
+@dataclass(frozen=True)
+class ResourceMemory:
+    bytes: int
+    alignment: int
+    memory_type_bits: int
+    memory_class: str
+    usages: tuple[str, ...]
+    first: int | None
+    last: int | None
+
+
+def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
+    out: dict[str, set[str]] = {}
+    for p in passes:
+        for a in p.accesses:
+            out.setdefault(a.resource, set()).add(a.usage)
+    return out
+
+
+def lifetimes(passes: Sequence[PassSpec]) -> dict[str, tuple[int, int]]:
+    """First and last executed pass index of each resource."""
+    out: dict[str, tuple[int, int]] = {}
+    for i, p in enumerate(passes):
+        for a in p.accesses:
+            first, _ = out.get(a.resource, (i, i))
+            out[a.resource] = (first, i)
+    return out
+
+
+def requirements(
+    resources: Mapping[str, ResourceSpec],
+    used: Mapping[str, set[str]],
+    outputs: Sequence[str],
+    provider: MemoryRequirementsProvider,
+) -> dict[str, tuple[int, int, int, str]]:
+    """(bytes, alignment, memory_type_bits, tiling) per used resource."""
+    out = {}
+    for name in sorted(used):
+        res = resources[name]
+        usages = sorted(used[name] | ({"transfer_src"} if name in outputs or res.lifetime == "output" else set()))
+        try:
+            if res.is_image:
+                assert res.format is not None
+                size, align, bits = provider.image(
+                    res.format.vk_name, res.extent, res.mips, res.layers, res.samples, usages
+                )
+                tiling = "optimal"
+            else:
+                size, align, bits = provider.buffer(res.bytes, usages)
+                tiling = "linear"
+        except RGraphError as err:
+            raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None
+        out[name] = (size, align, bits, tiling)
+    return out
+
+
+def memory_classes(reqs: Mapping[str, tuple[int, int, int, str]]) -> dict[str, str]:
+    """Class per resource: tiling, plus the memoryTypeBits when a tiling has several."""
+    bits_by_tiling: dict[str, set[int]] = {}
+    for _, _, bits, tiling in reqs.values():
+        bits_by_tiling.setdefault(tiling, set()).add(bits)
+    out = {}
+    for name, (_, _, bits, tiling) in reqs.items():
+        cls = f"device_local_{tiling}"
+        out[name] = cls if len(bits_by_tiling[tiling]) == 1 else f"{cls}_types_{bits:x}"
+    return out
+
+
+def place_resources(
+    resources: Mapping[str, ResourceSpec],
+    reqs: Mapping[str, tuple[int, int, int, str]],
+    classes: Mapping[str, str],
+    spans: Mapping[str, tuple[int, int]],
+    policy: str,
+    outputs: Sequence[str],
+) -> Placement:
+    """Place transients with ``policy``; give every other resource its own heap."""
+    aliasable = [
+        n for n in sorted(reqs) if resources[n].lifetime == "transient" and n not in outputs
+    ]
+    blocks = [
+        Block(n, spans[n][0], spans[n][1], reqs[n][0], reqs[n][1], classes[n]) for n in aliasable
+    ]
+    from rgraph.memory import place
+
+    placed = place(blocks, policy)
+    offsets = dict(placed.offsets)
+    heaps = list(placed.heaps)
+    extra = 0
+    for n in sorted(set(reqs) - set(aliasable)):
+        heap = Heap(len(heaps), reqs[n][0], classes[n], reqs[n][1])
+        heaps.append(heap)
+        offsets[n] = (heap.id, 0)
+        extra += reqs[n][0]
+    s = placed.stats
+    stats = PlacementStats(
+        s.policy, s.peak_bytes + extra, s.lower_bound_bytes + extra, s.unaliased_bytes + extra,
+        s.allocations + len(reqs) - len(aliasable), s.seconds,
+    )
+    return Placement(offsets, heaps, stats)
+
+
+def alias_sources(placement: Placement, reqs, spans: Mapping[str, tuple[int, int]]) -> dict[str, list[str]]:
+    """For each resource, the earlier resources whose memory it reuses and that it must wait for.
+
+    An earlier overlapping resource is skipped when a later one, itself overlapping both,
+    already waited for it (the chain covers it)."""
+    by_heap: dict[int, list[str]] = {}
+    for name, (heap, _) in placement.offsets.items():
+        by_heap.setdefault(heap, []).append(name)
+    out: dict[str, list[str]] = {}
+    for names in by_heap.values():
+        if len(names) < 2:
+            continue
+        ordered = sorted(names, key=lambda n: (spans[n][0], n))
+        for i, r in enumerate(ordered):
+            r_lo, r_hi = _range(placement, reqs, r)
+            preds = [
+                p for p in ordered[:i]
+                if spans[p][1] < spans[r][0] and _overlaps((r_lo, r_hi), _range(placement, reqs, p))
+            ]
+            keep = []
+            for p in preds:
+                p_rng = _intersect(_range(placement, reqs, p), (r_lo, r_hi))
+                covered = any(
+                    q != p and spans[p][1] < spans[q][0] and _contains(_range(placement, reqs, q), p_rng)
+                    for q in preds
+                )
+                if not covered:
+                    keep.append(p)
+            if keep:
+                out[r] = keep
+    return out
+
+
+def _range(placement: Placement, reqs, name: str) -> tuple[int, int]:
+    off = placement.offsets[name][1]
+    return off, off + reqs[name][0]
+
+
+def _overlaps(a: tuple[int, int], b: tuple[int, int]) -> bool:
+    return a[0] < b[1] and b[0] < a[1]
+
+
+def _intersect(a: tuple[int, int], b: tuple[int, int]) -> tuple[int, int]:
+    return max(a[0], b[0]), min(a[1], b[1])
+
+
+def _contains(outer: tuple[int, int], inner: tuple[int, int]) -> bool:
+    return outer[0] <= inner[0] and inner[1] <= outer[1]

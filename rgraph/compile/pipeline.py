@@ -1,0 +1,118 @@
+"""Graph file + scene + params -> plan: the compiler's stages in order.
+
+    load -> specialize -> cull -> schedule -> lifetimes/placement -> sync -> plan
+
+Each stage is a pure function of the previous one's value; only the memory-requirements
+provider may talk to a device.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rgraph.compile import memory
+from rgraph.compile.memory import MemoryRequirementsProvider
+from rgraph.compile.sync import synchronize
+from rgraph.errors import RGraphError
+from rgraph.ir.cull import cull
+from rgraph.plan import build_plan
+from rgraph.resources import resolve_graph
+from rgraph.spec.loader import GraphSource, load_graph
+from rgraph.spec.scene import ALL_PRESENT, Scene, load_scene
+from rgraph.spec.specialize import Spec, resolve_params, specialize
+
+DEFAULT_SIZE = (1920, 1080)
+DEFAULT_POLICY = "aliased"
+DEFAULT_PROFILE = "lavapipe"
+
+
+@dataclass
+class Frontend:
+    """What ``validate`` needs: the loaded graph, its scene and the specialized spec."""
+
+    source: GraphSource
+    scene: Scene | None
+    spec: Spec
+
+
+def load_scene_for(source: GraphSource, scene_path: str | Path | None) -> Scene | None:
+    if scene_path is not None:
+        return load_scene(scene_path)
+    if source.default_scene is not None:
+        if not source.default_scene.is_file():
+            raise RGraphError.at(
+                source.passes[next(iter(source.passes))].smap.value(("scene",)) if source.passes else
+                RGraphError.in_file(source.path, "").first.location,
+                f"default scene '{source.default_scene}' not found",
+            )
+        return load_scene(source.default_scene)
+    return None
+
+
+def frontend(
+    graph: str | Path,
+    scene_path: str | Path | None = None,
+    params: Mapping[str, str] | None = None,
+    size: tuple[int, int] = DEFAULT_SIZE,
+) -> Frontend:
+    source = load_graph(resolve_graph(str(graph)))
+    scene = load_scene_for(source, scene_path)
+    features = scene.features if scene else ALL_PRESENT
+    resolved = resolve_params(source, params or {})
+    spec = specialize(source, features=features, params=resolved, size=size, scene_name=scene.name if scene else None)
+    return Frontend(source, scene, spec)
+
+
+def compile_spec(
+    spec: Spec,
+    *,
+    policy: str = DEFAULT_POLICY,
+    memory_provider: MemoryRequirementsProvider | None = None,
+    profile_name: str | None = None,
+) -> dict[str, Any]:
+    """Spec -> plan dict (the part benchmarked by benchmarks/compile_scaling.py)."""
+    culling = cull(spec)
+    passes = culling.passes  # schedule: declaration order minus culled passes
+    if memory_provider is None:
+        from rgraph.memory_requirements import ProfileMemoryRequirements
+
+        memory_provider = ProfileMemoryRequirements.named(DEFAULT_PROFILE)
+        profile_name = profile_name or DEFAULT_PROFILE
+    used = memory.usages_by_resource(passes)
+    spans = memory.lifetimes(passes)
+    reqs = memory.requirements(spec.resources, used, spec.outputs, memory_provider)
+    classes = memory.memory_classes(reqs)
+    try:
+        placement = memory.place_resources(spec.resources, reqs, classes, spans, policy, spec.outputs)
+    except ValueError as exc:
+        raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
+    aliases = memory.alias_sources(placement, reqs, spans)
+    sync = synchronize(passes, spec.resources, aliases)
+    return build_plan(
+        spec, culling, passes, sync, placement, reqs, classes, spans, used, profile_name or "device"
+    )
+
+
+def compile_graph(
+    graph: str | Path,
+    scene_path: str | Path | None = None,
+    params: Mapping[str, str] | None = None,
+    size: tuple[int, int] = DEFAULT_SIZE,
+    policy: str | None = None,
+    memory: MemoryRequirementsProvider | None = None,
+    profile: str | None = None,
+) -> dict[str, Any]:
+    """Compile a graph file (or bundled graph name) into a plan dict."""
+    front = frontend(graph, scene_path, params, size)
+    provider = memory
+    profile_name = None
+    if provider is None and profile is not None:
+        from rgraph.memory_requirements import ProfileMemoryRequirements
+
+        provider = ProfileMemoryRequirements.named(profile)
+        profile_name = provider.name
+    chosen = policy or front.source.memory_policy or DEFAULT_POLICY
+    return compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name)

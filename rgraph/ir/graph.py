@@ -1,0 +1,81 @@
+"""The dependency graph of passes: a networkx DiGraph with one edge per hazard kind.
+
+Nodes are pass names (attribute ``order``: declaration order). An edge ``u -> v`` carries
+``kinds`` (subset of RAW, WAR, WAW) and ``resources``. Dependencies are found per
+subresource cell (resource, mip, layer), like SSA renaming of each cell.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+
+import networkx as nx
+
+from rgraph.spec.specialize import AccessSpec, PassSpec
+
+READ_WRITE_USAGES = frozenset({"color_attachment_blend", "depth_attachment", "storage_rw"})
+
+Cell = tuple[str, int, int]
+
+
+def cells(access: AccessSpec) -> Iterator[Cell]:
+    """The (resource, mip, layer) cells an access touches; buffers have the one cell (0, 0)."""
+    if access.mips is None or access.layers is None:
+        yield (access.resource, 0, 0)
+        return
+    for mip in range(*access.mips):
+        for layer in range(*access.layers):
+            yield (access.resource, mip, layer)
+
+
+def reads(access: AccessSpec) -> bool:
+    return not access.write or access.usage in READ_WRITE_USAGES
+
+
+def build_graph(passes: Iterable[PassSpec]) -> nx.DiGraph:
+    """RAW, WAR and WAW edges between passes, in declaration (program) order."""
+    graph = nx.DiGraph()
+    last_writer: dict[Cell, str] = {}
+    readers: dict[Cell, list[str]] = {}
+
+    def add(u: str, v: str, kind: str, resource: str) -> None:
+        if u == v:
+            return
+        if graph.has_edge(u, v):
+            data = graph.edges[u, v]
+            data["kinds"].add(kind)
+            data["resources"].add(resource)
+        else:
+            graph.add_edge(u, v, kinds={kind}, resources={resource})
+
+    for p in passes:
+        graph.add_node(p.name, order=p.order)
+        for access in p.accesses:
+            for cell in cells(access):
+                writer = last_writer.get(cell)
+                if reads(access) and writer is not None:
+                    add(writer, p.name, "RAW", access.resource)
+                if access.write:
+                    for reader in readers.get(cell, ()):
+                        add(reader, p.name, "WAR", access.resource)
+                    if writer is not None:
+                        add(writer, p.name, "WAW", access.resource)
+        for access in p.accesses:
+            for cell in cells(access):
+                if access.write:
+                    last_writer[cell] = p.name
+                    readers[cell] = []
+                else:
+                    readers.setdefault(cell, []).append(p.name)
+    return graph
+
+
+def last_writers(passes: Iterable[PassSpec], resources: set[str]) -> set[str]:
+    """Passes whose writes to ``resources`` survive to the end of the frame."""
+    final: dict[Cell, str] = {}
+    for p in passes:
+        for access in p.accesses:
+            if access.write and access.resource in resources:
+                for cell in cells(access):
+                    final[cell] = p.name
+    return set(final.values())

@@ -1,0 +1,163 @@
+"""The scene file (FORMAT.md section 2) and the features a graph's ``requires`` sees."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from rgraph.errors import RGraphError
+from rgraph.spec.pydantic_errors import translate
+from rgraph.spec.vocabulary import SCENE_FEATURES
+from rgraph.spec.yaml_source import SourceMap, load_yaml
+
+SCENE_VERSION = 1
+LARGE_WORLD_METERS = 1e5
+
+Vec3 = list[float | int]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Camera(_Strict):
+    position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 1.0], min_length=3, max_length=3)
+    look_at: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+    up: Vec3 = Field(default_factory=lambda: [0.0, 1.0, 0.0], min_length=3, max_length=3)
+    fov_y: float = Field(45.0, gt=0, lt=180)
+    near: float = Field(0.01, gt=0)
+
+
+class Light(_Strict):
+    type: Literal["directional", "point", "spot"]
+    direction: Vec3 | None = Field(None, min_length=3, max_length=3)
+    position: Vec3 | None = Field(None, min_length=3, max_length=3)
+    color: Vec3 = Field(default_factory=lambda: [1.0, 1.0, 1.0], min_length=3, max_length=3)
+    intensity: float = Field(1.0, ge=0)
+    radius: float = Field(1.0, gt=0)
+    shadows: bool = False
+
+
+class Material(_Strict):
+    base_color: Vec3 = Field(default_factory=lambda: [0.8, 0.8, 0.8], min_length=3, max_length=3)
+    roughness: float = Field(0.5, ge=0, le=1)
+    metallic: float = Field(0.0, ge=0, le=1)
+    sss: float = Field(0.0, ge=0, le=1)
+    reflective: float = Field(0.0, ge=0, le=1)
+    refractive: float = Field(0.0, ge=0, le=1)
+    ior: float = Field(1.5, gt=0)
+    opacity: float = Field(1.0, ge=0, le=1)
+    emissive: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+    baked_ao: float = Field(1.0, ge=0, le=1)
+
+
+class Instances(_Strict):
+    grid: list[int] = Field(min_length=3, max_length=3)
+    spacing: float = 1.0
+
+
+class Mesh(_Strict):
+    shape: Literal["box", "sphere", "cylinder", "capsule", "torus", "plane", "tube", "neck", "blob", "segments"]
+    params: dict[str, float | int] = Field(default_factory=dict)
+    material: str
+    deformable: bool = False
+    position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+    rotation: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+    scale: float | Vec3 = 1.0
+    instances: Instances | None = None
+    seed: int = 0
+
+
+class Decal(_Strict):
+    material: str
+    position: Vec3 = Field(min_length=3, max_length=3)
+    size: Vec3 = Field(min_length=3, max_length=3)
+    rotation: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+
+
+class SceneFile(_Strict):
+    scene: int
+    name: str | None = None
+    camera: Camera = Field(default_factory=Camera)
+    lights: list[Light] = Field(default_factory=list)
+    materials: dict[str, Material] = Field(default_factory=dict)
+    meshes: list[Mesh] = Field(default_factory=list)
+    decals: list[Decal] = Field(default_factory=list)
+    decal_materials: dict[str, Material] = Field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    path: Path | None
+    model: SceneFile
+    features: dict[str, int]
+
+
+def features_of(scene: SceneFile) -> dict[str, int]:
+    """Scene features (FORMAT.md 1): counts, zero meaning absent. Material features count
+    the materials some mesh actually uses."""
+    used = {m.material for m in scene.meshes}
+    mats = [mat for name, mat in sorted(scene.materials.items()) if name in used]
+    far = max(
+        [math.dist(scene.camera.position, (0, 0, 0))]
+        + [math.dist(m.position, (0, 0, 0)) for m in scene.meshes],
+    )
+    feats = {
+        "lights": len(scene.lights),
+        "point_lights": sum(1 for light in scene.lights if light.type in ("point", "spot")),
+        "shadow_lights": sum(1 for light in scene.lights if light.type == "directional" and light.shadows),
+        "sss_materials": sum(1 for m in mats if m.sss > 0),
+        "decals": len(scene.decals),
+        "reflective_materials": sum(1 for m in mats if m.reflective > 0 or m.metallic > 0.5),
+        "refractive_materials": sum(1 for m in mats if m.refractive > 0),
+        "transparent_materials": sum(1 for m in mats if m.opacity < 1),
+        "deformable_meshes": sum(1 for m in scene.meshes if m.deformable),
+        "large_world": int(far > LARGE_WORLD_METERS),
+    }
+    assert set(feats) == set(SCENE_FEATURES)
+    return feats
+
+
+ALL_PRESENT = {name: 1 for name in SCENE_FEATURES}
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Load and validate a scene file; unknown materials are errors at the reference."""
+    p = Path(path)
+    data, smap = load_yaml(p, str(path))
+    if not isinstance(data, dict):
+        raise RGraphError.at(smap.value(()), "a scene file must be a mapping with 'scene: 1'")
+    if "rgraph" in data and "scene" not in data:
+        raise RGraphError.at(smap.key(("rgraph",)), "this is a graph file, not a scene file (expected 'scene: 1')")
+    if data.get("scene") != SCENE_VERSION or isinstance(data.get("scene"), bool):
+        where = smap.value(("scene",)) if "scene" in data else smap.value(())
+        raise RGraphError.at(where, f"unsupported or missing scene version; expected 'scene: {SCENE_VERSION}'")
+    try:
+        model = SceneFile.model_validate(data)
+    except ValidationError as exc:
+        raise translate(exc, smap, SceneFile, data) from None
+    _check_references(model, smap)
+    return Scene(model.name or p.stem, p, model, features_of(model))
+
+
+def _check_references(model: SceneFile, smap: SourceMap) -> None:
+    from rgraph.spec.pydantic_errors import did_you_mean
+
+    for i, mesh in enumerate(model.meshes):
+        if mesh.material not in model.materials:
+            raise RGraphError.at(
+                smap.value(("meshes", i, "material")),
+                f"unknown material '{mesh.material}'{did_you_mean(mesh.material, model.materials)}",
+            )
+    for i, decal in enumerate(model.decals):
+        pool = {**model.materials, **model.decal_materials}
+        if decal.material not in pool and decal.material != "blood":
+            raise RGraphError.at(
+                smap.value(("decals", i, "material")),
+                f"unknown decal material '{decal.material}'{did_you_mean(decal.material, pool)}",
+            )

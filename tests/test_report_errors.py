@@ -77,9 +77,8 @@ def test_unwritable_outputs(capsys, tmp_path):
 
 
 def test_parse_param_and_size():
-    assert parse_param("hbao.directions=8") == ("hbao.directions", 8)
-    assert parse_param("scale=0.5") == ("scale", 0.5)
-    assert parse_param("taa=false") == ("taa", False)
+    assert parse_param("hbao.directions=8") == ("hbao.directions", "8")
+    assert parse_param("expr=a=b") == ("expr", "a=b")
     assert parse_param("mode = fast") == ("mode", "fast")
     assert parse_size("640x360") == (640, 360)
     for bad in ("640", "x360", "0x10", "ax b"):
@@ -87,3 +86,27 @@ def test_parse_param_and_size():
             parse_size(bad)
     with pytest.raises(RGraphError, match="NAME=VALUE"):
         parse_param("novalue")
+
+
+def test_graph_arguments_are_compiled_with_the_flags(capsys, monkeypatch):
+    """A non-.json argument goes to compile_graph with scene, params, size, policy and profile."""
+    import sys
+    import types
+
+    calls = []
+
+    def fake_compile_graph(graph, scene_path=None, **options):
+        calls.append((graph, scene_path, options))
+        return load(FORWARD)
+
+    fake = types.ModuleType("rgraph.compile.pipeline")
+    fake.compile_graph = fake_compile_graph
+    monkeypatch.setitem(sys.modules, "rgraph.compile.pipeline", fake)
+    code, out, _ = inspect(capsys, "surgery", "--scene", "cct", "-p", "hbao.directions=4", "-p", "taa=false",
+                           "--size", "640x360", "--policy", "dedicated", "--profile", "lavapipe")
+    assert code == 0 and "Schedule (8 passes)" in out
+    assert calls == [("surgery", "cct", {"params": {"hbao.directions": "4", "taa": "false"}, "policy": "dedicated",
+                                         "size": (640, 360), "profile": "lavapipe"})]
+    calls.clear()
+    inspect(capsys, "graphs/surgery.yaml")
+    assert calls == [("graphs/surgery.yaml", None, {"params": {}, "policy": None})]

@@ -37,27 +37,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="override a graph parameter (when compiling a graph)")
     parser.add_argument("--size", metavar="WxH", help="output size (when compiling a graph)")
     parser.add_argument("--policy", metavar="P", help="memory placement policy (when compiling a graph)")
+    parser.add_argument("--profile", metavar="D", help="device profile for memory sizes (when compiling a graph)")
     parser.set_defaults(func=run)
 
 
-def parse_param(text: str) -> tuple[str, Any]:
-    """``k=v`` with ``v`` read as an int, float, bool or else a string."""
+def parse_param(text: str) -> tuple[str, str]:
+    """``k=v`` -> (k, v); the compiler reads the value against the graph's declared param."""
     key, sep, value = text.partition("=")
     if not sep or not key.strip():
         raise RGraphError.in_file(COMMAND_LINE, f"-p expects NAME=VALUE, got {text!r}")
-    return key.strip(), parse_value(value.strip())
-
-
-def parse_value(value: str) -> Any:
-    lowered = value.lower()
-    if lowered in ("true", "false"):
-        return lowered == "true"
-    for kind in (int, float):
-        try:
-            return kind(value)
-        except ValueError:
-            pass
-    return value
+    return key.strip(), value.strip()
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -71,7 +60,7 @@ def parse_size(text: str) -> tuple[int, int]:
 def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     """Load the plan file, or compile the graph with the given scene, params, size and policy."""
     target: str = args.target
-    compile_flags = [f for f in ("scene", "size", "policy") if getattr(args, f)] + (["-p"] if args.params else [])
+    compile_flags = [f for f in ("scene", "size", "policy", "profile") if getattr(args, f)] + (["-p"] if args.params else [])
     if target.endswith(".json"):
         if compile_flags:
             raise RGraphError.in_file(
@@ -80,9 +69,12 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
         return load_plan(target)
     from rgraph.compile.pipeline import compile_graph
 
-    params = dict(parse_param(p) for p in args.params)
-    size = parse_size(args.size) if args.size else None
-    plan = compile_graph(target, scene_path=args.scene, params=params, size=size, policy=args.policy)
+    options: dict[str, Any] = {"params": dict(parse_param(p) for p in args.params), "policy": args.policy}
+    if args.size:
+        options["size"] = parse_size(args.size)
+    if args.profile:
+        options["profile"] = args.profile
+    plan = compile_graph(target, scene_path=args.scene, **options)
     check_plan(plan, target)
     return plan
 

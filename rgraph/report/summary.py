@@ -97,7 +97,8 @@ def stats_lines(plan: Plan) -> list[str]:
     unaliased = stats.get("unaliased_bytes")
     allocations = stats.get("allocations", len(plan.get("heaps") or []))
     rows = [("barriers", barrier_text), ("semaphores", str(stats.get("semaphores", "-")))]
-    rows.append(("peak", f"{bytes_exact(peak)} in {plural(allocations, 'allocation')}"))
+    if peak is not None:
+        rows.append(("peak", f"{bytes_exact(peak)} in {plural(allocations, 'allocation')}"))
     if lower is not None:
         ratio = f", peak/lower bound {peak / lower:.3f}" if peak is not None and lower else ""
         rows.append(("lower bound", f"{bytes_exact(lower)}{ratio}"))

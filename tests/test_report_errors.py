@@ -7,7 +7,6 @@ import json
 import pytest
 from report_plans.helpers import FORWARD, inspect, load
 
-from rgraph.commands.inspect import parse_param, parse_size
 from rgraph.errors import RGraphError
 from rgraph.report.plan_file import check_plan, load_plan
 
@@ -76,18 +75,6 @@ def test_unwritable_outputs(capsys, tmp_path):
         assert err.startswith(f"{missing / name}:1:1: error: cannot write"), err
 
 
-def test_parse_param_and_size():
-    assert parse_param("hbao.directions=8") == ("hbao.directions", "8")
-    assert parse_param("expr=a=b") == ("expr", "a=b")
-    assert parse_param("mode = fast") == ("mode", "fast")
-    assert parse_size("640x360") == (640, 360)
-    for bad in ("640", "x360", "0x10", "ax b"):
-        with pytest.raises(RGraphError):
-            parse_size(bad)
-    with pytest.raises(RGraphError, match="NAME=VALUE"):
-        parse_param("novalue")
-
-
 def test_graph_arguments_are_compiled_with_the_flags(capsys, monkeypatch):
     """A non-.json argument goes to compile_graph with scene, params, size, policy and profile."""
     import sys
@@ -107,6 +94,8 @@ def test_graph_arguments_are_compiled_with_the_flags(capsys, monkeypatch):
     assert code == 0 and "Schedule (8 passes)" in out
     assert calls == [("surgery", "cct", {"params": {"hbao.directions": "4", "taa": "false"}, "policy": "dedicated",
                                          "size": (640, 360), "profile": "lavapipe"})]
+    code, _, err = inspect(capsys, "surgery", "-p", "novalue")
+    assert code == 2 and err.startswith("<command line>:1:1: error: -p expects name=value")
     calls.clear()
     inspect(capsys, "graphs/surgery.yaml")
     assert calls == [("graphs/surgery.yaml", None, {"params": {}, "policy": None})]

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from report_plans.helpers import FORWARD, MINIMAL, inspect
+import json
+
+from report_plans.helpers import FORWARD, MINIMAL, inspect, load
 
 
 def lines_of(text: str) -> list[str]:
@@ -157,3 +159,17 @@ def test_views_combine(capsys):
     _, memory, _ = inspect(capsys, str(FORWARD), "--memory")
     assert both == barriers + "\n" + memory
     assert "Schedule" not in both
+
+
+def test_aliases_may_be_a_list_and_extra_header_keys_show(capsys, tmp_path):
+    plan = load(FORWARD)
+    plan["passes"][5]["barriers"][0]["aliases"] = ["depth", "shadow_maps"]
+    plan["outputs"] = ["color"]
+    plan["features"] = {"lights": 2, "sss_materials": 0}
+    path = tmp_path / "listed.json"
+    path.write_text(json.dumps(plan))
+    _, out, _ = inspect(capsys, str(path), "--barriers")
+    assert any(line.endswith("(aliases depth, shadow_maps)") for line in lines_of(out))
+    _, out, _ = inspect(capsys, str(path))
+    assert "outputs  color" in lines_of(out)
+    assert "features lights=2 sss_materials=0" in lines_of(out)

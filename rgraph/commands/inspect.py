@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 from typing import Any, TextIO
 
+from rgraph.commands.common import parse_params, parse_size
 from rgraph.errors import RGraphError
 from rgraph.report.plan_file import check_plan, load_plan
 
@@ -41,22 +42,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run)
 
 
-def parse_param(text: str) -> tuple[str, str]:
-    """``k=v`` -> (k, v); the compiler reads the value against the graph's declared param."""
-    key, sep, value = text.partition("=")
-    if not sep or not key.strip():
-        raise RGraphError.in_file(COMMAND_LINE, f"-p expects NAME=VALUE, got {text!r}")
-    return key.strip(), value.strip()
-
-
-def parse_size(text: str) -> tuple[int, int]:
-    """``1920x1080`` -> (1920, 1080)."""
-    w, sep, h = text.lower().partition("x")
-    if sep and w.isdigit() and h.isdigit() and int(w) > 0 and int(h) > 0:
-        return int(w), int(h)
-    raise RGraphError.in_file(COMMAND_LINE, f"--size expects WIDTHxHEIGHT such as 1920x1080, got {text!r}")
-
-
 def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     """Load the plan file, or compile the graph with the given scene, params, size and policy."""
     target: str = args.target
@@ -69,7 +54,7 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
         return load_plan(target)
     from rgraph.compile.pipeline import compile_graph
 
-    options: dict[str, Any] = {"params": dict(parse_param(p) for p in args.params), "policy": args.policy}
+    options: dict[str, Any] = {"params": parse_params(args.params), "policy": args.policy}
     if args.size:
         options["size"] = parse_size(args.size)
     if args.profile:

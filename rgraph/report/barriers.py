@@ -20,8 +20,9 @@ def barrier_text(b: dict[str, Any], transfer_word: str) -> str:
     src_q, dst_q = src.get("queue"), dst.get("queue")
     if src_q and dst_q and src_q != dst_q:
         text += f" {transfer_word} {src_q}->{dst_q}"
-    if b.get("aliases"):
-        text += f" (aliases {b['aliases']})"
+    aliases = b.get("aliases")
+    if aliases:  # docs/plan.md: a name; the compiler may list several previous occupants
+        text += f" (aliases {aliases if isinstance(aliases, str) else ', '.join(aliases)})"
     return text
 
 

@@ -124,7 +124,10 @@ def check_plan(plan: Any, file: str) -> None:
 
     def barrier(b: dict[str, Any], at: str) -> None:
         c.field(b, "resource", at, str_, "a resource name")
-        c.field(b, "aliases", at, opt_str, "a resource name or null", required=False)
+        aliases = c.field(b, "aliases", at, (str, list, type(None)), "resource name(s) or null", required=False)
+        if isinstance(aliases, list):
+            for i, name in enumerate(aliases):
+                c.typed(name, f"{at}.aliases[{i}]", str_, "a resource name")
         sub(b, at)
         state(b, "src", at)
         state(b, "dst", at)

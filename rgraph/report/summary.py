@@ -26,6 +26,11 @@ def header_lines(plan: Plan) -> list[str]:
         ("policy", stats.get("policy") or "-"),
         ("queues", ", ".join(plan.get("queues") or []) or "-"),
     ]
+    if plan.get("outputs"):
+        rows.append(("outputs", ", ".join(plan["outputs"])))
+    features = plan.get("features") or {}
+    if features:
+        rows.append(("features", " ".join(f"{k}={param_value(features[k])}" for k in sorted(features))))
     return [f"{key:<8} {value}" for key, value in rows]
 
 

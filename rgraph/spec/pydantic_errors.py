@@ -145,7 +145,7 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
             msg = f"'{_field_name(loc)}': {err['msg'].lower()}"
         else:
             msg = f"'{_field_name(loc)}': {err['msg']}"
-        if loc and loc[-1] == "size" and kind not in ("extra_forbidden", "missing"):
+        if len(loc) == 3 and loc[0] == "resources" and loc[-1] == "size" and kind not in ("extra_forbidden", "missing"):
             msg = f"size must be 'output', [width, height] or {{scale: s}}, got {describe(value)}"
         location = smap.key(loc) if at_key else smap.value(loc)
         sig = (str(location), "")  # one message per place: union branches repeat themselves

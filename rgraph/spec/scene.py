@@ -62,7 +62,7 @@ class Instances(_Strict):
 
 class Mesh(_Strict):
     shape: Literal["box", "sphere", "cylinder", "capsule", "torus", "plane", "tube", "neck", "blob", "segments"]
-    params: dict[str, float | int] = Field(default_factory=dict)
+    params: dict[str, float | int | list[float | int]] = Field(default_factory=dict)
     material: str
     deformable: bool = False
     position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)

@@ -10,7 +10,7 @@ import pytest
 from report_plans.helpers import FORWARD, MINIMAL, inspect, load
 
 from rgraph.report.html import plan_html
-from rgraph.report.timeline import live_bytes, placed_blocks, timeline_title, write_timeline_png
+from rgraph.report.timeline import class_layout, live_bytes, placed_blocks, timeline_title, write_timeline_png
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -32,6 +32,13 @@ def test_blocks_from_the_plan():
     live = live_bytes(heap0, len(plan["passes"]))
     assert max(live) == 58654720 == plan["heaps"][0]["bytes"]  # heap 0 is as small as it can be
     assert live[4] == 58654720 and live[0] == 0
+
+
+def test_heaps_stack_per_memory_class():
+    assert class_layout(load(FORWARD)) == {
+        "device_local_linear": [(2, 0, 256)],
+        "device_local_optimal": [(0, 0, 58654720), (1, 58654720, 16646144)],
+    }
 
 
 def test_title():

@@ -1,6 +1,7 @@
 """The ``--timeline`` view: the plan's memory placement drawn as a PNG.
 
-Pass index runs across, heap offset up; one rectangle per placed resource. When
+Pass index runs across, offset up (a panel per memory class, its heaps stacked in id
+order); one rectangle per placed resource. When
 ``rgraph.memory.timeline.draw_timeline(blocks, placement, path, title)`` exists it does the
 drawing from blocks converted out of the plan; otherwise this module draws it itself.
 """
@@ -125,8 +126,18 @@ def _to_memory_model(plan: Plan) -> tuple[list[Any], Any]:
     return blocks, placement
 
 
+def class_layout(plan: Plan) -> dict[str, list[tuple[int, int, int]]]:
+    """Per memory class (sorted), its heaps as (heap id, base, bytes), stacked in id order."""
+    layout: dict[str, list[tuple[int, int, int]]] = {}
+    for h in sorted(plan.get("heaps") or [], key=lambda h: h["id"]):
+        column = layout.setdefault(h.get("memory_class") or "-", [])
+        base = column[-1][1] + column[-1][2] if column else 0
+        column.append((h["id"], base, h["bytes"]))
+    return dict(sorted(layout.items()))
+
+
 def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
-    """This module's own drawing: one panel per heap, rectangles in MiB over pass indices."""
+    """This module's own drawing: one panel per memory class, its heaps stacked bottom-up."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import Rectangle
@@ -134,47 +145,51 @@ def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
     passes = plan["passes"]
     n = max(len(passes), 1)
     blocks = placed_blocks(plan)
-    heaps = sorted(plan.get("heaps") or [], key=lambda h: h["id"])
-    heap_ids = [h["id"] for h in heaps] or sorted({b.heap for b in blocks}) or [0]
-    heap_bytes = {h["id"]: h["bytes"] for h in heaps}
-    heap_class = {h["id"]: h.get("memory_class") or "-" for h in heaps}
-
-    biggest = max([heap_bytes.get(h, 0) for h in heap_ids] + [1])
-    ratios = [min(max((max(heap_bytes.get(h, 0), 1) / biggest) ** 0.5, 0.3), 1.0) for h in heap_ids]
-    fig = Figure(figsize=(max(9.0, 1.1 * n + 4), 2.0 + 3.2 * sum(ratios)), dpi=100)
+    layout = class_layout(plan) or {"-": [(b, 0, 0) for b in sorted({b.heap for b in blocks})]}
+    heap_base = {heap: base for column in layout.values() for heap, base, _ in column}
+    totals = {cls: max([base + size for _, base, size in column] + [1]) for cls, column in layout.items()}
+    biggest = max(totals.values())
+    ratios = [min(max((totals[cls] / biggest) ** 0.5, 0.35), 1.0) for cls in layout]
+    fig = Figure(figsize=(max(9.0, 1.1 * n + 4), 2.0 + 3.6 * sum(ratios)), dpi=100)
     FigureCanvasAgg(fig)
-    axes = fig.subplots(len(heap_ids), 1, sharex=True, squeeze=False, height_ratios=ratios)[:, 0]
+    axes = fig.subplots(len(layout), 1, sharex=True, squeeze=False, height_ratios=ratios)[:, 0]
     palette = [
         "#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948",
         "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac",
     ]
-    for ax, heap_id in zip(axes, heap_ids, strict=True):
-        members = [b for b in blocks if b.heap == heap_id]
+    for ax, (cls, column) in zip(axes, layout.items(), strict=True):
+        heaps = {heap for heap, _, _ in column}
+        members = [b for b in blocks if b.heap in heaps]
         live = live_bytes(members, len(passes))
         bound = max(live, default=0)
-        size = heap_bytes.get(heap_id, max((b.offset + b.aligned_size for b in members), default=0))
-        top = max([size, bound, 1] + [b.offset + b.aligned_size for b in members])
+        top = max([totals[cls], bound, 1] + [heap_base[b.heap] + b.offset + b.aligned_size for b in members])
         scale, unit = (MIB, "MiB") if top >= MIB else (1024, "KiB") if top >= 1024 else (1, "B")
         for k, b in enumerate(members):
+            bottom = heap_base[b.heap] + b.offset
             ax.add_patch(Rectangle(
-                (b.start - 0.45, b.offset / scale), b.end - b.start + 0.9, b.aligned_size / scale,
+                (b.start - 0.45, bottom / scale), b.end - b.start + 0.9, b.aligned_size / scale,
                 facecolor=palette[k % len(palette)], edgecolor="black", linewidth=0.8, alpha=0.85,
                 hatch=None if b.aliasable else "//",
             ))
             tall = b.aligned_size / top > 0.08
             ax.text(
-                (b.start + b.end) / 2, (b.offset + b.aligned_size / 2) / scale,
+                (b.start + b.end) / 2, (bottom + b.aligned_size / 2) / scale,
                 f"{b.name}\n{human_bytes(b.size)}" if tall else b.name,
                 ha="center", va="center", fontsize=7 if tall else 6, clip_on=True,
             )
+        for heap, base, size in column:
+            ax.axhline((base + size) / scale, color="black", linestyle=":", linewidth=1.0)
+            if size / top > 0.04:
+                ax.text(n - 0.45, (base + size) / scale, f"heap {heap} ", ha="right", va="top", fontsize=7)
         ax.step(range(len(live)), [v / scale for v in live], where="mid", color="#666666", linewidth=0.9,
                 linestyle=(0, (1, 1)), label="live bytes")
         ax.axhline(bound / scale, color="#d62728", linestyle="--", linewidth=1.2,
                    label=f"lower bound {human_bytes(bound)}")
-        ax.axhline(size / scale, color="black", linestyle=":", linewidth=1.2, label=f"heap {human_bytes(size)}")
+        ax.plot([], [], color="black", linestyle=":", linewidth=1.0,
+                label=f"{len(column)} heap{'s' if len(column) != 1 else ''}: {human_bytes(totals[cls])}")
         ax.set_ylim(0, top / scale * 1.08)
         ax.set_ylabel(f"offset ({unit})")
-        ax.set_title(f"heap {heap_id} ({heap_class.get(heap_id, '-')})", fontsize=9, loc="left")
+        ax.set_title(cls, fontsize=9, loc="left")
         ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=7, framealpha=0.8)
         ax.grid(axis="y", alpha=0.3)
     axes[-1].set_xlim(-0.6, n - 0.4)

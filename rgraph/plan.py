@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping, Sequence
+from functools import lru_cache
 from typing import Any
 
 from rgraph.compile.sync import Barrier, State, SyncResult
@@ -21,13 +22,14 @@ def dumps(plan: Mapping[str, Any]) -> str:
     return json.dumps(plan, sort_keys=True, indent=1, ensure_ascii=True) + "\n"
 
 
+@lru_cache(maxsize=65536)
+def _state_items(st: State) -> tuple:
+    return (sorted(st.stages), sorted(st.access), st.layout, st.queue)
+
+
 def _state(st: State) -> dict[str, Any]:
-    return {
-        "stages": sorted(st.stages),
-        "access": sorted(st.access),
-        "layout": st.layout,
-        "queue": st.queue,
-    }
+    stages, access, layout, queue = _state_items(st)
+    return {"stages": list(stages), "access": list(access), "layout": layout, "queue": queue}
 
 
 def _subresource(res: ResourceSpec, mips, layers) -> dict[str, list[int]] | None:
@@ -149,6 +151,7 @@ def build_plan(
         plan_resources.append(entry)
     stats = placement.stats
     kept_resources = set(reqs)
+    by_name = {p.name: p for p in spec.passes}
     return {
         "format": PLAN_FORMAT,
         "graph": spec.name,
@@ -160,7 +163,7 @@ def build_plan(
         "device_profile": profile_name,
         "queues": queues,
         "passes": plan_passes,
-        "culled": [_culled_entry(c, spec, kept_resources) for c in culling.culled],
+        "culled": [_culled_entry(c, by_name[c.pass_name], kept_resources) for c in culling.culled],
         "dropped_reads": [
             {"pass": d.pass_name, "resource": d.resource, "reason": d.reason} for d in culling.dropped_reads
         ],
@@ -182,9 +185,8 @@ def build_plan(
     }
 
 
-def _culled_entry(c, spec: Spec, kept_resources: set[str]) -> dict[str, Any]:
+def _culled_entry(c, p: PassSpec, kept_resources: set[str]) -> dict[str, Any]:
     """A culled pass with the resources only it (and other culled passes) used."""
-    p = next(p for p in spec.passes if p.name == c.pass_name)
     only = sorted({a.resource for a in p.accesses} - kept_resources)
     return {"pass": c.pass_name, "reason": c.reason, "resources": only}
 

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from rgraph.errors import RGraphError
-
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
@@ -38,6 +37,10 @@ class ResourceMemory:
     usages: tuple[str, ...]
     first: int | None
     last: int | None
+
+
+# Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
+_SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw"}
 
 
 def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
@@ -77,7 +80,8 @@ def requirements(
                 )
                 tiling = "optimal"
             else:
-                size, align, bits = provider.buffer(res.bytes, usages)
+                flags = sorted({_SAME_BUFFER_FLAG.get(u, u) for u in usages})
+                size, align, bits = provider.buffer(res.bytes, flags)
                 tiling = "linear"
         except RGraphError as err:
             raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None

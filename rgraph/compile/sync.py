@@ -158,8 +158,13 @@ def synchronize(
         return _Cell("UNDEFINED" if res.is_image else None, None, None, [])
 
     # Frame 1 from scratch gives the end-of-frame state; frame 2 starts persistent cells there.
+    # Frame 1 is needed only for persistent cells and for the resources others alias.
+    needed = {r for r, res in resources.items() if res.lifetime in PERSISTENT}
+    needed |= {p for preds in alias_sources.values() for p in preds}
     first = _Simulation(passes, per_pass_cells, timeline, resources, {}, {})
-    first.run({c: fresh(c) for c in timeline})
+    if needed:
+        first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
+        first.run({c: fresh(c) for c in timeline if c[0] in needed})
     final_first = first.final_states()
     start: dict[Cell, _Cell] = {}
     for c in timeline:

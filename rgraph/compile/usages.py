@@ -7,6 +7,7 @@ without prefixes and ``_BIT`` (FORMAT.md section 3).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 # Shader stages of a pass kind, used by sampled/storage/uniform/accel_read usages.
 KIND_SHADER_STAGES: dict[str, tuple[str, ...]] = {
@@ -91,6 +92,7 @@ class Sync:
         return self.access & WRITE_ACCESS
 
 
+@lru_cache(maxsize=4096)
 def sync_of(
     usage: str,
     pass_kind: str,

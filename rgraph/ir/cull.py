@@ -11,10 +11,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import networkx as nx
 
-from rgraph.ir.graph import build_graph, cells, last_writers, reads
+from rgraph.ir.graph import build_graph, cells, dependencies, last_writers, raw_ancestors, reads
 from rgraph.spec.specialize import PassSpec, Spec
 
 
@@ -34,9 +35,13 @@ class DroppedRead:
 @dataclass
 class Culling:
     passes: list[PassSpec]  # kept, declaration order, with dropped reads removed
-    graph: nx.DiGraph
     culled: list[Culled]
     dropped_reads: list[DroppedRead]
+
+    @cached_property
+    def graph(self) -> nx.DiGraph:
+        """The dependency graph of the kept passes (built on first use)."""
+        return build_graph(self.passes)
 
 
 def cull(spec: Spec) -> Culling:
@@ -44,20 +49,12 @@ def cull(spec: Spec) -> Culling:
     culled = [Culled(name, reason) for name, reason in spec.removed]
     kept, dropped, cascade = _drop_unproduced_reads(spec, removed_reason)
     culled += cascade
-    graph = build_graph(kept)
-    roots = _roots(spec, kept)
-    alive: set[str] = set(roots)
-    raw = nx.DiGraph((u, v) for u, v, d in graph.edges(data=True) if "RAW" in d["kinds"])
-    raw.add_nodes_from(graph.nodes)
-    for root in roots:
-        alive |= nx.ancestors(raw, root)
+    alive = raw_ancestors(dependencies(kept), _roots(spec, kept))
     final = [p for p in kept if p.name in alive]
     culled += [Culled(p.name, "reaches no output") for p in kept if p.name not in alive]
-    if len(final) != len(kept):
-        graph = build_graph(final)
     order = {p.name: p.order for p in spec.passes}
     culled.sort(key=lambda c: order[c.pass_name])
-    return Culling(final, graph, culled, dropped)
+    return Culling(final, culled, dropped)
 
 
 def _roots(spec: Spec, kept: list[PassSpec]) -> set[str]:

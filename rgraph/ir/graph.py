@@ -32,28 +32,31 @@ def reads(access: AccessSpec) -> bool:
     return not access.write or access.usage in READ_WRITE_USAGES
 
 
-def build_graph(passes: Iterable[PassSpec]) -> nx.DiGraph:
-    """RAW, WAR and WAW edges between passes, in declaration (program) order."""
-    graph = nx.DiGraph()
+Edges = dict[tuple[str, str], tuple[set[str], set[str]]]  # (u, v) -> (kinds, resources)
+
+
+def dependencies(passes: Iterable[PassSpec]) -> Edges:
+    """RAW, WAR and WAW dependencies between passes, in declaration (program) order."""
+    edges: Edges = {}
     last_writer: dict[Cell, str] = {}
     readers: dict[Cell, list[str]] = {}
 
     def add(u: str, v: str, kind: str, resource: str) -> None:
         if u == v:
             return
-        if graph.has_edge(u, v):
-            data = graph.edges[u, v]
-            data["kinds"].add(kind)
-            data["resources"].add(resource)
+        entry = edges.get((u, v))
+        if entry is None:
+            edges[(u, v)] = ({kind}, {resource})
         else:
-            graph.add_edge(u, v, kinds={kind}, resources={resource})
+            entry[0].add(kind)
+            entry[1].add(resource)
 
     for p in passes:
-        graph.add_node(p.name, order=p.order)
         for access in p.accesses:
+            is_read = reads(access)
             for cell in cells(access):
                 writer = last_writer.get(cell)
-                if reads(access) and writer is not None:
+                if is_read and writer is not None:
                     add(writer, p.name, "RAW", access.resource)
                 if access.write:
                     for reader in readers.get(cell, ()):
@@ -67,7 +70,34 @@ def build_graph(passes: Iterable[PassSpec]) -> nx.DiGraph:
                     readers[cell] = []
                 else:
                     readers.setdefault(cell, []).append(p.name)
+    return edges
+
+
+def build_graph(passes: Iterable[PassSpec]) -> nx.DiGraph:
+    """The pass graph as a networkx DiGraph: edge attributes ``kinds`` and ``resources``."""
+    passes = list(passes)
+    graph = nx.DiGraph()
+    graph.add_nodes_from((p.name, {"order": p.order}) for p in passes)
+    graph.add_edges_from(
+        (u, v, {"kinds": kinds, "resources": res}) for (u, v), (kinds, res) in dependencies(passes).items()
+    )
     return graph
+
+
+def raw_ancestors(edges: Edges, roots: Iterable[str]) -> set[str]:
+    """``roots`` and every pass they reach backwards through read-after-write edges."""
+    preds: dict[str, list[str]] = {}
+    for (u, v), (kinds, _) in edges.items():
+        if "RAW" in kinds:
+            preds.setdefault(v, []).append(u)
+    seen = set(roots)
+    stack = list(seen)
+    while stack:
+        for u in preds.get(stack.pop(), ()):
+            if u not in seen:
+                seen.add(u)
+                stack.append(u)
+    return seen
 
 
 def last_writers(passes: Iterable[PassSpec], resources: set[str]) -> set[str]:

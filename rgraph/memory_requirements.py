@@ -142,6 +142,7 @@ class ProfileMemoryRequirements:
 
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
         rule = self.profile["buffer"]
+        usage_names = sorted({"storage_rw" if u.startswith("storage_") else u for u in usage_names})
         unknown = sorted(set(usage_names) - set(rule["alignment_by_usage"]))
         if unknown:
             raise self._error(f"device profile {self.name!r}: no buffer rule for usage {', '.join(unknown)}")

@@ -11,6 +11,8 @@ from rgraph.vk.loader import vk
 #: Usages the runtime always adds: readback of outputs (transfer_src) and initialisation of
 #: persistent/imported resources (transfer_dst). Memory-requirement providers add them too,
 #: so the plan's sizes match what the runtime creates.
+WHOLE_SIZE = 0xFFFFFFFFFFFFFFFF  # VK_WHOLE_SIZE (the binding exposes it as -1)
+
 RUNTIME_USAGES = ("transfer_src", "transfer_dst")
 
 _IMAGE_USAGE = {

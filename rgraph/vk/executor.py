@@ -1,0 +1,539 @@
+"""Execute a plan on a Vulkan device: resources, recorded command buffers, submits, readback.
+
+Command buffers are recorded once per frame-in-flight set (2) and resubmitted; per frame
+only the timeline values in the prebuilt submit structs change. Passes are grouped into
+batches: contiguous runs (in plan order) on one VkQueue, cut before a pass with waits and
+after a pass with signals; one command buffer and one VkSubmitInfo2 per batch, submitted in
+plan order. Frames are paced by fences (the validation layer understands fence waits).
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rgraph.probe.semantics import mip_extent, subresources
+from rgraph.probe.simulate import simulate
+from rgraph.probe.values import codec, initial_value, modulus
+from rgraph.vk import names
+from rgraph.vk.device import Device, create_device
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.instance import Instance, ValidationMessage, create_instance
+from rgraph.vk.loader import vk
+from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
+from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
+from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
+from rgraph.vk.resources import HostBuffer, ResourceSet
+
+FRAMES_IN_FLIGHT = 2
+
+
+@dataclass
+class RunResult:
+    messages: list[ValidationMessage]
+    timings: dict[str, Any]  # {"passes": {name: median ms}, "total_ms": median, "frames": n, "cpu_frame_ms": ...}
+    data_ok: bool | None  # None: not checked
+    device_name: str
+    mismatches: list[Mismatch] = field(default_factory=list)
+    unchecked: list[str] = field(default_factory=list)  # outputs the data check could not predict
+
+
+@dataclass
+class Batch:
+    queue: str  # plan queue of the first pass (all passes share its VkQueue)
+    passes: list[dict]
+    command_buffers: list[Any] = field(default_factory=list)  # per set
+    waits: list[Any] = field(default_factory=list)  # per set: VkSemaphoreSubmitInfo list
+    signals: list[Any] = field(default_factory=list)
+    submit: list[Any] = field(default_factory=list)  # per set: VkSubmitInfo2
+    wait_values: list[tuple[Any, str, int, bool]] = field(default_factory=list)  # (info, queue, value, frame_start)
+    signal_values: list[tuple[Any, str, int, bool]] = field(default_factory=list)
+
+
+def make_batches(plan: dict, device: Device) -> list[Batch]:
+    batches: list[Batch] = []
+    for p in plan["passes"]:
+        last = batches[-1] if batches else None
+        if (last is None or not device.same_queue(last.queue, p["queue"]) or p["waits"]
+                or last.passes[-1]["signals"]):
+            batches.append(Batch(p["queue"], [p]))
+        else:
+            last.passes.append(p)
+    return batches
+
+
+class Executor:
+    """Owns every Vulkan object of one run; ``close`` destroys them in reverse order."""
+
+    def __init__(self, plan: dict, *, validate: bool, device_index: int | None, verbose: bool = True) -> None:
+        if plan.get("format") != "rgraph-plan/1":
+            raise ExecutionError("not an rgraph plan (format != rgraph-plan/1)")
+        self.plan = plan
+        self.verbose = verbose
+        self.instance: Instance = create_instance(validate)
+        self.device: Device | None = None
+        self.resources: ResourceSet | None = None
+        self.passes: list[ProbePass] = []
+        self.pools: dict[tuple[int, int], Any] = {}
+        self.query_pools: list[Any] = []
+        self.fences: list[list[Any]] = []
+        self.sampler = None
+        self.host_buffers: list[HostBuffer] = []
+        self.batches: list[Batch] = []
+        self.barrier_batches: list[BarrierBatch] = []
+        try:
+            self.device = create_device(self.instance, device_index, verbose=verbose)
+            self._setup()
+        except BaseException:
+            self.close()
+            raise
+
+    @property
+    def log(self):
+        return self.instance.log
+
+    # ----------------------------------------------------------------- setup
+    def _setup(self) -> None:
+        v = vk()
+        dev = self.device
+        for p in self.plan["passes"]:
+            if p.get("impl"):
+                raise ExecutionError(f"pass {p['name']!r}: implementation {p['impl']!r} is not available to the "
+                                     "runtime yet (only the probe)")
+            if p.get("device", 0) != 0:
+                raise ExecutionError(f"pass {p['name']!r}: multi-device plans are not supported")
+        self.log.context = "creating resources"
+        self.resources = ResourceSet(dev, self.plan, FRAMES_IN_FLIGHT)
+        self.sampler = v.vkCreateSampler(dev.handle, v.VkSamplerCreateInfo(
+            magFilter=v.VK_FILTER_NEAREST, minFilter=v.VK_FILTER_NEAREST,
+            mipmapMode=v.VK_SAMPLER_MIPMAP_MODE_NEAREST, addressModeU=v.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            addressModeV=v.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, addressModeW=v.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            maxLod=1000.0), None)
+        self.log.context = "initialising persistent resources"
+        self._init_shared()
+        self.log.context = "creating pipelines"
+        self.passes = [ProbePass(dev, self.plan, p, self.resources, self.sampler) for p in self.plan["passes"]]
+        n = len(self.plan["passes"])
+        for _ in range(FRAMES_IN_FLIGHT):
+            self.query_pools.append(v.vkCreateQueryPool(dev.handle, v.VkQueryPoolCreateInfo(
+                queryType=v.VK_QUERY_TYPE_TIMESTAMP, queryCount=max(2 * n, 2)), None))
+        self.batches = make_batches(self.plan, dev)
+        self.log.context = "recording"
+        self._record()
+
+    def _pool(self, family: int, set_index: int) -> Any:
+        v = vk()
+        key = (family, set_index)
+        if key not in self.pools:
+            self.pools[key] = v.vkCreateCommandPool(self.device.handle, v.VkCommandPoolCreateInfo(
+                queueFamilyIndex=family), None)
+        return self.pools[key]
+
+    def _one_time(self, queue: str, record) -> None:
+        """Record, submit and wait for a one-time command buffer on plan queue ``queue``."""
+        v = vk()
+        dev = self.device
+        pool = self._pool(dev.families[queue], FRAMES_IN_FLIGHT)  # a separate pool for one-time work
+        cb = v.vkAllocateCommandBuffers(dev.handle, v.VkCommandBufferAllocateInfo(
+            commandPool=pool, level=v.VK_COMMAND_BUFFER_LEVEL_PRIMARY, commandBufferCount=1))[0]
+        v.vkBeginCommandBuffer(cb, v.VkCommandBufferBeginInfo(flags=v.VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT))
+        record(cb)
+        v.vkEndCommandBuffer(cb)
+        fence = v.vkCreateFence(dev.handle, v.VkFenceCreateInfo(), None)
+        cb_info = v.VkCommandBufferSubmitInfo(commandBuffer=cb)
+        submit = v.VkSubmitInfo2(commandBufferInfoCount=1, pCommandBufferInfos=[cb_info])
+        v.vkQueueSubmit2(dev.queues[queue], 1, [submit], fence)
+        v.vkWaitForFences(dev.handle, 1, [fence], v.VK_TRUE, 10**11)
+        v.vkDestroyFence(dev.handle, fence, None)
+        v.vkFreeCommandBuffers(dev.handle, pool, 1, [cb])
+
+    def _init_shared(self) -> None:
+        """Fill persistent/imported resources with their initial value, then move them to ``final``."""
+        v = vk()
+        plan_size = tuple(self.plan.get("size") or (64, 64))
+        by_queue: dict[str, list] = {}
+        for r in self.resources.shared():
+            by_queue.setdefault(r.plan["final"]["queue"], []).append(r)
+        for queue, items in by_queue.items():
+            work = []
+            for r in items:
+                res = r.plan
+                m = modulus(res)
+                value = initial_value(res["name"], m) if m else None
+                if r.is_image:
+                    whole = {"subresource": {"mips": [0, res["mips"]], "layers": [0, res["layers"]]}}
+                    data = fill_bytes(res, value, subresources(whole), plan_size)
+                    regions = image_copy_regions(res, whole)[0]
+                else:
+                    data = fill_bytes(res, value, [None], plan_size)
+                    regions = None
+                buf = HostBuffer.create(self.device, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
+                buf.write(data)
+                self.host_buffers.append(buf)
+                work.append((r, buf, regions))
+
+            def record(cb, work=work):
+                keep = []
+                for r, buf, regions in work:
+                    final = r.plan["final"]
+                    if r.is_image:
+                        rng = v.VkImageSubresourceRange(aspectMask=names.aspect_mask(r.plan["format"]), baseMipLevel=0,
+                                                        levelCount=r.plan["mips"], baseArrayLayer=0,
+                                                        layerCount=r.plan["layers"])
+                        to_dst = v.VkImageMemoryBarrier2(
+                            srcStageMask=0, srcAccessMask=0, dstStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT,
+                            dstAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT, oldLayout=v.VK_IMAGE_LAYOUT_UNDEFINED,
+                            newLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                            dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, image=r.handle, subresourceRange=rng)
+                        dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[to_dst])
+                        keep.append((to_dst, dep))
+                        v.vkCmdPipelineBarrier2(cb, dep)
+                        v.vkCmdCopyBufferToImage(cb, buf.handle, r.handle, v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                                 len(regions), regions)
+                        to_final = v.VkImageMemoryBarrier2(
+                            srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                            dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
+                            oldLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=names.layout(final["layout"]),
+                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                            image=r.handle, subresourceRange=rng)
+                        dep2 = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[to_final])
+                        keep.append((to_final, dep2))
+                        v.vkCmdPipelineBarrier2(cb, dep2)
+                    else:
+                        size = int(r.plan["size_bytes"] or r.plan["bytes"])
+                        v.vkCmdCopyBuffer(cb, buf.handle, r.handle, 1, [v.VkBufferCopy(srcOffset=0, dstOffset=0,
+                                                                                      size=size)])
+                        after = v.VkBufferMemoryBarrier2(
+                            srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                            dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
+                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                            buffer=r.handle, offset=0, size=names.WHOLE_SIZE)
+                        dep = v.VkDependencyInfo(bufferMemoryBarrierCount=1, pBufferMemoryBarriers=[after])
+                        keep.append((after, dep))
+                        v.vkCmdPipelineBarrier2(cb, dep)
+
+            self._one_time(queue, record)
+
+    def _label(self, cb: Any, text: str | None) -> None:
+        v = vk()
+        if text is None:
+            fn = self.device.fn("vkCmdEndDebugUtilsLabelEXT")
+            if fn:
+                fn(cb)
+            return
+        fn = self.device.fn("vkCmdBeginDebugUtilsLabelEXT")
+        if fn:
+            label = v.VkDebugUtilsLabelEXT(pLabelName=text, color=[0.0, 0.0, 0.0, 0.0])
+            fn(cb, label)
+
+    def _name_object(self, handle: Any, object_type: int, name: str) -> None:
+        v = vk()
+        fn = self.device.fn("vkSetDebugUtilsObjectNameEXT")
+        if not fn:
+            return
+        raw = int(v.ffi.cast("uint64_t", handle))
+        fn(self.device.handle, v.VkDebugUtilsObjectNameInfoEXT(objectType=object_type, objectHandle=raw,
+                                                               pObjectName=name))
+
+    def _record(self) -> None:
+        v = vk()
+        dev = self.device
+        index_of = {id(p): i for i, p in enumerate(self.plan["passes"])}
+        for s in range(FRAMES_IN_FLIGHT):
+            for bi, batch in enumerate(self.batches):
+                pool = self._pool(dev.families[batch.queue], s)
+                cb = v.vkAllocateCommandBuffers(dev.handle, v.VkCommandBufferAllocateInfo(
+                    commandPool=pool, level=v.VK_COMMAND_BUFFER_LEVEL_PRIMARY, commandBufferCount=1))[0]
+                names_in = ",".join(p["name"] for p in batch.passes)
+                self._name_object(cb, v.VK_OBJECT_TYPE_COMMAND_BUFFER, f"set {s} batch {bi} [{names_in}]")
+                batch.command_buffers.append(cb)
+                v.vkBeginCommandBuffer(cb, v.VkCommandBufferBeginInfo())
+                ctx = RecordContext(dev, cb)
+                timestamps = dev.timestamp_valid_bits.get(batch.queue, 0) > 0
+                for p in batch.passes:
+                    i = index_of[id(p)]
+                    self._label(cb, f"pass {p['name']}")
+                    if timestamps:
+                        v.vkCmdResetQueryPool(cb, self.query_pools[s], 2 * i, 2)
+                        v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
+                    barriers = build_barriers(dev, self.resources, s, p["barriers"], "barrier")
+                    if barriers:
+                        self.barrier_batches.append(barriers)
+                        v.vkCmdPipelineBarrier2(cb, barriers.dependency)
+                    self.passes[i].record(ctx, s)
+                    releases = build_barriers(dev, self.resources, s, p["releases"], "release")
+                    if releases:
+                        self.barrier_batches.append(releases)
+                        v.vkCmdPipelineBarrier2(cb, releases.dependency)
+                    if timestamps:
+                        v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, self.query_pools[s],
+                                               2 * i + 1)
+                    self._label(cb, None)
+                v.vkEndCommandBuffer(cb)
+        self._build_submits()
+
+    def _build_submits(self) -> None:
+        """Prebuilt VkSubmitInfo2 per batch and set; only semaphore values change per frame."""
+        v = vk()
+        dev = self.device
+        queues = list(dict.fromkeys(p["queue"] for p in self.plan["passes"]))
+        self.frame_span = {q: 1 + max([s["value"] for p in self.plan["passes"] for s in p["signals"]
+                                       if s["queue"] == q] + [0]) for q in queues}
+        distinct = len({int(v.ffi.cast("uintptr_t", dev.queues[q])) for q in queues}) > 1
+        first_of: dict[str, int] = {}
+        last_of: dict[int, int] = {}
+        for bi, batch in enumerate(self.batches):
+            first_of.setdefault(batch.queue, bi)
+            last_of[int(v.ffi.cast("uintptr_t", dev.queues[batch.queue]))] = bi
+        last_by_plan_queue = {}
+        for bi, batch in enumerate(self.batches):
+            last_by_plan_queue[batch.queue] = bi
+        self.fence_batches = sorted(set(last_of.values()))
+        for bi, batch in enumerate(self.batches):
+            first, last = batch.passes[0], batch.passes[-1]
+            wait_specs = [(w["queue"], w["value"], names.stages(w["stages"]), False) for w in first["waits"]]
+            if distinct and first_of[batch.queue] == bi:
+                wait_specs += [(q, self.frame_span[q], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, True)
+                               for q in queues if q != batch.queue]
+            signal_specs = [(s["queue"], s["value"], names.stages(s["stages"]), False) for s in last["signals"]]
+            if last_by_plan_queue[batch.queue] == bi:
+                signal_specs.append((batch.queue, self.frame_span[batch.queue], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                     True))
+            for s in range(FRAMES_IN_FLIGHT):
+                waits = [v.VkSemaphoreSubmitInfo(semaphore=dev.timelines[q], value=0, stageMask=st)
+                         for q, _val, st, _fs in wait_specs]
+                signals = [v.VkSemaphoreSubmitInfo(semaphore=dev.timelines[q], value=0, stageMask=st)
+                           for q, _val, st, _fs in signal_specs]
+                cbi = [v.VkCommandBufferSubmitInfo(commandBuffer=batch.command_buffers[s])]
+                submit = v.VkSubmitInfo2(
+                    waitSemaphoreInfoCount=len(waits), pWaitSemaphoreInfos=waits or None,
+                    commandBufferInfoCount=1, pCommandBufferInfos=cbi,
+                    signalSemaphoreInfoCount=len(signals), pSignalSemaphoreInfos=signals or None)
+                batch.waits.append((waits, wait_specs))
+                batch.signals.append((signals, signal_specs, cbi))
+                batch.submit.append(submit)
+        for _ in range(FRAMES_IN_FLIGHT):
+            self.fences.append([v.vkCreateFence(dev.handle, v.VkFenceCreateInfo(
+                flags=v.VK_FENCE_CREATE_SIGNALED_BIT), None) for _ in self.fence_batches])
+
+    # ----------------------------------------------------------------- frames
+    def run_frames(self, frames: int) -> dict[str, Any]:
+        v = vk()
+        dev = self.device
+        n = len(self.plan["passes"])
+        samples: list[list[float | None]] = [[] for _ in range(n)]
+        totals: list[float] = []
+        cpu_ms: list[float] = []
+        submitted: list[bool] = [False] * FRAMES_IN_FLIGHT
+        for frame in range(frames):
+            s = frame % FRAMES_IN_FLIGHT
+            self.log.context = f"frame {frame}"
+            fences = self.fences[s]
+            t0 = time.perf_counter()
+            v.vkWaitForFences(dev.handle, len(fences), fences, v.VK_TRUE, 10**11)
+            if submitted[s]:
+                self._collect_timestamps(s, samples, totals)
+            v.vkResetFences(dev.handle, len(fences), fences)
+            for bi, batch in enumerate(self.batches):
+                self.log.context = f"frame {frame} submit of batch {bi} [{', '.join(p['name'] for p in batch.passes)}]"
+                submit = batch.submit[s]
+                _waits, wait_specs = batch.waits[s]
+                for k, (q, value, _st, frame_start) in enumerate(wait_specs):
+                    # frame-start waits: every other queue finished the previous frame
+                    submit.pWaitSemaphoreInfos[k].value = (
+                        frame * self.frame_span[q] if frame_start else frame * self.frame_span[q] + value)
+                _signals, signal_specs, _cbi = batch.signals[s]
+                for k, (q, value, _st, _fs) in enumerate(signal_specs):
+                    submit.pSignalSemaphoreInfos[k].value = frame * self.frame_span[q] + value
+                fence = fences[self.fence_batches.index(bi)] if bi in self.fence_batches else None
+                v.vkQueueSubmit2(dev.queues[batch.queue], 1, [batch.submit[s]], fence)
+            submitted[s] = True
+            cpu_ms.append((time.perf_counter() - t0) * 1000.0)
+        self.log.context = "finishing"
+        for s in range(FRAMES_IN_FLIGHT):
+            if submitted[s]:
+                v.vkWaitForFences(dev.handle, len(self.fences[s]), self.fences[s], v.VK_TRUE, 10**11)
+                self._collect_timestamps(s, samples, totals)
+        period = dev.timestamp_period_ns / 1e6
+        per_pass = {}
+        for i, p in enumerate(self.plan["passes"]):
+            vals = [x for x in samples[i] if x is not None]
+            per_pass[p["name"]] = statistics.median(vals) * period if vals else None
+        return {"passes": per_pass, "total_ms": statistics.median(totals) * period if totals else None,
+                "frames": frames, "cpu_submit_ms": statistics.median(cpu_ms) if cpu_ms else None}
+
+    def _collect_timestamps(self, s: int, samples: list[list[float | None]], totals: list[float]) -> None:
+        v = vk()
+        n = len(self.plan["passes"])
+        data = v.ffi.new("uint64_t[]", 2 * n)
+        flags = v.VK_QUERY_RESULT_64_BIT | v.VK_QUERY_RESULT_WAIT_BIT
+        try:
+            v.vkGetQueryPoolResults(self.device.handle, self.query_pools[s], 0, 2 * n, 16 * n, data, 8, flags)
+        except v.VkError:
+            return
+        starts, ends = [], []
+        for i in range(n):
+            a, b = int(data[2 * i]), int(data[2 * i + 1])
+            samples[i].append(float(b - a))
+            starts.append(a)
+            ends.append(b)
+        if starts:
+            totals.append(float(max(ends) - min(starts)))
+
+    # ----------------------------------------------------------------- readback
+    def read_back(self, frames: int) -> dict[tuple, bytes]:
+        """Bytes of every output/persistent/imported subresource after the last frame."""
+        v = vk()
+        s = (frames - 1) % FRAMES_IN_FLIGHT
+        out: dict[tuple, bytes] = {}
+        wanted = [r for r in self.plan["resources"] if r["lifetime"] in ("output", "persistent", "imported")
+                  and r.get("first") is not None]
+        by_queue: dict[str, list[dict]] = {}
+        for res in wanted:
+            by_queue.setdefault(res["final"]["queue"], []).append(res)
+        for queue, items in by_queue.items():
+            jobs = []
+            for res in items:
+                r = self.resources.get(res["name"], s)
+                if r.is_image:
+                    whole = {"subresource": {"mips": [0, res["mips"]], "layers": [0, res["layers"]]}}
+                    regions, size = image_copy_regions(res, whole)
+                else:
+                    regions, size = None, int(res["size_bytes"] or res["bytes"])
+                buf = HostBuffer.create(self.device, size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT)
+                self.host_buffers.append(buf)
+                jobs.append((res, r, buf, regions, size))
+
+            def record(cb, jobs=jobs):
+                keep = []
+                for res, r, buf, regions, size in jobs:
+                    final = res["final"]
+                    src_stages, src_access = names.stages(final["stages"]), names.accesses(final["access"])
+                    if r.is_image:
+                        rng = v.VkImageSubresourceRange(aspectMask=names.aspect_mask(res["format"]), baseMipLevel=0,
+                                                        levelCount=res["mips"], baseArrayLayer=0,
+                                                        layerCount=res["layers"])
+                        b = v.VkImageMemoryBarrier2(
+                            srcStageMask=src_stages, srcAccessMask=src_access,
+                            dstStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, dstAccessMask=v.VK_ACCESS_2_TRANSFER_READ_BIT,
+                            oldLayout=names.layout(final["layout"]), newLayout=v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                            image=r.handle, subresourceRange=rng)
+                        dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[b])
+                        keep.append((b, dep))
+                        v.vkCmdPipelineBarrier2(cb, dep)
+                        v.vkCmdCopyImageToBuffer(cb, r.handle, v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf.handle,
+                                                 len(regions), regions)
+                    else:
+                        b = v.VkBufferMemoryBarrier2(
+                            srcStageMask=src_stages, srcAccessMask=src_access,
+                            dstStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, dstAccessMask=v.VK_ACCESS_2_TRANSFER_READ_BIT,
+                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                            buffer=r.handle, offset=0, size=names.WHOLE_SIZE)
+                        dep = v.VkDependencyInfo(bufferMemoryBarrierCount=1, pBufferMemoryBarriers=[b])
+                        keep.append((b, dep))
+                        v.vkCmdPipelineBarrier2(cb, dep)
+                        v.vkCmdCopyBuffer(cb, r.handle, buf.handle, 1, [v.VkBufferCopy(srcOffset=0, dstOffset=0,
+                                                                                      size=size)])
+
+            self.log.context = "readback"
+            self._one_time(queue, record)
+            for res, _r, buf, _regions, size in jobs:
+                data = buf.read(size)
+                if res["kind"] == "image":
+                    offset = 0
+                    for mip in range(res["mips"]):
+                        w, h = mip_extent(res, mip)
+                        from rgraph.vk.probe import texel_bytes
+
+                        n = texel_bytes(res["format"], w, h)
+                        for layer in range(res["layers"]):
+                            out[(res["name"], mip, layer)] = data[offset:offset + n]
+                            offset += n
+                else:
+                    out[(res["name"], None, None)] = data
+        return out
+
+    # ----------------------------------------------------------------- teardown
+    def close(self) -> list[ValidationMessage]:
+        v = vk()
+        dev = self.device
+        if dev is not None and dev.handle is not None:
+            self.log.context = "teardown"
+            v.vkDeviceWaitIdle(dev.handle)
+            for fences in self.fences:
+                for f in fences:
+                    v.vkDestroyFence(dev.handle, f, None)
+            self.fences = []
+            for pool in self.query_pools:
+                v.vkDestroyQueryPool(dev.handle, pool, None)
+            self.query_pools = []
+            for pool in self.pools.values():
+                v.vkDestroyCommandPool(dev.handle, pool, None)
+            self.pools = {}
+            for p in reversed(self.passes):
+                p.destroy()
+            self.passes = []
+            for buf in reversed(self.host_buffers):
+                buf.destroy()
+            self.host_buffers = []
+            if self.sampler is not None:
+                v.vkDestroySampler(dev.handle, self.sampler, None)
+                self.sampler = None
+            if self.resources is not None:
+                self.resources.destroy()
+                self.resources = None
+            dev.destroy()
+        if self.instance is not None and self.instance.handle is not None:
+            self.instance.destroy()
+        return self.instance.log.messages
+
+
+def execute_plan(plan: dict, *, validate: bool = False, frames: int = 1, device_index: int | None = None,
+                 check_data: bool | None = None, out_png: Path | None = None, verbose: bool = False) -> RunResult:
+    """Run ``plan`` for ``frames`` frames; check the probe's data flow (default: when validating)."""
+    if frames < 1:
+        raise ExecutionError("--frames must be at least 1")
+    check = validate if check_data is None else check_data
+    executor = Executor(plan, validate=validate, device_index=device_index, verbose=verbose)
+    timings: dict[str, Any] = {}
+    mismatches: list[Mismatch] = []
+    unchecked: list[str] = []
+    data_ok: bool | None = None
+    try:
+        timings = executor.run_frames(frames)
+        if check or out_png is not None:
+            data = executor.read_back(frames)
+            if check:
+                expected = simulate(plan, frames)
+                plan_size = tuple(plan.get("size") or (64, 64))
+                for key, raw in sorted(data.items(), key=lambda kv: (kv[0][0], kv[0][1] or 0, kv[0][2] or 0)):
+                    name, mip, layer = key
+                    res = next(r for r in plan["resources"] if r["name"] == name)
+                    want = expected.get(key)
+                    if want is None or (res["kind"] == "image" and codec(res["format"]) is None):
+                        unchecked.append(f"{name}" + (f" mip {mip} layer {layer}" if mip is not None else ""))
+                        continue
+                    if res["kind"] == "image":
+                        mm = compare_image(res, (mip, layer), raw, want)
+                        if mm:
+                            mismatches.append(mm)
+                    else:
+                        mismatches += compare_buffer(res, raw, want, plan_size)
+                data_ok = not mismatches
+            if out_png is not None:
+                outputs = [r for r in plan["resources"] if r["lifetime"] == "output" and r["kind"] == "image"]
+                if not outputs:
+                    raise ExecutionError("--out: the plan has no output image")
+                res = outputs[0]
+                w, h = mip_extent(res, 0)
+                write_png(Path(out_png), image_to_rgba8(res, data[(res["name"], 0, 0)], w, h))
+    finally:
+        messages = executor.close()
+    return RunResult(list(messages), timings, data_ok, executor.device.name if executor.device else "?",
+                     mismatches, unchecked)

@@ -1,0 +1,164 @@
+"""Recording: plan barriers as prebuilt sync2 structs, and the pass recording context.
+
+``RecordContext`` is what pass implementations get: draws, dispatches, copies, binds and
+push constants. It has no barrier calls: the graph owns synchronization.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from rgraph.vk import names
+from rgraph.vk.device import Device
+from rgraph.vk.loader import vk
+from rgraph.vk.resources import ResourceSet
+
+
+def _aspect_for_layout(format_name: str, layout: str) -> int:
+    v = vk()
+    if layout.startswith("DEPTH_") and not layout.startswith("DEPTH_STENCIL") and "STENCIL" not in layout:
+        return v.VK_IMAGE_ASPECT_DEPTH_BIT
+    if layout.startswith("STENCIL_"):
+        return v.VK_IMAGE_ASPECT_STENCIL_BIT
+    return names.aspect_mask(format_name)
+
+
+@dataclass
+class BarrierBatch:
+    """One vkCmdPipelineBarrier2's structs, kept alive until recorded."""
+
+    dependency: Any
+    keep: list[Any] = field(default_factory=list)
+    count: int = 0
+
+
+def build_barriers(device: Device, resources: ResourceSet, set_index: int, barriers: list[dict],
+                   role: str) -> BarrierBatch | None:
+    """Sync2 structs for plan barriers. ``role``: "barrier" (before the pass) or "release" (after).
+
+    A queue-family transfer whose two plan queues share a family becomes one ordinary barrier
+    at the acquire point; its release is skipped.
+    """
+    v = vk()
+    images, buffers = [], []
+    for b in barriers:
+        src, dst = b["src"], b["dst"]
+        transfer = src["queue"] != dst["queue"] and not device.same_family(src["queue"], dst["queue"])
+        if src["queue"] != dst["queue"] and not transfer and role == "release":
+            continue  # same family: executed once at the acquire point
+        src_family = device.families[src["queue"]] if transfer else v.VK_QUEUE_FAMILY_IGNORED
+        dst_family = device.families[dst["queue"]] if transfer else v.VK_QUEUE_FAMILY_IGNORED
+        src_stages, src_access = names.stages(src["stages"]), names.accesses(src["access"])
+        dst_stages, dst_access = names.stages(dst["stages"]), names.accesses(dst["access"])
+        if transfer and role == "release":
+            dst_stages, dst_access = 0, 0
+        elif transfer:
+            src_stages, src_access = 0, 0
+        r = resources.get(b["resource"], set_index)
+        if r.is_image:
+            sub = b["subresource"]
+            rng = v.VkImageSubresourceRange(
+                aspectMask=_aspect_for_layout(r.plan["format"], dst["layout"] if dst["layout"] != "UNDEFINED"
+                                              else src["layout"]),
+                baseMipLevel=sub["mips"][0], levelCount=sub["mips"][1] - sub["mips"][0],
+                baseArrayLayer=sub["layers"][0], layerCount=sub["layers"][1] - sub["layers"][0])
+            images.append(v.VkImageMemoryBarrier2(
+                srcStageMask=src_stages, srcAccessMask=src_access, dstStageMask=dst_stages, dstAccessMask=dst_access,
+                oldLayout=names.layout(src["layout"]), newLayout=names.layout(dst["layout"]),
+                srcQueueFamilyIndex=src_family, dstQueueFamilyIndex=dst_family, image=r.handle,
+                subresourceRange=rng))
+        else:
+            buffers.append(v.VkBufferMemoryBarrier2(
+                srcStageMask=src_stages, srcAccessMask=src_access, dstStageMask=dst_stages, dstAccessMask=dst_access,
+                srcQueueFamilyIndex=src_family, dstQueueFamilyIndex=dst_family, buffer=r.handle, offset=0,
+                size=names.WHOLE_SIZE))
+    if not images and not buffers:
+        return None
+    dep = v.VkDependencyInfo(
+        imageMemoryBarrierCount=len(images), pImageMemoryBarriers=images or None,
+        bufferMemoryBarrierCount=len(buffers), pBufferMemoryBarriers=buffers or None)
+    return BarrierBatch(dep, [images, buffers], len(images) + len(buffers))
+
+
+class RecordContext:
+    """Commands a pass implementation may record. Deliberately no barriers."""
+
+    def __init__(self, device: Device, command_buffer: Any) -> None:
+        self._device = device
+        self._cb = command_buffer
+
+    # pipeline state
+    def bind_compute(self, pipeline: Any, layout: Any, descriptor_sets: list[Any]) -> None:
+        v = vk()
+        v.vkCmdBindPipeline(self._cb, v.VK_PIPELINE_BIND_POINT_COMPUTE, pipeline)
+        if descriptor_sets:
+            v.vkCmdBindDescriptorSets(self._cb, v.VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0,
+                                      len(descriptor_sets), descriptor_sets, 0, None)
+
+    def bind_graphics(self, pipeline: Any, layout: Any, descriptor_sets: list[Any]) -> None:
+        v = vk()
+        v.vkCmdBindPipeline(self._cb, v.VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline)
+        if descriptor_sets:
+            v.vkCmdBindDescriptorSets(self._cb, v.VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0,
+                                      len(descriptor_sets), descriptor_sets, 0, None)
+
+    def push_constants(self, layout: Any, stages: int, data: bytes, offset: int = 0) -> None:
+        v = vk()
+        buf = v.ffi.new("char[]", data)
+        v.vkCmdPushConstants(self._cb, layout, stages, offset, len(data), buf)
+
+    def bind_vertex_buffers(self, buffers: list[Any], offsets: list[int]) -> None:
+        if buffers:
+            vk().vkCmdBindVertexBuffers(self._cb, 0, len(buffers), buffers, offsets)
+
+    def bind_index_buffer(self, buffer: Any, offset: int) -> None:
+        v = vk()
+        v.vkCmdBindIndexBuffer(self._cb, buffer, offset, v.VK_INDEX_TYPE_UINT32)
+
+    # render pass scope (attachments' layouts are the plan's; no implicit transitions)
+    def begin_render_pass(self, render_pass: Any, framebuffer: Any, extent: tuple[int, int],
+                          clear_values: list[Any]) -> None:
+        v = vk()
+        info = v.VkRenderPassBeginInfo(
+            renderPass=render_pass, framebuffer=framebuffer,
+            renderArea=v.VkRect2D(offset=v.VkOffset2D(x=0, y=0), extent=v.VkExtent2D(width=extent[0], height=extent[1])),
+            clearValueCount=len(clear_values), pClearValues=clear_values or None)
+        v.vkCmdBeginRenderPass(self._cb, info, v.VK_SUBPASS_CONTENTS_INLINE)
+
+    def end_render_pass(self) -> None:
+        vk().vkCmdEndRenderPass(self._cb)
+
+    # work
+    def draw(self, vertices: int, instances: int = 1) -> None:
+        vk().vkCmdDraw(self._cb, vertices, instances, 0, 0)
+
+    def draw_indexed(self, indices: int, instances: int = 1) -> None:
+        vk().vkCmdDrawIndexed(self._cb, indices, instances, 0, 0, 0)
+
+    def draw_indirect(self, buffer: Any, offset: int) -> None:
+        vk().vkCmdDrawIndirect(self._cb, buffer, offset, 1, 16)
+
+    def draw_indexed_indirect(self, buffer: Any, offset: int) -> None:
+        vk().vkCmdDrawIndexedIndirect(self._cb, buffer, offset, 1, 20)
+
+    def dispatch(self, x: int, y: int, z: int = 1) -> None:
+        vk().vkCmdDispatch(self._cb, x, y, z)
+
+    def dispatch_indirect(self, buffer: Any, offset: int) -> None:
+        vk().vkCmdDispatchIndirect(self._cb, buffer, offset)
+
+    def copy_buffer(self, src: Any, dst: Any, regions: list[Any]) -> None:
+        vk().vkCmdCopyBuffer(self._cb, src, dst, len(regions), regions)
+
+    def copy_image(self, src: Any, src_layout: int, dst: Any, dst_layout: int, regions: list[Any]) -> None:
+        vk().vkCmdCopyImage(self._cb, src, src_layout, dst, dst_layout, len(regions), regions)
+
+    def copy_buffer_to_image(self, src: Any, dst: Any, dst_layout: int, regions: list[Any]) -> None:
+        vk().vkCmdCopyBufferToImage(self._cb, src, dst, dst_layout, len(regions), regions)
+
+    def copy_image_to_buffer(self, src: Any, src_layout: int, dst: Any, regions: list[Any]) -> None:
+        vk().vkCmdCopyImageToBuffer(self._cb, src, src_layout, dst, len(regions), regions)
+
+    def trace_rays(self, *args: Any) -> None:
+        raise NotImplementedError("ray tracing passes are not supported by the runtime yet")

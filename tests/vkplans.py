@@ -103,55 +103,62 @@ class PlanBuilder:
         for p in passes:
             p["barriers"], p["releases"], p["waits"], p["signals"] = [], [], [], []
         for p in passes:
-            for a in p["accesses"]:
+            for a in _merged(p["accesses"]):
                 keys = self._keys(a)
-                st = states[keys[0]]
-                assert all(states[k] == st for k in keys), f"non-uniform state over {a['resource']}"
-                stages, acc = set(a["stages"]), set(a["access"])
-                writes = {x for x in acc if "WRITE" in x}
-                layout = a["layout"]
-                transition = layout is not None and layout != st.layout
-                needs = transition or (a["write"] and (st.write_stages or st.read_stages)) or (
-                    not a["write"] and st.write_stages and not {(s, x) for s in stages for x in acc} <= st.visible)
-                if st.layout == "UNDEFINED" and layout is not None:
-                    needs = True
-                has_content = st.write_stages and (st.layout != "UNDEFINED" or layout is None)
-                q_src = st.queue if (st.queue and has_content) else p["queue"]
-                barrier = None
-                if needs or q_src != p["queue"]:
-                    src_stages = st.write_stages | (st.read_stages if (a["write"] or transition) else set())
-                    barrier = {
-                        "resource": a["resource"], "subresource": copy.deepcopy(a["subresource"]),
-                        "src": {"stages": sorted(src_stages), "access": sorted(st.write_access),
-                                "layout": st.layout if layout is not None else None, "queue": q_src},
-                        "dst": {"stages": sorted(stages), "access": sorted(acc), "layout": layout,
-                                "queue": p["queue"]},
-                        "aliases": None,
-                    }
-                    if layout is None:
-                        barrier["src"]["layout"] = barrier["dst"]["layout"] = None
-                    p["barriers"].append(barrier)
-                    if q_src != p["queue"]:
-                        prev = passes[st.last_pass]
-                        prev["releases"].append(barrier)
-                        semaphores[prev["queue"]] = semaphores.get(prev["queue"], 0) + 1
-                        value = semaphores[prev["queue"]]
-                        prev["signals"].append({"queue": prev["queue"], "value": value, "stages": ["ALL_COMMANDS"]})
-                        p["waits"].append({"queue": prev["queue"], "value": value, "stages": ["ALL_COMMANDS"]})
-                for k in keys:
-                    s = states[k]
-                    if a["write"]:
-                        s.write_stages, s.write_access = set(stages), set(writes)
-                        s.read_stages, s.read_access, s.visible = set(), set(), set()
-                    else:
-                        if transition:
-                            s.write_stages, s.write_access, s.read_stages, s.read_access = set(stages), set(), set(), set()
-                        s.read_stages |= stages
-                        s.read_access |= acc
-                        s.visible |= {(x, y) for x in stages for y in acc}
-                    if layout is not None:
-                        s.layout = layout
-                    s.queue, s.last_pass, s.last_was_write = p["queue"], p["index"], a["write"]
+                groups = [keys] if all(states[k] == states[keys[0]] for k in keys) else [[k] for k in keys]
+                for group in groups:
+                    self._barrier_for(passes, p, a, group, states, semaphores)
+
+    def _barrier_for(self, passes, p, a, keys, states, semaphores):
+        st = states[keys[0]]
+        sub = copy.deepcopy(a["subresource"])
+        if sub is not None and len(keys) == 1 and len(self._keys(a)) > 1:
+            sub = {"mips": [keys[0][1], keys[0][1] + 1], "layers": [keys[0][2], keys[0][2] + 1]}
+        stages, acc = set(a["stages"]), set(a["access"])
+        writes = {x for x in acc if "WRITE" in x}
+        layout = a["layout"]
+        transition = layout is not None and layout != st.layout
+        needs = transition or (a["write"] and (st.write_stages or st.read_stages)) or (
+            not a["write"] and st.write_stages and not {(s, x) for s in stages for x in acc} <= st.visible)
+        if st.layout == "UNDEFINED" and layout is not None:
+            needs = True
+        has_content = st.write_stages and (st.layout != "UNDEFINED" or layout is None)
+        q_src = st.queue if (st.queue and has_content) else p["queue"]
+        barrier = None
+        if needs or q_src != p["queue"]:
+            src_stages = st.write_stages | (st.read_stages if (a["write"] or transition) else set())
+            barrier = {
+                "resource": a["resource"], "subresource": sub,
+                "src": {"stages": sorted(src_stages), "access": sorted(st.write_access),
+                        "layout": st.layout if layout is not None else None, "queue": q_src},
+                "dst": {"stages": sorted(stages), "access": sorted(acc), "layout": layout,
+                        "queue": p["queue"]},
+                "aliases": None,
+            }
+            if layout is None:
+                barrier["src"]["layout"] = barrier["dst"]["layout"] = None
+            p["barriers"].append(barrier)
+            if q_src != p["queue"]:
+                prev = passes[st.last_pass]
+                prev["releases"].append(barrier)
+                semaphores[prev["queue"]] = semaphores.get(prev["queue"], 0) + 1
+                value = semaphores[prev["queue"]]
+                prev["signals"].append({"queue": prev["queue"], "value": value, "stages": ["ALL_COMMANDS"]})
+                p["waits"].append({"queue": prev["queue"], "value": value, "stages": ["ALL_COMMANDS"]})
+        for k in keys:
+            s = states[k]
+            if a["write"]:
+                s.write_stages, s.write_access = set(stages), set(writes)
+                s.read_stages, s.read_access, s.visible = set(), set(), set()
+            else:
+                if transition:
+                    s.write_stages, s.write_access, s.read_stages, s.read_access = set(stages), set(), set(), set()
+                s.read_stages |= stages
+                s.read_access |= acc
+                s.visible |= {(x, y) for x in stages for y in acc}
+            if layout is not None:
+                s.layout = layout
+            s.queue, s.last_pass, s.last_was_write = p["queue"], p["index"], a["write"]
 
     def _fresh_states(self, finals=None):
         states = {}
@@ -247,3 +254,18 @@ def drop_barrier(plan, pass_name, resource):
     p["barriers"] = [b for b in p["barriers"] if b["resource"] != resource]
     assert len(p["barriers"]) < before, f"{pass_name} has no barrier on {resource}"
     return out
+
+
+def _merged(accesses):
+    """One synthetic access per (resource, range) of a pass: several usages share one barrier."""
+    out = {}
+    for a in accesses:
+        key = (a["resource"], repr(a["subresource"]))
+        if key not in out:
+            out[key] = copy.deepcopy(a)
+            continue
+        m = out[key]
+        m["stages"] = sorted(set(m["stages"]) | set(a["stages"]))
+        m["access"] = sorted(set(m["access"]) | set(a["access"]))
+        m["write"] = m["write"] or a["write"]
+    return list(out.values())

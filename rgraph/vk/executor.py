@@ -53,11 +53,13 @@ class Batch:
     signal_values: list[tuple[Any, str, int, bool]] = field(default_factory=list)
 
 
-def make_batches(plan: dict, device: Device) -> list[Batch]:
+def make_batches(plan: dict, device: Device, one_per_pass: bool = False) -> list[Batch]:
+    """Batches of passes; ``one_per_pass`` (under validation) gives each pass its own named
+    command buffer so that validation messages name the pass."""
     batches: list[Batch] = []
     for p in plan["passes"]:
         last = batches[-1] if batches else None
-        if (last is None or not device.same_queue(last.queue, p["queue"]) or p["waits"]
+        if (one_per_pass or last is None or not device.same_queue(last.queue, p["queue"]) or p["waits"]
                 or last.passes[-1]["signals"]):
             batches.append(Batch(p["queue"], [p]))
         else:
@@ -120,7 +122,7 @@ class Executor:
         for _ in range(FRAMES_IN_FLIGHT):
             self.query_pools.append(v.vkCreateQueryPool(dev.handle, v.VkQueryPoolCreateInfo(
                 queryType=v.VK_QUERY_TYPE_TIMESTAMP, queryCount=max(2 * n, 2)), None))
-        self.batches = make_batches(self.plan, dev)
+        self.batches = make_batches(self.plan, dev, one_per_pass=self.instance.validate)
         self.log.context = "recording"
         self._record()
 
@@ -249,14 +251,16 @@ class Executor:
                 pool = self._pool(dev.families[batch.queue], s)
                 cb = v.vkAllocateCommandBuffers(dev.handle, v.VkCommandBufferAllocateInfo(
                     commandPool=pool, level=v.VK_COMMAND_BUFFER_LEVEL_PRIMARY, commandBufferCount=1))[0]
-                names_in = ",".join(p["name"] for p in batch.passes)
-                self._name_object(cb, v.VK_OBJECT_TYPE_COMMAND_BUFFER, f"set {s} batch {bi} [{names_in}]")
+                label = (f"pass {batch.passes[0]['name']} (set {s})" if len(batch.passes) == 1
+                         else f"batch {bi} (set {s}): " + ",".join(p["name"] for p in batch.passes))
+                self._name_object(cb, v.VK_OBJECT_TYPE_COMMAND_BUFFER, label)
                 batch.command_buffers.append(cb)
                 v.vkBeginCommandBuffer(cb, v.VkCommandBufferBeginInfo())
                 ctx = RecordContext(dev, cb)
                 timestamps = dev.timestamp_valid_bits.get(batch.queue, 0) > 0
                 for p in batch.passes:
                     i = index_of[id(p)]
+                    self.log.context = f"recording pass {p['name']}"
                     self._label(cb, f"pass {p['name']}")
                     if timestamps:
                         v.vkCmdResetQueryPool(cb, self.query_pools[s], 2 * i, 2)

@@ -7,11 +7,14 @@ labels active when they were raised; the executor labels each pass, so a message
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph.vk.errors import INSTALL_HINT, VulkanUnavailable
 from rgraph.vk.loader import vk
+
+_PASS_IN_TEXT = re.compile(r"\[pass (\S+) \(set \d+\)\]")
 
 VALIDATION_LAYER = "VK_LAYER_KHRONOS_validation"
 
@@ -38,9 +41,16 @@ class ValidationMessage:
 
     @property
     def pass_name(self) -> str | None:
+        """The pass: from debug labels, else the command buffer name (``pass NAME (set N)``), else
+        the runtime context (``recording pass NAME``)."""
         for label in reversed(self.labels):
             if label.startswith("pass "):
                 return label.removeprefix("pass ")
+        found = _PASS_IN_TEXT.search(self.text)
+        if found:
+            return found.group(1)
+        if self.context.startswith("recording pass "):
+            return self.context.removeprefix("recording pass ")
         return None
 
     def __str__(self) -> str:

@@ -17,7 +17,7 @@ def image_create_info(format_name: str, extent: Sequence[int], mips: int, layers
     v = vk()
     depth = int(extent[2]) if len(extent) > 2 else 1
     return v.VkImageCreateInfo(
-        flags=v.VK_IMAGE_CREATE_ALIAS_BIT if alias else 0,
+        flags=v.VK_IMAGE_CREATE_ALIAS_BIT_KHR if alias else 0,
         imageType=v.VK_IMAGE_TYPE_3D if depth > 1 else v.VK_IMAGE_TYPE_2D,
         format=names.format_value(format_name),
         extent=v.VkExtent3D(width=int(extent[0]), height=int(extent[1]), depth=depth),

@@ -32,7 +32,7 @@ def test_wrong_format_tag(tmp_path):
     path.write_text(json.dumps({"format": "something-else", "passes": []}))
     with pytest.raises(RGraphError) as info:
         load_plan(path)
-    assert str(info.value) == f'{path}:1:1: error: malformed plan: format: expected \'rgraph-plan/1\', got "something-else"'
+    assert str(info.value) == f'{path}:1:12: error: malformed plan: format: expected \'rgraph-plan/1\', got "something-else"'
 
 
 @pytest.mark.parametrize(
@@ -99,3 +99,18 @@ def test_graph_arguments_are_compiled_with_the_flags(capsys, monkeypatch):
     calls.clear()
     inspect(capsys, "graphs/surgery.yaml")
     assert calls == [("graphs/surgery.yaml", None, {"params": {}, "policy": None})]
+
+
+def test_shape_errors_in_a_file_carry_line_and_column(capsys, tmp_path):
+    plan = load(FORWARD)
+    plan["passes"][3]["barriers"][1]["src"]["stages"] = "COMPUTE_SHADER"
+    path = tmp_path / "bad.json"
+    text = json.dumps(plan, indent=1, sort_keys=True)
+    path.write_text(text)
+    code, _, err = inspect(capsys, str(path))
+    assert code == 2
+    # the line of the offending value in the written text
+    line = next(i for i, t in enumerate(text.splitlines(), 1) if '"stages": "COMPUTE_SHADER"' in t)
+    col = text.splitlines()[line - 1].index('"COMPUTE_SHADER"') + 1
+    assert err.strip() == (f"{path}:{line}:{col}: error: malformed plan: passes[3].barriers[1].src.stages: "
+                           "expected a list, got \"COMPUTE_SHADER\"")

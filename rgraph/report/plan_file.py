@@ -1,16 +1,19 @@
 """Read a plan JSON file (docs/plan.md) and check the shape the views rely on.
 
 Bad files raise ``RGraphError``: decode errors carry the JSON line and column; shape
-errors name the JSON path of the offending value (at line 1, column 1).
+errors name the JSON path of the offending value and, when the text is at hand, its line
+and column.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from rgraph.check.jsonloc import locate
 from rgraph.errors import RGraphError
 
 PLAN_FORMAT = "rgraph-plan/1"
@@ -31,7 +34,7 @@ def load_plan(path: str | Path) -> Plan:
         plan = json.loads(text)
     except json.JSONDecodeError as exc:
         raise RGraphError.in_file(path, f"invalid JSON: {exc.msg}", exc.lineno, exc.colno) from None
-    check_plan(plan, str(path))
+    check_plan(plan, str(path), text)
     return plan
 
 
@@ -39,12 +42,24 @@ def _join(where: str, key: str) -> str:
     return f"{where}.{key}" if where else key
 
 
+_PATH_PART = re.compile(r"\[(\d+)\]|([^.\[\]]+)")
+
+
+def path_parts(where: str) -> list[str | int]:
+    """``passes[3].src`` -> ``["passes", 3, "src"]`` (``top level`` -> ``[]``)."""
+    if where == "top level":
+        return []
+    return [int(index) if index else key for index, key in _PATH_PART.findall(where)]
+
+
 class _Checker:
-    def __init__(self, file: str) -> None:
+    def __init__(self, file: str, text: str | None) -> None:
         self.file = file
+        self.text = text
 
     def fail(self, where: str, message: str) -> RGraphError:
-        return RGraphError.in_file(self.file, f"malformed plan: {where}: {message}")
+        line, col = locate(self.text, path_parts(where)) if self.text is not None else (1, 1)
+        return RGraphError.in_file(self.file, f"malformed plan: {where}: {message}", line, col)
 
     def typed(self, value: Any, where: str, kinds: tuple[type, ...], what: str) -> Any:
         ok = isinstance(value, kinds) and not (isinstance(value, bool) and bool not in kinds)
@@ -77,9 +92,12 @@ class _Checker:
             check(self.obj(item, at), at)
 
 
-def check_plan(plan: Any, file: str) -> None:
-    """Raise ``RGraphError`` unless ``plan`` has the keys and types the views read."""
-    c = _Checker(file)
+def check_plan(plan: Any, file: str, text: str | None = None) -> None:
+    """Raise ``RGraphError`` unless ``plan`` has the keys and types the views read.
+
+    ``text`` is the JSON ``plan`` was read from, to locate the offending value.
+    """
+    c = _Checker(file, text)
     if not isinstance(plan, dict):
         raise c.fail("top level", "expected an object")
     fmt = plan.get("format")

@@ -52,7 +52,7 @@ def main() -> None:
     xs = [math.log(n) for n, _ in rows]
     ys = [math.log(t) for _, t in rows]
     mx, my = statistics.fmean(xs), statistics.fmean(ys)
-    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys, strict=True)) / sum((x - mx) ** 2 for x in xs)
     print(f"growth exponent: {slope:.2f}  (policy {args.policy})")
 
 

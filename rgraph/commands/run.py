@@ -1,0 +1,106 @@
+"""``rgraph run G-or-PLAN``: compile (sizes from the live device) and execute on Vulkan."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
+from rgraph.errors import RGraphError
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
+    add_graph_arguments(parser, size_default="640x360")
+    parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
+    parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
+    parser.add_argument("--validate", action="store_true",
+                        help="Khronos validation + synchronization validation; exit 1 on any message")
+    parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
+                        help="compare outputs with the probe's CPU simulation (default: on with --validate)")
+    parser.add_argument("--out", type=Path, help="write the first output image as PNG")
+    parser.add_argument("--timings", type=Path, help="write per-pass GPU times (median ms) as JSON")
+    parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.set_defaults(func=run)
+
+
+def _load_plan(args: argparse.Namespace) -> dict:
+    path = Path(args.graph)
+    if path.suffix == ".json" and path.is_file():
+        try:
+            plan = json.loads(path.read_text())
+        except json.JSONDecodeError as exc:
+            raise RGraphError.in_file(path, f"invalid JSON: {exc.msg}", exc.lineno, exc.colno) from None
+        if plan.get("format") != "rgraph-plan/1":
+            raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
+        return plan
+    from rgraph.compile.pipeline import compile_graph
+    from rgraph.vk.device import create_device
+    from rgraph.vk.instance import create_instance
+    from rgraph.vk.memreq import DeviceMemoryRequirements
+
+    instance = create_instance(validate=False)
+    try:
+        device = create_device(instance, args.device, verbose=False)
+        try:
+            return compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
+                                 size=parse_size(args.size), policy=args.policy,
+                                 memory=DeviceMemoryRequirements(device))
+        finally:
+            device.destroy()
+    finally:
+        instance.destroy()
+
+
+def _print_table(plan: dict, timings: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"GPU time per pass (median of {timings.get('frames')} frames)")
+    table.add_column("#", justify="right")
+    table.add_column("pass")
+    table.add_column("queue")
+    table.add_column("kind")
+    table.add_column("ms", justify="right")
+    for p in plan["passes"]:
+        ms = timings["passes"].get(p["name"])
+        table.add_row(str(p["index"]), p["name"], p["queue"], p["kind"], "-" if ms is None else f"{ms:.3f}")
+    total = timings.get("total_ms")
+    table.add_row("", "frame", "", "", "-" if total is None else f"{total:.3f}")
+    Console(stderr=True).print(table)
+
+
+def run(args: argparse.Namespace) -> int:
+    from rgraph.vk.errors import ExecutionError, VulkanUnavailable
+    from rgraph.vk.executor import execute_plan
+
+    try:
+        plan = _load_plan(args)
+        result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
+                              check_data=args.check_data, out_png=args.out, verbose=True)
+    except (VulkanUnavailable, ExecutionError) as exc:
+        print(f"rgraph: error: {exc}", file=sys.stderr)
+        return 2
+    _print_table(plan, result.timings)
+    if args.timings:
+        args.timings.write_text(json.dumps({"device": result.device_name, **result.timings}, indent=1,
+                                           sort_keys=True) + "\n")
+    status = 0
+    for message in result.messages:
+        print(str(message), file=sys.stderr)
+    if args.validate:
+        print(f"rgraph: {len(result.messages)} validation message(s)", file=sys.stderr)
+        if result.messages:
+            status = 1
+    if result.data_ok is not None:
+        for mismatch in result.mismatches:
+            print(f"rgraph: data mismatch: {mismatch}", file=sys.stderr)
+        note = f" ({len(result.unchecked)} subresource(s) not predictable)" if result.unchecked else ""
+        print(f"rgraph: data check {'ok' if result.data_ok else 'FAILED'}{note}", file=sys.stderr)
+        if not result.data_ok:
+            status = 1
+    if args.out:
+        print(f"rgraph: wrote {args.out}", file=sys.stderr)
+    return status

@@ -413,7 +413,8 @@ def _check_rects(passes: list[Pass], resources: list[Resource]) -> None:
         if not res.is_image:
             raise _fail(path, f"'{res.name}' is a {res.kind}: its subresource must be null")
         if rect[1] > res.mips or rect[3] > res.layers:
-            raise _fail(path, f"range exceeds '{res.name}' ({res.mips} mips, {res.layers} layers)")
+            key = "mips" if rect[1] > res.mips else "layers"
+            raise _fail(path + [key], f"range exceeds '{res.name}' ({res.mips} mips, {res.layers} layers)")
 
     for p in passes:
         at: list[PathPart] = ["passes", p.index]

@@ -1,1 +1,74 @@
-"""Package."""
+"""Transient memory placement: lifetimes in, heaps and offsets out.
+
+``place(blocks, policy)`` is what the compiler calls; see ``docs/memory.md`` for the
+policies. Pure Python and numpy (no Vulkan): sizes and alignments come in with the blocks.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+
+from rgraph.memory.aliased import place_class
+from rgraph.memory.bounds import lower_bound
+from rgraph.memory.instance import Instance
+from rgraph.memory.model import Block, Heap, Placement, PlacementStats, by_class, check_blocks
+from rgraph.memory.online import place_blocks, place_tlsf
+from rgraph.memory.policy import Policy, parse_policy
+
+__all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "place"]
+
+#: Budget of the ``optimal`` policy when the caller leaves the default.
+OPTIMAL_BUDGET_S = 2.0
+DEFAULT_BUDGET_S = 0.05
+
+
+def place(
+    blocks: Sequence[Block], policy: str | Policy = "aliased", *, time_budget_s: float = DEFAULT_BUDGET_S
+) -> Placement:
+    """Place ``blocks`` under ``policy``. Heap ids go by memory class (sorted), then by
+    creation order within a class. Deterministic: the same input gives the same output."""
+    began = time.perf_counter()
+    chosen = parse_policy(policy)
+    check_blocks(blocks)
+    if chosen.kind == "optimal" and time_budget_s == DEFAULT_BUDGET_S:
+        time_budget_s = OPTIMAL_BUDGET_S
+    offsets: dict[str, tuple[int, int]] = {}
+    heaps: list[Heap] = []
+
+    def new_heap(size: int, memory_class: str, alignment: int) -> int:
+        heaps.append(Heap(len(heaps), size, memory_class, alignment))
+        return len(heaps) - 1
+
+    for memory_class, group in by_class(blocks).items():
+        max_align = max(b.alignment for b in group)
+        if chosen.kind == "dedicated":
+            for b in group:
+                offsets[b.name] = (new_heap(b.aligned_size, memory_class, b.alignment), 0)
+        elif chosen.kind in ("aliased", "optimal"):
+            result = place_class(Instance.build(group), time_budget_s)
+            heap_id = new_heap(result.peak, memory_class, max_align)
+            for b, offset in zip(group, result.offsets, strict=True):
+                offsets[b.name] = (heap_id, offset)
+        elif chosen.kind == "tlsf":
+            tlsf_offsets, high_water = place_tlsf(group)
+            heap_id = new_heap(high_water, memory_class, max_align)
+            for b, offset in zip(group, tlsf_offsets, strict=True):
+                offsets[b.name] = (heap_id, offset)
+        else:
+            where, sizes = place_blocks(group, chosen.block_bytes)
+            first = len(heaps)
+            for k, size in enumerate(sizes):
+                members = [b.alignment for b, (alloc, _) in zip(group, where, strict=True) if alloc == k]
+                new_heap(size, memory_class, max(members, default=1))
+            for b, (alloc, offset) in zip(group, where, strict=True):
+                offsets[b.name] = (first + alloc, offset)
+    stats = PlacementStats(
+        policy=str(chosen),
+        peak_bytes=sum(h.bytes for h in heaps),
+        lower_bound_bytes=lower_bound(blocks),
+        unaliased_bytes=sum(b.aligned_size for b in blocks),
+        allocations=len(heaps),
+        seconds=time.perf_counter() - began,
+    )
+    return Placement(offsets=offsets, heaps=heaps, stats=stats)

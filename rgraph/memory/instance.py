@@ -1,0 +1,79 @@
+"""One memory class's blocks as flat arrays, with time overlaps and sections precomputed."""
+
+from __future__ import annotations
+
+from bisect import bisect_left
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from rgraph.memory.model import Block
+
+
+@dataclass
+class Instance:
+    """Blocks of one memory class, indexed 0..n-1 in input order.
+
+    Sections are the maximal time ranges in which the set of live blocks does not change;
+    block ``i`` lives in sections ``sec_lo[i] .. sec_hi[i]-1``.
+    """
+
+    blocks: list[Block]
+    start: list[int]
+    end: list[int]
+    size: list[int]  # aligned sizes
+    align: list[int]
+    neighbors: list[list[int]]  # blocks overlapping in time, ascending index
+    sec_lo: list[int]
+    sec_hi: list[int]
+    section_count: int
+
+    @property
+    def n(self) -> int:
+        return len(self.blocks)
+
+    @classmethod
+    def build(cls, blocks: Sequence[Block]) -> Instance:
+        blocks = list(blocks)
+        start = [b.start for b in blocks]
+        end = [b.end for b in blocks]
+        starts = np.asarray(start, dtype=np.int64)
+        ends = np.asarray(end, dtype=np.int64)
+        neighbors: list[list[int]] = []
+        for i in range(len(blocks)):
+            row = (starts <= end[i]) & (ends >= start[i])
+            row[i] = False
+            neighbors.append(np.flatnonzero(row).tolist())
+        coords = sorted(set(start) | {e + 1 for e in end})
+        sec_lo = [bisect_left(coords, s) for s in start]
+        sec_hi = [bisect_left(coords, e + 1) for e in end]
+        return cls(
+            blocks=blocks,
+            start=start,
+            end=end,
+            size=[b.aligned_size for b in blocks],
+            align=[b.alignment for b in blocks],
+            neighbors=neighbors,
+            sec_lo=sec_lo,
+            sec_hi=sec_hi,
+            section_count=max(len(coords) - 1, 0),
+        )
+
+    def section_totals(self) -> list[int]:
+        """Aligned bytes alive in each section."""
+        diff = [0] * (self.section_count + 1)
+        for i in range(self.n):
+            diff[self.sec_lo[i]] += self.size[i]
+            diff[self.sec_hi[i]] -= self.size[i]
+        totals, running = [], 0
+        for k in range(self.section_count):
+            running += diff[k]
+            totals.append(running)
+        return totals
+
+    def lower_bound(self) -> int:
+        return max(self.section_totals(), default=0)
+
+    def peak(self, offsets: Sequence[int]) -> int:
+        return max((offsets[i] + self.size[i] for i in range(self.n)), default=0)

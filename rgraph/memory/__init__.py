@@ -16,11 +16,24 @@ from rgraph.memory.model import Block, Heap, Placement, PlacementStats, by_class
 from rgraph.memory.online import place_blocks, place_tlsf
 from rgraph.memory.policy import Policy, parse_policy
 
-__all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "place"]
+__all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "parse_place_args", "place"]
 
 #: Budget of the ``optimal`` policy when the caller leaves the default.
 OPTIMAL_BUDGET_S = 2.0
 DEFAULT_BUDGET_S = 0.05
+
+
+def parse_place_args(policy: str, budget: float | None, source: str = "<command line>") -> tuple[Policy, float | None]:
+    """Validate a policy name and budget given by a user; bad ones raise RGraphError."""
+    from rgraph.errors import RGraphError
+
+    try:
+        chosen = parse_policy(policy)
+    except ValueError as exc:
+        raise RGraphError.in_file(source, str(exc)) from None
+    if budget is not None and not budget > 0:
+        raise RGraphError.in_file(source, f"time budget must be positive, got {budget}")
+    return chosen, budget
 
 
 def place(

@@ -44,13 +44,16 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
     if best.peak <= lb or inst.n == 0:
         return best
     budget = node_budget_for(inst, time_budget_s)
+    if budget < 2 * inst.n:
+        return best  # too little to finish even one dive of the search
+    orders = [preorder(inst, h) for h in PREORDERINGS]
     # First the lower bound itself (often reachable), then bisection between the highest
     # capacity that failed and the best peak found, each try with a share of what is left.
     low, tries = lb, 0
     while budget > 0 and best.peak - low > max(best.peak // 1000, 1):
         capacity = lb if tries == 0 else (low + best.peak) // 2
         share = budget // 3 if tries == 0 else max(budget // 2, 1)
-        found, spent = search_capacity(inst, capacity, share)
+        found, spent = search_capacity(inst, orders, capacity, share)
         budget -= spent
         tries += 1
         if found is None:
@@ -67,11 +70,12 @@ def node_budget_for(inst: Instance, time_budget_s: float) -> int:
     return int(time_budget_s * NODES_PER_SECOND / work_per_node)
 
 
-def search_capacity(inst: Instance, capacity: int, node_budget: int) -> tuple[list[int] | None, int]:
+def search_capacity(
+    inst: Instance, orders: list[list[int]], capacity: int, node_budget: int
+) -> tuple[list[int] | None, int]:
     """Round robin over the preorderings with doubling node limits (as MiniMalloc does),
     until a placement within ``capacity`` is found, one is proven impossible, or the node
     budget is spent. Returns the offsets (or None) and the nodes spent."""
-    orders = [preorder(inst, h) for h in PREORDERINGS]
     limit = 2 * max(inst.n, 1)
     remaining = node_budget
     while remaining > 0:

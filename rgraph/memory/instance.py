@@ -5,6 +5,7 @@ from __future__ import annotations
 from bisect import bisect_left
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -59,6 +60,14 @@ class Instance:
             sec_hi=sec_hi,
             section_count=max(len(coords) - 1, 0),
         )
+
+    @cached_property
+    def members(self) -> np.ndarray:
+        """``members[s, i]``: block ``i`` lives in section ``s``."""
+        matrix = np.zeros((self.section_count, self.n), dtype=bool)
+        for i in range(self.n):
+            matrix[self.sec_lo[i] : self.sec_hi[i], i] = True
+        return matrix
 
     def section_totals(self) -> list[int]:
         """Aligned bytes alive in each section."""

@@ -63,10 +63,7 @@ class CapacitySearch:
         self.min_off = [0] * inst.n
         self.floor = np.zeros(inst.section_count, dtype=np.int64)
         self.total = np.asarray(inst.section_totals(), dtype=np.int64)
-        # members[s, i]: block i lives in section s (for the unplaced-floor inference).
-        self.members = np.zeros((inst.section_count, inst.n), dtype=bool)
-        for i in range(inst.n):
-            self.members[inst.sec_lo[i] : inst.sec_hi[i], i] = True
+        self.members = inst.members
         self.pending_min = np.zeros(inst.n, dtype=np.int64)  # min_off, or a huge value once placed
         for i in range(inst.n):
             if inst.size[i] == 0:

@@ -76,7 +76,7 @@ def print_table(rows: Sequence[dict[str, object]]) -> None:
             times = [row[label][1] for row in members]  # type: ignore[index]
             means.append(f"{sum(ratios) / len(ratios):>10.3f}x {1000 * max(times):>6.1f}ms^")
         print(f"{'mean ' + group:<16}{len(members):>7}" + "".join(f"{m:>22}" for m in means))
-    print("(per row: peak / lower bound, then seconds; 'mean' rows: mean ratio, ^ = slowest)")
+    print("(per row: peak / lower bound, then wall time; 'mean' rows: mean ratio, ^ = slowest)")
 
 
 def main() -> int:

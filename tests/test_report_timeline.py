@@ -10,7 +10,14 @@ import pytest
 from report_plans.helpers import FORWARD, MINIMAL, inspect, load
 
 from rgraph.report.html import plan_html
-from rgraph.report.timeline import class_layout, live_bytes, placed_blocks, timeline_title, write_timeline_png
+from rgraph.report.timeline import (
+    class_layout,
+    live_bytes,
+    placed_blocks,
+    timeline_title,
+    to_memory_model,
+    write_timeline_png,
+)
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -50,10 +57,23 @@ def test_title():
 @pytest.mark.parametrize("fixture", [FORWARD, MINIMAL])
 def test_own_drawing_writes_a_png(tmp_path, fixture):
     path = tmp_path / "t.png"
-    assert write_timeline_png(load(fixture), path, shared=False) == "report"
+    assert write_timeline_png(load(fixture), path) == "report"
     data = path.read_bytes()
     width, height = png_size(data)
     assert width >= 800 and height >= 300 and len(data) > 10_000
+
+
+def test_memory_library_drawing_of_the_transient_blocks(tmp_path):
+    plan = load(FORWARD)
+    blocks, placement = to_memory_model(plan)
+    assert sorted(b.name for b in blocks) == ["ao", "bloom_tex", "depth", "hdr", "lights", "shadow_maps"]
+    assert [h.id for h in placement.heaps] == [0, 2]
+    assert placement.offsets["bloom_tex"] == (0, 0) and placement.offsets["hdr"] == (0, 42008576)
+    stats = placement.stats
+    assert (stats.peak_bytes, stats.lower_bound_bytes, stats.unaliased_bytes) == (58654976, 58654976, 62849280)
+    path = tmp_path / "m.png"
+    assert write_timeline_png(plan, path, drawer="memory") == "memory"
+    png_size(path.read_bytes())
 
 
 def test_timeline_flag_writes_a_png(capsys, tmp_path):

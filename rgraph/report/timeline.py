@@ -1,9 +1,8 @@
 """The ``--timeline`` view: the plan's memory placement drawn as a PNG.
 
 Pass index runs across, offset up (a panel per memory class, its heaps stacked in id
-order); one rectangle per placed resource. When
-``rgraph.memory.timeline.draw_timeline(blocks, placement, path, title)`` exists it does the
-drawing from blocks converted out of the plan; otherwise this module draws it itself.
+order); one rectangle per placed resource. ``rgraph.memory.timeline.draw_timeline`` can
+draw the transient part instead, from blocks converted out of the plan.
 """
 
 from __future__ import annotations
@@ -84,42 +83,55 @@ def timeline_title(plan: Plan) -> str:
     return ", ".join(parts)
 
 
-def write_timeline_png(plan: Plan, path: str | Path, title: str | None = None, shared: bool = True) -> str:
-    """Draw the plan's placement into ``path``; returns which drawer did it (``memory`` or ``report``)."""
-    title = title or timeline_title(plan)
-    if shared:
+def write_timeline_png(plan: Plan, path: str | Path, title: str | None = None, drawer: str = "report") -> str:
+    """Draw the plan's placement into ``path``; returns the drawer used (``report`` or ``memory``).
+
+    ``report`` (default) draws every placed resource, a panel per memory class, pass names
+    across. ``memory`` hands the transient (aliased) blocks to the placement library's
+    ``draw_timeline``, the picture ``rgraph place`` draws; it falls back to ``report`` when
+    that library is absent. Non-transient resources each own a heap, and ``draw_timeline``
+    draws its class's lower bound in every heap panel, so they are left out there.
+    """
+    if drawer not in ("report", "memory"):
+        raise ValueError(f"unknown timeline drawer {drawer!r}")
+    if drawer == "memory":
         try:
             from rgraph.memory.timeline import draw_timeline
         except ImportError:
             draw_timeline = None
         if draw_timeline is not None:
-            blocks, placement = _to_memory_model(plan)
-            draw_timeline(blocks, placement, str(path), title)
+            blocks, placement = to_memory_model(plan)
+            draw_timeline(blocks, placement, str(path), title or str(plan.get("graph") or "plan"))
             return "memory"
-    draw_plan_timeline(plan, path, title)
+    draw_plan_timeline(plan, path, title or timeline_title(plan))
     return "report"
 
 
-def _to_memory_model(plan: Plan) -> tuple[list[Any], Any]:
-    """The plan as ``rgraph.memory.model`` blocks and placement, for the shared drawer."""
+def to_memory_model(plan: Plan) -> tuple[list[Any], Any]:
+    """The plan's transient resources as ``rgraph.memory.model`` blocks and placement."""
     from rgraph.memory.model import Block, Heap, Placement, PlacementStats
 
-    placed = placed_blocks(plan)
+    placed = [b for b in placed_blocks(plan) if b.aliasable]
     blocks = [Block(b.name, b.start, b.end, b.size, b.alignment, b.memory_class) for b in placed]
+    used = {b.heap for b in placed}
     heaps = [
         Heap(h["id"], h["bytes"], h.get("memory_class") or "-", h.get("alignment") or 1)
         for h in plan.get("heaps") or []
+        if h["id"] in used
     ]
-    stats = plan.get("stats") or {}
+    peak = sum(h.bytes for h in heaps)
+    unaliased = sum(b.aligned_size for b in placed)
+    lower = sum(max(live_bytes([b for b in placed if b.memory_class == cls], len(plan["passes"])), default=0)
+                for cls in sorted({b.memory_class for b in placed}))
     placement = Placement(
         offsets={b.name: (b.heap, b.offset) for b in placed},
         heaps=heaps,
         stats=PlacementStats(
-            policy=stats.get("policy") or "?",
-            peak_bytes=stats.get("peak_bytes") or sum(h.bytes for h in heaps),
-            lower_bound_bytes=stats.get("lower_bound_bytes") or 0,
-            unaliased_bytes=stats.get("unaliased_bytes") or sum(b.aligned_size for b in placed),
-            allocations=stats.get("allocations") or len(heaps),
+            policy=(plan.get("stats") or {}).get("policy") or "?",
+            peak_bytes=peak,
+            lower_bound_bytes=lower,
+            unaliased_bytes=unaliased,
+            allocations=len(heaps),
             seconds=0.0,
         ),
     )

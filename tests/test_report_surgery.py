@@ -85,3 +85,15 @@ def test_timeline_and_html(capsys, tmp_path):
     assert code == 0, err
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert '<h2 id="memory">' in page.read_text()
+
+
+def test_a_compiled_plan_file_reads_the_same_as_the_graph(capsys, tmp_path):
+    from rgraph.cli import main
+
+    path = tmp_path / "surgery.json"
+    assert main(["compile", "surgery", "--size", "640x360", "-o", str(path)]) == 0
+    capsys.readouterr()
+    for view in ([], ["--barriers"], ["--memory"], ["--dot"]):
+        _, from_file, _ = inspect(capsys, str(path), *view)
+        _, from_graph, _ = inspect(capsys, "surgery", "--size", "640x360", *view)
+        assert from_file == from_graph, view

@@ -49,21 +49,31 @@ def _barrier(b: Barrier, resources: Mapping[str, ResourceSpec]) -> dict[str, Any
         "subresource": _subresource(res, b.mips, b.layers),
         "src": src,
         "dst": dst,
-        "aliases": list(b.key.aliases) or None,
+        "aliases": _aliases(b.key.aliases),
     }
 
 
-def _uniform_state(res: ResourceSpec, states: Mapping[Any, State] | None) -> Any:
-    """One state object when every cell agrees, else a list of per-cell-range states."""
+def _aliases(names: tuple[str, ...]) -> str | list[str] | None:
+    """The previous occupant of aliased memory: a name, a list when several, else null."""
+    if not names:
+        return None
+    return names[0] if len(names) == 1 else list(names)
+
+
+def _end_state(res: ResourceSpec, lifetime: str, states: Mapping[Any, State] | None) -> Any:
+    """One state object when every cell agrees. Otherwise: null for transients (nothing
+    outlives the frame), a list of per-cell states for the others (docs/plan.md)."""
     if not states:
         return None
     distinct = set(states.values())
     if len(distinct) == 1:
         return _state(next(iter(distinct)))
-    ranges = []
-    for (_, mip, layer), st in sorted(states.items()):
-        ranges.append({"subresource": {"mips": [mip, mip + 1], "layers": [layer, layer + 1]}, **_state(st)})
-    return ranges
+    if lifetime == "transient":
+        return None
+    return [
+        {"subresource": {"mips": [mip, mip + 1], "layers": [layer, layer + 1]}, **_state(st)}
+        for (_, mip, layer), st in sorted(states.items())
+    ]
 
 
 def build_plan(
@@ -143,8 +153,8 @@ def build_plan(
             "last": spans[name][1],
             "heap": heap,
             "offset": offset,
-            "initial": _uniform_state(res, sync.initial.get(name)),
-            "final": _uniform_state(res, sync.final.get(name)),
+            "initial": _end_state(res, lifetime, sync.initial.get(name)),
+            "final": _end_state(res, lifetime, sync.final.get(name)),
         }
         if res.is_image:
             entry.update({"extent": list(res.extent), "mips": res.mips, "layers": res.layers, "samples": res.samples})

@@ -42,13 +42,16 @@ def _make_resources(rng: random.Random, count: int) -> list[_Res]:
     for i in range(count):
         roll = rng.random()
         lifetime = "persistent" if rng.random() < 0.1 else "transient"
+        single = lifetime == "persistent" or rng.random() < 0.3  # persistent ones end the frame uniform
         if roll < 0.2:
             out.append(_Res(f"buf{i}", "buffer", None, lifetime=lifetime))
         elif roll < 0.35:
-            out.append(_Res(f"depth{i}", "image", DEPTH_FORMAT, rng.choice(SIZES), rng.choice((1, 1, 2)), 1, lifetime))
+            layers = 1 if single else rng.choice((1, 2))
+            out.append(_Res(f"depth{i}", "image", DEPTH_FORMAT, rng.choice(SIZES), layers, 1, lifetime))
         else:
             fmt = rng.choice(COLOR_FORMATS)
-            out.append(_Res(f"img{i}", "image", fmt, rng.choice(SIZES), rng.choice((1, 1, 2, 3)), rng.choice((1, 1, 2)), lifetime))
+            layers, mips = (1, 1) if single else (rng.choice((1, 2, 3)), rng.choice((1, 1, 2)))
+            out.append(_Res(f"img{i}", "image", fmt, rng.choice(SIZES), layers, mips, lifetime))
     return out
 
 
@@ -89,7 +92,7 @@ def random_graph(seed: int, passes: int, *, queues: bool = True, resources: int 
         if rng.random() < 0.05:
             entry["side_effects"] = True
         graph_passes[f"p{i:05d}"] = entry
-    written = [r for r in res_list if r.written]
+    written = [r for r in res_list if r.written and r.layers == 1 and r.mips == 1]
     outputs = sorted({r.name for r in rng.sample(written, k=min(len(written), max(1, len(written) // 4)))}) if written else []
     resources_out: dict[str, Any] = {}
     for r in res_list:

@@ -87,6 +87,7 @@ def build_plan(
     spans: Mapping[str, tuple[int, int]],
     usages: Mapping[str, set[str]],
     profile_name: str,
+    culled_bytes: Mapping[str, int] | None = None,
 ) -> dict[str, Any]:
     resources = spec.resources
     queues = [q for q in QUEUE_ORDER if any(p.queue == q for p in passes)]
@@ -173,7 +174,7 @@ def build_plan(
         "device_profile": profile_name,
         "queues": queues,
         "passes": plan_passes,
-        "culled": [_culled_entry(c, by_name[c.pass_name], kept_resources) for c in culling.culled],
+        "culled": [_culled_entry(c, by_name[c.pass_name], kept_resources, culled_bytes or {}) for c in culling.culled],
         "dropped_reads": [
             {"pass": d.pass_name, "resource": d.resource, "reason": d.reason} for d in culling.dropped_reads
         ],
@@ -195,10 +196,10 @@ def build_plan(
     }
 
 
-def _culled_entry(c, p: PassSpec, kept_resources: set[str]) -> dict[str, Any]:
-    """A culled pass with the resources only it (and other culled passes) used."""
+def _culled_entry(c, p: PassSpec, kept_resources: set[str], sizes: Mapping[str, int]) -> dict[str, Any]:
+    """A culled pass with the resources only culled passes used, and their bytes."""
     only = sorted({a.resource for a in p.accesses} - kept_resources)
-    return {"pass": c.pass_name, "reason": c.reason, "resources": only}
+    return {"pass": c.pass_name, "reason": c.reason, "resources": only, "bytes": sum(sizes.get(r, 0) for r in only)}
 
 
 def _signal_values(passes: Sequence[PassSpec], sync: SyncResult) -> dict[int, int]:

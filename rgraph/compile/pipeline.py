@@ -103,9 +103,16 @@ def _compile_spec(spec, policy, memory_provider, profile_name) -> dict[str, Any]
     except ValueError as exc:
         raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
     aliases = memory.alias_sources(placement, reqs, spans)
+    culled_passes = {c.pass_name for c in culling.culled}
+    culled_used = {
+        r: u for r, u in memory.usages_by_resource([p for p in spec.passes if p.name in culled_passes]).items()
+        if r not in reqs
+    }
+    culled_bytes = {r: v[0] for r, v in memory.requirements(spec.resources, culled_used, spec.outputs, memory_provider).items()}
     sync = synchronize(passes, spec.resources, aliases)
     return build_plan(
-        spec, culling, passes, sync, placement, reqs, classes, spans, used, profile_name or "device"
+        spec, culling, passes, sync, placement, reqs, classes, spans, used, profile_name or "device",
+        culled_bytes
     )
 
 

@@ -183,6 +183,11 @@ def _str(value: Any, path: list[PathPart], allow_none: bool = False) -> str | No
 
 def _names(value: Any, path: list[PathPart], known: frozenset[str], what: str) -> list[str]:
     items = _list(value, path)
+    try:
+        if known.issuperset(items):
+            return items
+    except TypeError:  # an unhashable item: report it below
+        pass
     for i, name in enumerate(items):
         if not isinstance(name, str) or name not in known:
             raise _fail(path + [i], f"unknown {what} name {name!r}")

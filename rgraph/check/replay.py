@@ -11,6 +11,7 @@ orders a queue's own past too).
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Iterable
 from dataclasses import replace
 
@@ -223,10 +224,10 @@ class Replay:
             yield chosen
 
     def _signal_for(self, queue: int, value: int) -> tuple[int, int, list[int]] | None:
-        for sig in self.signals[queue]:
-            if sig[0] >= value:
-                return sig
-        return None
+        """The first recorded signal of ``queue`` that reaches ``value`` (values increase)."""
+        signals = self.signals[queue]
+        i = bisect_left(signals, value, key=lambda sig: sig[0])
+        return signals[i] if i < len(signals) else None
 
     def _run_pass(self, p: Pass) -> None:
         q = p.queue
@@ -293,7 +294,8 @@ class Replay:
                         memo[key] = self._barrier_cell(p, b, before, res, st, pairs)
                     for finding in memo[key][1]:
                         found.setdefault(finding, []).append(rect)
-                self._emit_findings(found, p, res, self._barrier_head(p, b, before, res))
+                if found:
+                    self._emit_findings(found, p, res, self._barrier_head(p, b, before, res))
                 cells.update(b.rect, lambda st, memo=memo: memo[id(st)][0])
         chains.apply_batch(pairs)
 
@@ -470,7 +472,8 @@ class Replay:
                     memo[key] = self._access_checks(p, a, res, st)
                 for finding in memo[key]:
                     found.setdefault(finding, []).append(rect)
-            self._emit_findings(found, p, res, self._access_head(p, a, res))
+            if found:
+                self._emit_findings(found, p, res, self._access_head(p, a, res))
         for a in sorted(p.accesses, key=lambda a: not a.write):
             self.cells[a.resource].update(a.rect, lambda st, a=a: self._apply_access(p, a, st))
 

@@ -73,6 +73,8 @@ def print_report(report, out=sys.stdout) -> None:
     if base is not None:
         flags = base.caught_by
         state = "clean" if not flags else f"NOT CLEAN ({', '.join(flags)}): mutation results are unreliable"
+        if base.check_error:
+            state += " (check could not read it)"
         console.print(f"baseline plan: {state}")
     for o in report.check_errors()[:3]:
         console.print(f"check could not read the plan of {o.mutant.name}: {o.check_error}")

@@ -1,0 +1,66 @@
+"""Soak: the surgery plan resubmitted for many frames at a small size keeps a flat resident set
+(the teardown leak test itself lives in tests/test_vk_device.py)."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from rgraph.compile.pipeline import compile_graph
+from rgraph.vk.errors import VulkanUnavailable
+
+pytestmark = pytest.mark.vulkan
+
+RSS_TOLERANCE_KIB = 2048  # allocator noise; a per-frame leak of even 3 KiB over 900 frames exceeds it
+
+
+def rss_kib() -> int:
+    with open("/proc/self/status") as f:
+        return int(re.search(r"VmRSS:\s+(\d+) kB", f.read()).group(1))
+
+
+def rss_at_frames(frames: int, marks: tuple[int, ...], size=(16, 16)) -> dict[int, int]:
+    """Run surgery for ``frames`` frames in one run; resident set size (KiB) as frame ``m`` starts.
+
+    The executor announces each frame through its message log's ``context`` (``"frame N"``);
+    the sampler listens there, so the frame loop itself is the one under test."""
+    from rgraph.vk.executor import Executor
+
+    plan = compile_graph("surgery", size=size)
+    try:
+        executor = Executor(plan, validate=False, device_index=None, verbose=False)
+    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
+        pytest.skip(str(exc))
+    samples: dict[int, int] = {}
+    log = executor.log
+    base = type(log)
+
+    class Sampling(base):  # type: ignore[misc, valid-type]
+        def __setattr__(self, name, value):
+            if name == "context" and isinstance(value, str):
+                m = re.fullmatch(r"frame (\d+)", value)
+                if m and int(m.group(1)) in marks:
+                    samples[int(m.group(1))] = rss_kib()
+            base.__setattr__(self, name, value)
+
+    log.__class__ = Sampling
+    try:
+        executor.run_frames(frames)
+    finally:
+        log.__class__ = base
+        messages = executor.close()
+    assert messages == []
+    assert set(samples) == set(marks), samples
+    return samples
+
+
+def test_soak_200_frames_rss_flat():
+    rss = rss_at_frames(200, (20, 199))
+    assert rss[199] - rss[20] <= RSS_TOLERANCE_KIB, rss
+
+
+@pytest.mark.slow
+def test_soak_1000_frames_rss_flat():
+    rss = rss_at_frames(1000, (100, 999))
+    assert rss[999] - rss[100] <= RSS_TOLERANCE_KIB, rss

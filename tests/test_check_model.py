@@ -97,7 +97,7 @@ def test_barriers_of_one_batch_do_not_chain_but_consecutive_batches_do():
         passes[y_barrier_pass]["barriers"].append(barrier("y", scope(FS, [], BUF), scope(VS, [], BUF)))
         return plan_of(passes, [
             resource("x", "buffer", 0, 2, lifetime="imported", initial=scope(FS, ["UNIFORM_READ"], BUF)),
-            resource("y", "buffer", 0, 2, lifetime="imported", initial=scope(FS, ["UNIFORM_READ"], BUF))])
+            resource("y", "buffer", 0, 2, lifetime="imported", initial=scope(FS + VS, ["UNIFORM_READ"], BUF))])
 
     assert check_plan(plan(1)) == []  # FS -> VS (pass 1), then VS -> CS (pass 2): a chain
     assert {h.kind for h in check_plan(plan(2))} == {WAR}  # same batch: no chain
@@ -232,3 +232,37 @@ def test_aliasing_analysis_picks_direct_predecessors_only():
     names = {plan.resources[k].name: [plan.resources[e].name for e in v] for k, v in info.handoffs.items()}
     assert names == {"mid": ["old"], "late": ["mid", "old"]}  # 'old' still owns bytes 50..100
     assert info.overlaps == [] and info.lifetime_errors == []
+
+
+def test_previous_frames_reads_keep_their_write_visible_only_to_them():
+    def plan(read_stages):
+        img = scope(CS, [], "GENERAL")
+        return plan_of([gpass(0, "r", [access("x", read_stages, ["SHADER_STORAGE_READ"], "GENERAL")])],
+                       [resource("x", lifetime="persistent", initial=img, final=img)])
+
+    assert check_plan(plan(CS)) == []
+    hazards = [h for h in check_plan(plan(FS)) if h.pass_name == "r"]
+    assert [h.kind for h in hazards] == [RAW] and "the previous frame's last write" in hazards[0].message
+
+
+def test_aliases_may_list_several_previous_occupants():
+    plan = json.loads((__import__("pathlib").Path(__file__).parent / "plans" / "aliasing.json").read_text())
+    plan["passes"][4]["barriers"][0]["aliases"] = ["a", "b", "c"]
+    assert check_plan(plan) == []
+
+
+def test_per_subresource_end_states():
+    layer = [{"mips": [0, 1], "layers": [i, i + 1]} for i in range(2)]
+    states = [dict(scope(FS, [], "SHADER_READ_ONLY_OPTIMAL"), subresource=layer[0]),
+              dict(scope(CS, STORE_W, "GENERAL"), subresource=layer[1])]
+    plan = plan_of([
+        gpass(0, "use", [access("x", FS, SAMPLED, "SHADER_READ_ONLY_OPTIMAL", sub=layer[0]),
+                         access("x", CS, STORE_W, "GENERAL", True, sub=layer[1])],
+              [barrier("x", scope(CS, STORE_W, "GENERAL"), scope(CS, STORE_W, "GENERAL"), layer[1])]),
+    ], [resource("x", layers=2, lifetime="persistent", initial=states, final=states)])
+    assert check_plan(plan) == []
+    plan["resources"][0]["final"] = [states[1] | {"subresource": layer[0]}, states[1]]
+    hazards = check_plan(plan)
+    assert {(h.kind, h.subresource) for h in hazards} == {("final state", ((0, 1), (0, 1))),
+                                                           ("final state", ((0, 1), (0, 2)))}
+    assert any("ends in SHADER_READ_ONLY_OPTIMAL but 'final' declares GENERAL" in h.message for h in hazards)

@@ -42,7 +42,7 @@ class Barrier:
     rect: Rect | None
     src: Scope
     dst: Scope
-    aliases: str | None
+    aliases: tuple[str, ...] | None  # previous occupants handed over (informational)
     position: int  # index in its list
 
     @property
@@ -99,11 +99,15 @@ class Pass:
 
 @dataclass(slots=True)
 class EndState:
+    """A resource's state at a frame boundary, for ``rect`` (None: every cell)."""
+
+    rect: Rect | None
     stages: int
     access: int
     layout: str | None
     queue: int | None
     raw: dict[str, Any]
+    index: int | None = None  # position in a per-subresource list
 
 
 @dataclass(slots=True)
@@ -118,8 +122,8 @@ class Resource:
     heap: int | None
     offset: int | None
     bytes: int | None
-    initial: EndState | None
-    final: EndState | None
+    initial: list[EndState] | None  # one entry, or one per cell group (non-uniform end states)
+    final: list[EndState] | None
 
     @property
     def is_image(self) -> bool:
@@ -244,20 +248,42 @@ class _Reader:
             queue=self.queue(_get(raw, "queue", path), path + ["queue"]),
         )
 
-    def end_state(self, value: Any, path: list[PathPart]) -> EndState | None:
+    def end_states(self, value: Any, path: list[PathPart]) -> list[EndState] | None:
+        """One state (an object) or a list of per-subresource states; None stays None."""
         if value is None:
             return None
+        if isinstance(value, list):
+            return [self.end_state(item, path + [i], i) for i, item in enumerate(value)]
+        return [self.end_state(value, path, None)]
+
+    def end_state(self, value: Any, path: list[PathPart], index: int | None) -> EndState:
         raw = _obj(value, path)
         stages = _names(_get(raw, "stages", path, []), path + ["stages"], vocab.KNOWN_STAGE_NAMES, "stage")
         access = _names(_get(raw, "access", path, []), path + ["access"], vocab.KNOWN_ACCESS_NAMES, "access")
         queue = _get(raw, "queue", path, None)
+        rect = self.rect(_get(raw, "subresource", path, None), path + ["subresource"])
+        if index is not None and rect is None and "subresource" not in raw:
+            raise _fail(path, "a per-subresource end state needs 'subresource'")
         return EndState(
+            rect=rect,
             stages=vocab.stage_mask(stages, vocab.SCOPE_ACCESS),
             access=vocab.access_mask(access),
             layout=self.layout(_get(raw, "layout", path, None), path + ["layout"]),
             queue=None if queue is None else self.queue(queue, path + ["queue"]),
             raw=raw,
+            index=index,
         )
+
+
+def _aliases(value: Any, path: list[PathPart]) -> tuple[str, ...] | None:
+    if value is None:
+        return None
+    if isinstance(value, str):
+        return (value,)
+    items = _list(value, path)
+    for i, name in enumerate(items):
+        _str(name, path + [i])
+    return tuple(items)
 
 
 def read_plan(raw: Any) -> Plan:
@@ -315,7 +341,7 @@ def read_plan(raw: Any) -> Plan:
             rect=rect,
             src=reader.scope(_get(raw_b, "src", path), path + ["src"], vocab.SCOPE_FIRST),
             dst=reader.scope(_get(raw_b, "dst", path), path + ["dst"], vocab.SCOPE_SECOND),
-            aliases=_str(raw_b.get("aliases"), path + ["aliases"], allow_none=True),
+            aliases=_aliases(raw_b.get("aliases"), path + ["aliases"]),
             position=position,
         )
 
@@ -388,7 +414,7 @@ def read_plan(raw: Any) -> Plan:
         assert mips is not None and layers is not None
         if mips < 1 or layers < 1:
             raise _fail(at, "an image needs at least one mip and one layer")
-        initial = reader.end_state(_get(r, "initial", at, None), at + ["initial"])
+        initial = reader.end_states(_get(r, "initial", at, None), at + ["initial"])
         if lifetime in ("persistent", "imported") and initial is None:
             raise _fail(at, f"a {lifetime} resource needs an 'initial' state")
         resources.append(Resource(
@@ -399,7 +425,7 @@ def read_plan(raw: Any) -> Plan:
             offset=_int(_get(r, "offset", at, None), at + ["offset"], allow_none=True),
             bytes=_int(_get(r, "bytes", at, None), at + ["bytes"], allow_none=True),
             initial=initial,
-            final=reader.end_state(_get(r, "final", at, None), at + ["final"]),
+            final=reader.end_states(_get(r, "final", at, None), at + ["final"]),
         ))
 
     _check_rects(passes, resources)
@@ -421,6 +447,11 @@ def _check_rects(passes: list[Pass], resources: list[Resource]) -> None:
             key = "mips" if rect[1] > res.mips else "layers"
             raise _fail(path + [key], f"range exceeds '{res.name}' ({res.mips} mips, {res.layers} layers)")
 
+    for i, res in enumerate(resources):
+        for key in ("initial", "final"):
+            for k, state in enumerate(getattr(res, key) or []):
+                where: list[PathPart] = ["resources", i, key] + ([] if state.index is None else [k])
+                check(i, state.rect, where + ["subresource"])
     for p in passes:
         at: list[PathPart] = ["passes", p.index]
         for j, a in enumerate(p.accesses):

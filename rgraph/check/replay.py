@@ -20,11 +20,13 @@ from rgraph.check import vocab
 from rgraph.check.aliasing import analyse
 from rgraph.check.cells import CellMap, merge_rects
 from rgraph.check.chains import BarrierStages, ChainRegistry, batch_add
-from rgraph.check.plan import Access, Barrier, Pass, Plan, Rect, Resource
+from rgraph.check.plan import Access, Barrier, EndState, Pass, Plan, Rect, Resource
 from rgraph.check.state import READ, TRANSITION, WRITE, CellState, Rec, Release
 
 NOTHING = -2  # vector clock entry: no pass of that queue is known to be complete
-PREVIOUS_FRAME = -1
+PREVIOUS_FRAME = -1  # pass index of the previous frame's final accesses
+PREVIOUS_ORIGIN = "the previous frame"
+PREVIOUS_WRITE = "the previous frame's last write (visible to its final reads only)"
 
 Finding = tuple[str, str]  # (kind, detail)
 
@@ -46,22 +48,47 @@ class Replay:
         self.queues = plan.queues
         nq = max(len(plan.queues), 1)
         self.chains = [ChainRegistry() for _ in range(nq)]
-        self.vc = [[NOTHING] * nq for _ in range(nq)]
+        # Frame-boundary waits (docs/plan.md): the previous frame's accesses on *other*
+        # queues are ordered before, and visible to, everything in this frame.
+        self.vc = [[NOTHING if q == other else PREVIOUS_FRAME for other in range(nq)] for q in range(nq)]
         self.signals: list[list[tuple[int, int, list[int]]]] = [[] for _ in range(nq)]
         self.hazards: list[hz.Hazard] = []
         self.touched = [False] * len(plan.resources)
         self.alias = analyse(plan)
-        self.cells = [CellMap(res.whole, self._initial_state(res)) for res in plan.resources]
+        self.wrap_acquires = self._wraparound_acquires()
+        self.cells = [self._initial_cells(i, res) for i, res in enumerate(plan.resources)]
 
     # --- setup --------------------------------------------------------------------------
 
-    def _initial_state(self, res: Resource) -> CellState:
-        layout = vocab.UNDEFINED if res.is_image else None
-        if res.lifetime in ("transient", "output") or res.initial is None:
-            return CellState(layout=layout, owner=-1, defined=False, touched=False)
-        init = res.initial
+    def _wraparound_acquires(self) -> dict[int, list[Barrier]]:
+        """Acquires in the first pass touching a persistent/imported resource: their release
+        ran at the end of the previous frame (docs/plan.md, ownership across the boundary)."""
+        out: dict[int, list[Barrier]] = {}
+        for i, res in enumerate(self.plan.resources):
+            span = self.alias.used[i]
+            if res.lifetime not in ("persistent", "imported") or span is None:
+                continue
+            acquires = [b for b in self.plan.passes[span[0]].barriers if b.resource == i and b.is_transfer]
+            if acquires:
+                out[i] = acquires
+        return out
+
+    def _initial_cells(self, res_index: int, res: Resource) -> CellMap[CellState]:
+        fresh = CellState(layout=vocab.UNDEFINED if res.is_image else None, owner=-1, defined=False, touched=False)
+        cells: CellMap[CellState] = CellMap(res.whole, fresh)
+        if res.lifetime in ("transient", "output") or not res.initial:
+            return cells
+        for entry in res.initial:
+            state = self._carried_state(res, entry)
+            cells.update(entry.rect, lambda _old, state=state: state)
+        for b in self.wrap_acquires.get(res_index, []):
+            cells.update(b.rect, lambda old, b=b: self._released_at_start(res, b, old))
+        return cells
+
+    def _carried_state(self, res: Resource, init: EndState) -> CellState:
+        """A cell as the previous frame left it: its final accesses just happened on its queue."""
         queue = init.queue if init.queue is not None else 0
-        origin = "the previous frame"
+        origin = PREVIOUS_ORIGIN
         writes: list[Rec] = []
         reads: list[Rec] = []
         write_bits = init.access & vocab.WRITE_MASK
@@ -71,10 +98,28 @@ class Replay:
             else:
                 cls = self.chains[queue].get(stage, 0)
                 reads.append(Rec(READ, queue, PREVIOUS_FRAME, stage, init.access, cls, origin))
+        if reads:
+            # The write those reads saw is available, chained to their stages and visible to
+            # them only (any read access when 'access' does not name them).
+            seen = init.access & vocab.READ_MASK or vocab.READ_MASK
+            writes.append(Rec(WRITE, queue, PREVIOUS_FRAME, 0, 0, self.chains[queue].get(init.stages, init.stages),
+                              PREVIOUS_WRITE, ((init.stages, seen),)))
         return CellState(
             layout=init.layout if res.is_image else None, owner=queue, defined=True, touched=True,
             writes=tuple(writes), reads=tuple(reads),
         )
+
+    def _released_at_start(self, res: Resource, b: Barrier, old: CellState) -> CellState:
+        if old.owner != b.src.queue:
+            return old  # the acquire will report the mismatch
+        image = res.is_image
+        rel = Release(b.src.queue, b.dst.queue, old.layout if image else None, b.dst.layout if image else None,
+                      PREVIOUS_FRAME, "the previous frame's final release")
+        if image and old.layout != b.dst.layout:
+            trans = Rec(TRANSITION, b.src.queue, PREVIOUS_FRAME, 0, 0, -1,
+                        f"layout transition {old.layout} -> {b.dst.layout} by the previous frame's final release")
+            return replace(old, release=rel, layout=b.dst.layout, writes=(trans,), reads=())
+        return replace(old, release=rel)
 
     # --- queries ------------------------------------------------------------------------
 
@@ -144,11 +189,11 @@ class Replay:
                 entry[2] |= missing.get(id(rec), 0)
         out = []
         for (kind, origin, queue), (stages, access, miss) in groups.items():
-            if kind == TRANSITION:
+            if kind == TRANSITION or origin == PREVIOUS_WRITE:
                 text = origin
             else:
                 verb = "write" if kind == WRITE else "read"
-                if origin == "the previous frame":
+                if origin == PREVIOUS_ORIGIN:
                     text = f"{verb} by the previous frame ({vocab.stage_names(stages)}/{vocab.access_names(access)})"
                 else:
                     text = f"{verb} by {origin} ({vocab.stage_names(stages)}/{vocab.access_names(access)})"
@@ -554,33 +599,40 @@ class Replay:
 
     def _check_final_states(self) -> None:
         for res_index, res in enumerate(self.plan.resources):
-            final = res.final
-            if final is None or self.alias.used[res_index] is None:
+            if res.final is None or self.alias.used[res_index] is None:
                 continue
             found: dict[Finding, list[Rect]] = {}
-            for rect, st in self.cells[res_index].states():
-                if not st.touched:
-                    continue
-                for finding in self._final_findings(res, st):
-                    found.setdefault(finding, []).append(rect)
-            init = res.initial
-            if res.lifetime in ("persistent", "imported") and init is not None and (
-                    init.layout, init.queue, init.stages, init.access) != (
-                    final.layout, final.queue, final.stages, final.access):
+            for entry in res.final:
+                for rect, st in self.cells[res_index].query(entry.rect):
+                    if st.touched:
+                        for finding in self._final_findings(res_index, res, entry, st):
+                            found.setdefault(finding, []).append(rect)
+            if res.lifetime in ("persistent", "imported") and res.initial is not None and (
+                    [_end_key(e) for e in res.initial] != [_end_key(e) for e in res.final]):
                 found.setdefault((hz.FINAL_STATE, "'initial' differs from 'final' (the next frame starts from "
                                                   "this frame's final state)"), []).append(res.whole)
             self._emit_findings(found, None, res, f"end of frame: '{res.name}'{{sub}}")
 
-    def _final_findings(self, res: Resource, st: CellState) -> list[Finding]:
-        final = res.final
-        assert final is not None
+    def _wraps(self, res_index: int, rel: Release) -> bool:
+        """Is ``rel`` the end-of-frame release that the next frame's first acquire matches?"""
+        for b in self.wrap_acquires.get(res_index, []):
+            if (b.src.queue, b.dst.queue, b.dst.layout if self.plan.resources[res_index].is_image else None) == (
+                    rel.src_queue, rel.dst_queue, rel.dst_layout):
+                return True
+        return False
+
+    def _final_findings(self, res_index: int, res: Resource, final: EndState, st: CellState) -> list[Finding]:
         out: list[Finding] = []
-        if res.is_image and st.layout != final.layout:
-            out.append((hz.FINAL_STATE, f"ends in {st.layout} but 'final' declares {final.layout}"))
-        if st.release is not None:
-            out.append((hz.QUEUE_OWNERSHIP, f"released by {st.release.origin} and never acquired"))
-        elif final.queue is not None and st.owner >= 0 and st.owner != final.queue:
-            out.append((hz.FINAL_STATE, f"ends owned by queue '{self._queue_name(st.owner)}' but 'final' "
+        layout, owner = st.layout, st.owner
+        rel = st.release
+        if rel is not None:
+            if not self._wraps(res_index, rel):
+                return [(hz.QUEUE_OWNERSHIP, f"released by {rel.origin} and never acquired")]
+            layout, owner = rel.src_layout, rel.src_queue  # 'final' is the state before that release
+        if res.is_image and layout != final.layout:
+            out.append((hz.FINAL_STATE, f"ends in {layout} but 'final' declares {final.layout}"))
+        if final.queue is not None and owner >= 0 and owner != final.queue:
+            out.append((hz.FINAL_STATE, f"ends owned by queue '{self._queue_name(owner)}' but 'final' "
                                          f"declares '{self._queue_name(final.queue)}'"))
         if res.lifetime == "transient":
             return out
@@ -602,3 +654,7 @@ class Replay:
                                              f"is not covered by 'final' ({vocab.stage_names(final.stages)}/"
                                              f"{vocab.access_names(final.access)})"))
         return out
+
+
+def _end_key(e: EndState) -> tuple[object, ...]:
+    return (e.rect, e.layout, e.queue, e.stages, e.access)

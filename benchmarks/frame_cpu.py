@@ -26,12 +26,12 @@ from rgraph.vk.instance import create_instance
 from rgraph.vk.memreq import DeviceMemoryRequirements
 
 
-def compile_for_device(size: tuple[int, int]) -> tuple[dict, str, bool]:
+def compile_for_device(size: tuple[int, int], policy: str | None = None) -> tuple[dict, str, bool]:
     instance = create_instance(validate=False)
     try:
         device = create_device(instance, None, verbose=False)
         try:
-            plan = compile_graph("surgery", size=size, memory=DeviceMemoryRequirements(device))
+            plan = compile_graph("surgery", size=size, policy=policy, memory=DeviceMemoryRequirements(device))
             return plan, device.name, device.physical.device_type != "cpu"
         finally:
             device.destroy()
@@ -81,9 +81,10 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=2000)
     parser.add_argument("--busy-frames", type=int, default=300)
     parser.add_argument("--size", default="64x64", help="size for the CPU measurement (default 64x64)")
+    parser.add_argument("--policy", default=None, help="memory placement policy (default: the compiler's)")
     args = parser.parse_args()
     w, h = (int(x) for x in args.size.lower().split("x"))
-    plan, device, is_gpu = compile_for_device((w, h))
+    plan, device, is_gpu = compile_for_device((w, h), args.policy)
     per_frame = frame_cpu_us(plan, args.frames)
     passes = len(plan["passes"])
     print(f"device: {device}")
@@ -94,7 +95,7 @@ def main() -> None:
     if not is_gpu:
         print("GPU busy fraction: skipped (CPU device: lavapipe runs the frame on CPU threads)")
         return
-    plan1080, _, _ = compile_for_device((1920, 1080))
+    plan1080, _, _ = compile_for_device((1920, 1080), args.policy)
     busy = gpu_busy(plan1080, args.busy_frames)
     print(f"surgery 1920x1080, {args.busy_frames} frames: wall {busy['wall_ms']:.3f} ms/frame, GPU span "
           f"{busy['span_ms']:.3f} ms, GPU pass sum {busy['sum_ms']:.3f} ms, submit CPU {busy['cpu_submit_ms']:.3f} ms")

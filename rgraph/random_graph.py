@@ -71,6 +71,13 @@ def _selector(rng: random.Random, res: _Res, cells: set[tuple[int, int]], whole_
     return f"{res.name}[{', '.join(parts)}]", {(mip, x) for x in range(layer, layer_end)}
 
 
+def _layer_key(res: _Res, layer: int) -> tuple[str, set[tuple[int, int]]]:
+    """Select one layer of a single-mip resource (the whole resource when it has one layer)."""
+    if res.layers == 1:
+        return res.name, {(0, 0)}
+    return f"{res.name}[layer={layer}]", {(0, layer)}
+
+
 def random_graph(seed: int, passes: int, *, queues: bool = True, resources: int | None = None) -> dict[str, Any]:
     """A valid random graph with ``passes`` passes (deterministic for a seed)."""
     rng = random.Random(seed)
@@ -94,6 +101,8 @@ def random_graph(seed: int, passes: int, *, queues: bool = True, resources: int 
         graph_passes[f"p{i:05d}"] = entry
     written = [r for r in res_list if r.written and r.layers == 1 and r.mips == 1]
     outputs = sorted({r.name for r in rng.sample(written, k=min(len(written), max(1, len(written) // 4)))}) if written else []
+    if not outputs and graph_passes:  # never cull a graph to nothing
+        graph_passes[next(reversed(graph_passes))]["side_effects"] = True
     resources_out: dict[str, Any] = {}
     for r in res_list:
         if r.kind == "buffer":
@@ -114,15 +123,18 @@ def _random_pass(rng: random.Random, kind: str, res_list: list[_Res]) -> dict[st
         targets = [r for r in res_list if r.kind == "image" and r.mips == 1 and r.size == size]
         colors = [r for r in targets if not r.depth]
         depths = [r for r in targets if r.depth]
+        layer = rng.choice((0, 0, 1))  # every attachment of a pass covers one layer (same count)
+        colors = [r for r in colors if r.layers > layer]
+        depths = [r for r in depths if r.layers > layer]
         for r in rng.sample(colors, k=min(len(colors), rng.choice((1, 1, 2)))):
-            key, cells = _selector(rng, r, r.all_cells())
+            key, cells = _layer_key(r, layer)
             blend = cells <= r.written and rng.random() < 0.3
             writes[key] = "color_attachment_blend" if blend else "color_attachment"
             used.add(r.name)
             r.written |= cells
         if depths and rng.random() < 0.5:
             r = rng.choice(depths)
-            key, cells = _selector(rng, r, r.all_cells())
+            key, cells = _layer_key(r, layer)
             if cells <= r.written and rng.random() < 0.4:
                 reads[key] = ["depth_read", "sampled"] if rng.random() < 0.5 else "depth_read"
             else:
@@ -141,10 +153,14 @@ def _random_pass(rng: random.Random, kind: str, res_list: list[_Res]) -> dict[st
             usage = rng.choice(("uniform", "storage_read", "indirect") if kind == "compute" else ("uniform", "storage_read", "vertex", "index", "indirect"))
         else:
             usage = "sampled" if r.depth or r.format == "r8g8b8a8_unorm" or rng.random() < 0.7 else "storage_read"
+        if usage == "indirect" and "indirect" in reads.values():
+            usage = "uniform"  # one indirect buffer per pass
         reads[key] = usage
         used.add(r.name)
     if kind != "raster" or rng.random() < 0.2:
         writable = [r for r in res_list if r.name not in used and not r.depth]
+        if kind == "raster":  # storage written from fragments: within the attachments' area
+            writable = [r for r in writable if r.kind == "buffer" or (r.size[0] <= size[0] and r.size[1] <= size[1])]
         for r in rng.sample(writable, k=min(len(writable), rng.choice((1, 1, 2)))):
             key, cells = _selector(rng, r, r.all_cells())
             if kind == "transfer":

@@ -155,7 +155,5 @@ def test_surgery_every_mutant_caught_or_explained():
 
 
 @pytest.mark.vulkan
-@pytest.mark.xfail(strict=True, reason="check_plan rejects list-valued BARRIER.aliases that the compiler emits for "
-                                       "aliased surgery (docs/plan.md allows a list); remove when check reads lists")
 def test_surgery_aliased_every_drop_caught_or_explained():
     _assert_all_explained(_report(surgery("aliased"), kinds=["drop"]))

@@ -18,7 +18,7 @@ from dataclasses import replace
 from rgraph.check import hazards as hz
 from rgraph.check import vocab
 from rgraph.check.aliasing import analyse
-from rgraph.check.cells import CellMap, merge_rects
+from rgraph.check.cells import CellMap, intersect, merge_rects
 from rgraph.check.chains import BarrierStages, ChainRegistry, batch_add
 from rgraph.check.plan import Access, Barrier, EndState, Pass, Plan, Rect, Resource
 from rgraph.check.state import READ, TRANSITION, WRITE, CellState, Rec, Release
@@ -607,11 +607,18 @@ class Replay:
                     if st.touched:
                         for finding in self._final_findings(res_index, res, entry, st):
                             found.setdefault(finding, []).append(rect)
+                        if st.release is None and self._expects_release(res_index, rect):
+                            found.setdefault((hz.QUEUE_OWNERSHIP, "the next frame's first acquire expects a "
+                                              "release at the end of this frame, and none happened"), []).append(rect)
             if res.lifetime in ("persistent", "imported") and res.initial is not None and (
                     [_end_key(e) for e in res.initial] != [_end_key(e) for e in res.final]):
                 found.setdefault((hz.FINAL_STATE, "'initial' differs from 'final' (the next frame starts from "
                                                   "this frame's final state)"), []).append(res.whole)
             self._emit_findings(found, None, res, f"end of frame: '{res.name}'{{sub}}")
+
+    def _expects_release(self, res_index: int, rect: Rect) -> bool:
+        """Does an acquire at the start of the frame (wrapping around) cover ``rect``?"""
+        return any(b.rect is None or intersect(b.rect, rect) is not None for b in self.wrap_acquires.get(res_index, []))
 
     def _wraps(self, res_index: int, rel: Release) -> bool:
         """Is ``rel`` the end-of-frame release that the next frame's first acquire matches?"""

@@ -88,6 +88,8 @@ class _Cell:
     aliases: tuple[str, ...] = ()
     last_pass: int | None = None
     last_in_previous_frame: bool = False
+    visible: tuple[frozenset[str], frozenset[str]] = (frozenset(), frozenset())  # dst scope since the write
+    alias_waits: tuple[tuple[str, int], ...] = ()  # (queue, last pass) of each previous occupant
 
     def state(self) -> State:
         if self.reads:
@@ -171,21 +173,23 @@ def synchronize(
         res = resources[c[0]]
         if res.lifetime in PERSISTENT:
             st = first.cells[c]
-            # A transition with no access (st.write[2] empty) happens once, at creation, not
-            # every frame: the steady state only waits for real accesses.
-            write = (PREVIOUS_FRAME, st.write[1], st.write[2]) if st.write and st.write[2] else None
+            write = (PREVIOUS_FRAME, st.write[1], st.write[2]) if st.write else None
             reads = [(PREVIOUS_FRAME, stages) for _, stages in st.reads]
-            start[c] = _Cell(st.layout, st.queue, write, reads, last_pass=st.last_pass, last_in_previous_frame=True)
+            start[c] = _Cell(
+                st.layout, st.queue, write, reads, last_pass=st.last_pass, last_in_previous_frame=True,
+                visible=st.visible,
+            )
         else:
             start[c] = fresh(c)
     alias_init = _alias_initial_states(alias_sources, first, resources)
     for c, cell in start.items():
         if c[0] in alias_init:
-            stages, access, queue, last, names = alias_init[c[0]]
+            stages, access, queue, last, names, waits = alias_init[c[0]]
             cell.write = (PREVIOUS_FRAME, stages, access) if stages or access else None
             cell.queue = queue
             cell.last_pass = last
             cell.aliases = names
+            cell.alias_waits = waits
     sim = _Simulation(passes, per_pass_cells, timeline, resources, alias_init, final_first)
     initial = {c: st.state() for c, st in start.items()}
     sim.run(start)
@@ -209,6 +213,7 @@ def _alias_initial_states(alias_sources, first: _Simulation, resources):
         stages: set[str] = set()
         access: set[str] = set()
         last: tuple[int, str | None] = (-1, None)
+        waits: set[tuple[str, int]] = set()
         for pred in preds:
             for c, st in first.cells.items():
                 if c[0] != pred:
@@ -218,7 +223,12 @@ def _alias_initial_states(alias_sources, first: _Simulation, resources):
                 access |= s.access
                 if st.last_pass is not None and st.last_pass > last[0]:
                     last = (st.last_pass, st.queue)
-        out[name] = (frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)))
+                if st.last_pass is not None and st.queue is not None:
+                    waits.add((st.queue, st.last_pass))
+        out[name] = (
+            frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
+            tuple(sorted(waits)),
+        )
     return out
 
 
@@ -244,8 +254,7 @@ class _Simulation:
                     groups[(c[0], key)].append(c)
                     if release_at is not None:
                         release_groups[(release_at, c[0], key)].append(c)
-                if wait_on is not None:
-                    q, j = wait_on
+                for q, j in wait_on:
                     prev = waits.get(q)
                     waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | set(s.stages))
             self.out[i].barriers = _rectangles(groups)
@@ -266,9 +275,10 @@ class _Simulation:
         else:
             has_content = not cell.aliases and (cell.write is not None or bool(cell.reads))
         cross = cell.queue is not None and cell.queue != queue
-        release_at = wait_on = None
+        release_at = None
+        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue]  # aliased memory used on another queue
         if cross and cell.last_pass is not None and not cell.last_in_previous_frame:
-            wait_on = (cell.queue, cell.last_pass)  # earlier frames: the runtime's frame-boundary waits
+            wait_on.append((cell.queue, cell.last_pass))  # earlier frames: the runtime's frame-boundary waits
         transfer = cross and has_content
         if transfer and cell.last_pass is not None:
             release_at = cell.last_pass
@@ -287,24 +297,29 @@ class _Simulation:
                 if not write:  # a transition for a read group: cover the whole group
                     dst_stages, dst_access = self._group(uses, k, s.layout, queue)
                     cell.covered_until = self._group_end(uses, k, s.layout, queue)
+                    cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             if write:
                 cell.write = (i, s.stages, s.writes)
                 cell.reads = []
                 cell.covered_until = k
+                cell.visible = (frozenset(), frozenset())
             else:
-                cell.write = (i, s.stages, frozenset()) if layout_change else cell.write
+                if layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
+                    cell.write = (i, s.stages, frozenset()) if cell.layout != "UNDEFINED" else None
                 if layout_change:
                     cell.reads = []
                 cell.reads.append((i, s.stages))
         else:  # a read in the current layout
-            if transfer or (cell.write and k > cell.covered_until):
-                if transfer and cell.reads:
+            seen = s.stages <= cell.visible[0] and s.access <= cell.visible[1]  # e.g. last frame's barrier
+            if transfer or (cell.write and k > cell.covered_until and not seen):
+                if cell.reads:  # the write is already available: chain through the reads
                     src = State(prev.stages, frozenset(), cell.layout, src_queue)
                 else:
                     src = State(cell.write[1] if cell.write else frozenset(), cell.write[2] if cell.write else frozenset(), cell.layout, src_queue)
                 dst_stages, dst_access = self._group(uses, k, s.layout, queue)
                 cell.covered_until = self._group_end(uses, k, s.layout, queue)
+                cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             cell.reads.append((i, s.stages))
         if key is not None and not (key.src.stages or key.src.access) and key.src.layout == key.dst.layout and not transfer:
@@ -314,6 +329,7 @@ class _Simulation:
         cell.layout = s.layout
         cell.queue = queue
         cell.aliases = ()
+        cell.alias_waits = ()
         cell.last_pass = i
         cell.last_in_previous_frame = False
         return key, release_at, wait_on

@@ -18,7 +18,7 @@ REQUIRED_13 = ("synchronization2", "maintenance4")
 #: Core features the probe uses when a plan needs them (enabled when present).
 OPTIONAL_CORE = (
     "fragmentStoresAndAtomics", "vertexPipelineStoresAndAtomics", "shaderStorageImageWriteWithoutFormat",
-    "shaderStorageImageReadWithoutFormat", "drawIndirectFirstInstance", "multiDrawIndirect",
+    "shaderStorageImageReadWithoutFormat", "drawIndirectFirstInstance", "multiDrawIndirect", "independentBlend",
 )
 
 

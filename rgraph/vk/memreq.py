@@ -45,12 +45,18 @@ class DeviceMemoryRequirements:
         v = vk()
         info = image_create_info(format_vk_name, extent, mips, layers, samples, usage_names)
         query = v.VkDeviceImageMemoryRequirements(pCreateInfo=info, planeAspect=0)
-        req = v.vkGetDeviceImageMemoryRequirements(self.device.handle, query).memoryRequirements
+        # Pass our own output struct: the binding's default is zero-filled (sType 0), which
+        # lavapipe ignores but NVIDIA's driver leaves unwritten (size and alignment 0).
+        out = v.VkMemoryRequirements2()
+        v.vkGetDeviceImageMemoryRequirements(self.device.handle, query, out)
+        req = out.memoryRequirements
         return int(req.size), int(req.alignment), int(req.memoryTypeBits)
 
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
         v = vk()
         info = buffer_create_info(size, usage_names)
         query = v.VkDeviceBufferMemoryRequirements(pCreateInfo=info)
-        req = v.vkGetDeviceBufferMemoryRequirements(self.device.handle, query).memoryRequirements
+        out = v.VkMemoryRequirements2()
+        v.vkGetDeviceBufferMemoryRequirements(self.device.handle, query, out)
+        req = out.memoryRequirements
         return int(req.size), int(req.alignment), int(req.memoryTypeBits)

@@ -40,15 +40,11 @@ def _subresource(res: ResourceSpec, mips, layers) -> dict[str, list[int]] | None
 
 def _barrier(b: Barrier, resources: Mapping[str, ResourceSpec]) -> dict[str, Any]:
     res = resources[b.resource]
-    src = _state(b.key.src)
-    dst = _state(b.key.dst)
-    if not res.is_image:
-        src["layout"] = dst["layout"] = None
     return {
         "resource": b.resource,
         "subresource": _subresource(res, b.mips, b.layers),
-        "src": src,
-        "dst": dst,
+        "src": _state(b.key.src),
+        "dst": _state(b.key.dst),
         "aliases": _aliases(b.key.aliases),
     }
 

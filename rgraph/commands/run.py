@@ -29,10 +29,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _load_plan(args: argparse.Namespace) -> dict:
     path = Path(args.graph)
     if path.suffix == ".json" and path.is_file():
-        try:
-            plan = json.loads(path.read_text())
-        except json.JSONDecodeError as exc:
-            raise RGraphError.in_file(path, f"invalid JSON: {exc.msg}", exc.lineno, exc.colno) from None
+        from rgraph.check import load_plan_file
+
+        plan, _ = load_plan_file(path)
         if plan.get("format") != "rgraph-plan/1":
             raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
         return plan

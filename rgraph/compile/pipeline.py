@@ -44,11 +44,8 @@ def load_scene_for(source: GraphSource, scene_path: str | Path | None) -> Scene 
         return load_scene(scene_path)
     if source.default_scene is not None:
         if not source.default_scene.is_file():
-            raise RGraphError.at(
-                source.passes[next(iter(source.passes))].smap.value(("scene",)) if source.passes else
-                RGraphError.in_file(source.path, "").first.location,
-                f"default scene '{source.default_scene}' not found",
-            )
+            assert source.default_scene_loc is not None
+            raise RGraphError.at(source.default_scene_loc, f"default scene '{source.default_scene}' not found")
         return load_scene(source.default_scene)
     return None
 

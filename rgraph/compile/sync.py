@@ -163,11 +163,10 @@ def synchronize(
     # Frame 1 is needed only for persistent cells and for the resources others alias.
     needed = {r for r, res in resources.items() if res.lifetime in PERSISTENT}
     needed |= {p for preds in alias_sources.values() for p in preds}
-    first = _Simulation(passes, per_pass_cells, timeline, resources, {}, {})
+    first = _Simulation(passes, per_pass_cells, timeline, resources)
     if needed:
         first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
         first.run({c: fresh(c) for c in timeline if c[0] in needed})
-    final_first = first.final_states()
     start: dict[Cell, _Cell] = {}
     for c in timeline:
         res = resources[c[0]]
@@ -181,7 +180,7 @@ def synchronize(
             )
         else:
             start[c] = fresh(c)
-    alias_init = _alias_initial_states(alias_sources, first, resources)
+    alias_init = _alias_initial_states(alias_sources, first)
     for c, cell in start.items():
         if c[0] in alias_init:
             stages, access, queue, last, names, waits = alias_init[c[0]]
@@ -190,7 +189,7 @@ def synchronize(
             cell.last_pass = last
             cell.aliases = names
             cell.alias_waits = waits
-    sim = _Simulation(passes, per_pass_cells, timeline, resources, alias_init, final_first)
+    sim = _Simulation(passes, per_pass_cells, timeline, resources)
     initial = {c: st.state() for c, st in start.items()}
     sim.run(start)
     final = sim.final_states()
@@ -204,8 +203,11 @@ def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
     return dict(out)
 
 
-def _alias_initial_states(alias_sources, first: _Simulation, resources):
+def _alias_initial_states(alias_sources, first: _Simulation):
     """Union of the last accesses of each aliased resource's predecessors."""
+    cells_of: dict[str, list[_Cell]] = defaultdict(list)
+    for c, st in first.cells.items():
+        cells_of[c[0]].append(st)
     out = {}
     for name, preds in alias_sources.items():
         if not preds:
@@ -215,9 +217,7 @@ def _alias_initial_states(alias_sources, first: _Simulation, resources):
         last: tuple[int, str | None] = (-1, None)
         waits: set[tuple[str, int]] = set()
         for pred in preds:
-            for c, st in first.cells.items():
-                if c[0] != pred:
-                    continue
+            for st in cells_of[pred]:
                 s = st.state()
                 stages |= s.stages
                 access |= s.access
@@ -233,7 +233,7 @@ def _alias_initial_states(alias_sources, first: _Simulation, resources):
 
 
 class _Simulation:
-    def __init__(self, passes, per_pass_cells, timeline, resources, alias_init, final_first) -> None:
+    def __init__(self, passes, per_pass_cells, timeline, resources) -> None:
         self.passes = passes
         self.per_pass_cells = per_pass_cells
         self.timeline = timeline

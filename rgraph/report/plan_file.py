@@ -23,17 +23,9 @@ Plan = dict[str, Any]
 
 def load_plan(path: str | Path) -> Plan:
     """The plan dict in ``path``; ``RGraphError`` for a missing, undecodable or malformed file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise RGraphError.in_file(path, "plan file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RGraphError.in_file(path, f"cannot read plan file: {exc}") from None
-    try:
-        plan = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise RGraphError.in_file(path, f"invalid JSON: {exc.msg}", exc.lineno, exc.colno) from None
+    from rgraph.check import load_plan_file
+
+    plan, text = load_plan_file(path)
     check_plan(plan, str(path), text)
     return plan
 

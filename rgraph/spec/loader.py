@@ -47,6 +47,7 @@ class GraphSource:
     path: Path
     description: str | None
     default_scene: Path | None
+    default_scene_loc: Location | None = None
     memory_policy: str | None = None
     params: dict[str, Located] = field(default_factory=dict)
     resources: dict[str, Located] = field(default_factory=dict)
@@ -91,6 +92,7 @@ def load_graph(path: str | Path) -> GraphSource:
         path=root,
         description=model.description,
         default_scene=(root.parent / model.scene) if model.scene else None,
+        default_scene_loc=smap.value(("scene",)) if model.scene else None,
         memory_policy=model.memory_policy,
     )
     _merge(source, root, str(path), model, smap, chain=(root.resolve(),))

@@ -153,12 +153,7 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
             seen.add(sig)
             diagnostics.append(Diagnostic(location, msg))
     diagnostics.sort(key=lambda d: (d.location.line, d.location.col))
-    return RGraphError(diagnostics[:1] if _is_union_noise(diagnostics) else diagnostics)
-
-
-def _is_union_noise(diagnostics: list[Diagnostic]) -> bool:
-    """Several errors at one spot come from union branches: show the first only."""
-    return len({str(d.location) for d in diagnostics}) == 1 and len(diagnostics) > 1
+    return RGraphError(diagnostics)
 
 
 def _field_name(loc: PathKey) -> str:

@@ -192,7 +192,7 @@ def specialize(
         if missing:
             removed.append((name, "scene has no " + " and no ".join(missing)))
         passes.append(spec)
-    _check_program_order(passes, resources, {n for n, _ in removed})
+    _check_program_order(passes, resources)
     return Spec(
         name=source.name,
         source=str(source.path),
@@ -420,7 +420,7 @@ def _layout_class(usage: str) -> str:
     return {"sampled": "ro", "depth_read": "ro", "storage_read": "general", "transfer_src": "src"}.get(usage, usage)
 
 
-def _check_program_order(passes: list[PassSpec], resources: dict[str, ResourceSpec], removed: set[str]) -> None:
+def _check_program_order(passes: list[PassSpec], resources: dict[str, ResourceSpec]) -> None:
     """A non-optional read of a transient resource needs an earlier write of every cell it reads."""
     written: dict[str, set[tuple[int, int]]] = {}
     for p in passes:

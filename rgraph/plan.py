@@ -164,6 +164,7 @@ def build_plan(
         "graph": spec.name,
         "source": spec.source,
         "scene": spec.scene_name,
+        "scene_source": spec.scene_source,
         "size": list(spec.size),
         "params": dict(sorted(spec.params.items())),
         "features": dict(sorted(spec.features.items())),

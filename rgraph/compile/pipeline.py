@@ -9,7 +9,7 @@ provider may talk to a device.
 from __future__ import annotations
 
 import gc
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +22,7 @@ from rgraph.ir.cull import cull
 from rgraph.plan import build_plan
 from rgraph.resources import resolve_graph
 from rgraph.spec.loader import GraphSource, load_graph
+from rgraph.spec.pydantic_errors import did_you_mean
 from rgraph.spec.scene import ALL_PRESENT, Scene, load_scene
 from rgraph.spec.specialize import Spec, resolve_params, specialize
 
@@ -61,6 +62,7 @@ def frontend(
     features = scene.features if scene else ALL_PRESENT
     resolved = resolve_params(source, params or {})
     spec = specialize(source, features=features, params=resolved, size=size, scene_name=scene.name if scene else None)
+    spec.scene_source = str(scene.path) if scene is not None and scene.path is not None else None
     return Frontend(source, scene, spec)
 
 
@@ -113,6 +115,17 @@ def _compile_spec(spec, policy, memory_provider, profile_name) -> dict[str, Any]
     )
 
 
+def add_outputs(spec: Spec, names: Sequence[str]) -> None:
+    """Append resources ``names`` to ``spec.outputs`` (a name already there is kept once)."""
+    for name in names:
+        if name not in spec.resources:
+            raise RGraphError.in_file(
+                "<command line>", f"extra output '{name}' is not a resource{did_you_mean(name, spec.resources)}"
+            )
+        if name not in spec.outputs:
+            spec.outputs.append(name)
+
+
 def compile_graph(
     graph: str | Path,
     scene_path: str | Path | None = None,
@@ -121,9 +134,15 @@ def compile_graph(
     policy: str | None = None,
     memory: MemoryRequirementsProvider | None = None,
     profile: str | None = None,
+    extra_outputs: Sequence[str] = (),
 ) -> dict[str, Any]:
-    """Compile a graph file (or bundled graph name) into a plan dict."""
+    """Compile a graph file (or bundled graph name) into a plan dict.
+
+    ``extra_outputs`` names resources kept as outputs besides the graph's own (their
+    writers are not culled and the runtime reads them back), e.g. an HDR intermediate.
+    """
     front = frontend(graph, scene_path, params, size)
+    add_outputs(front.spec, extra_outputs)
     provider = memory
     profile_name = None
     if provider is None and profile is not None:

@@ -100,6 +100,7 @@ class Spec:
     passes: list[PassSpec]
     outputs: list[str]
     removed: list[tuple[str, str]]  # (pass, reason) for `requires` the scene lacks
+    scene_source: str | None = None  # the scene file's path (the runtime builds its geometry)
 
 
 _SELECTOR = re.compile(r"^(?P<name>[^\[\]]+?)\s*(\[(?P<sel>[^\]]*)\])?$")

@@ -21,12 +21,14 @@ from rgraph.probe.values import codec, initial_value, modulus
 from rgraph.vk import names
 from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
+from rgraph.vk.impl_pass import ImplPass
 from rgraph.vk.instance import Instance, ValidationMessage, create_instance
 from rgraph.vk.loader import vk
 from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
 from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
 from rgraph.vk.resources import HostBuffer, ResourceSet
+from rgraph.vk.texels import decode, encode
 
 FRAMES_IN_FLIGHT = 2
 
@@ -39,6 +41,9 @@ class RunResult:
     device_name: str
     mismatches: list[Mismatch] = field(default_factory=list)
     unchecked: list[str] = field(default_factory=list)  # outputs the data check could not predict
+    # read-back outputs as shader-visible values: images (h, w, c) float32 (layers > 1: (layers, h, w, c),
+    # mip 0), buffers uint8; present when asked for (read_outputs) or when checking data
+    outputs: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass
@@ -70,15 +75,20 @@ def make_batches(plan: dict, device: Device, one_per_pass: bool = False) -> list
 class Executor:
     """Owns every Vulkan object of one run; ``close`` destroys them in reverse order."""
 
-    def __init__(self, plan: dict, *, validate: bool, device_index: int | None, verbose: bool = True) -> None:
+    def __init__(self, plan: dict, *, validate: bool, device_index: int | None, verbose: bool = True,
+                 inputs: dict[str, Any] | None = None) -> None:
         if plan.get("format") != "rgraph-plan/1":
             raise ExecutionError("not an rgraph plan (format != rgraph-plan/1)")
         self.plan = plan
         self.verbose = verbose
+        self.inputs = dict(inputs or {})
+        self.scene_gpu: Any = None
+        self.samplers: dict[str, Any] = {}
+        self.updaters: list[ImplPass] = []
         self.instance: Instance = create_instance(validate)
         self.device: Device | None = None
         self.resources: ResourceSet | None = None
-        self.passes: list[ProbePass] = []
+        self.passes: list[ProbePass | ImplPass] = []
         self.pools: dict[tuple[int, int], Any] = {}
         self.query_pools: list[Any] = []
         self.fences: list[list[Any]] = []
@@ -102,9 +112,6 @@ class Executor:
         v = vk()
         dev = self.device
         for p in self.plan["passes"]:
-            if p.get("impl"):
-                raise ExecutionError(f"pass {p['name']!r}: implementation {p['impl']!r} is not available to the "
-                                     "runtime yet (only the probe)")
             if p.get("device", 0) != 0:
                 raise ExecutionError(f"pass {p['name']!r}: multi-device plans are not supported")
         self.log.context = "creating resources"
@@ -117,7 +124,14 @@ class Executor:
         self.log.context = "initialising persistent resources"
         self._init_shared()
         self.log.context = "creating pipelines"
-        self.passes = [ProbePass(dev, self.plan, p, self.resources, self.sampler) for p in self.plan["passes"]]
+        for p in self.plan["passes"]:
+            self.log.context = f"creating pipelines of pass {p['name']}"
+            if p.get("impl"):
+                self.passes.append(ImplPass(dev, self.plan, p, self.resources, sets=FRAMES_IN_FLIGHT,
+                                            scene=self._scene, samplers=self.samplers))
+            else:
+                self.passes.append(ProbePass(dev, self.plan, p, self.resources, self.sampler))
+        self.updaters = [p for p in self.passes if isinstance(p, ImplPass) and _overrides_update(p)]
         n = len(self.plan["passes"])
         for _ in range(FRAMES_IN_FLIGHT):
             self.query_pools.append(v.vkCreateQueryPool(dev.handle, v.VkQueryPoolCreateInfo(
@@ -125,6 +139,17 @@ class Executor:
         self.batches = make_batches(self.plan, dev, one_per_pass=self.instance.validate)
         self.log.context = "recording"
         self._record()
+
+    def _scene(self) -> Any:
+        """The scene's geometry on the device (``rgraph.vk.scene_gpu``), built on first use."""
+        if self.scene_gpu is None:
+            from rgraph.vk.scene_gpu import SceneGPU
+
+            context = self.log.context
+            self.log.context = "uploading the scene"
+            self.scene_gpu = SceneGPU(self.device, self.plan, FRAMES_IN_FLIGHT, self._one_time)
+            self.log.context = context
+        return self.scene_gpu
 
     def _pool(self, family: int, set_index: int) -> Any:
         v = vk()
@@ -172,6 +197,8 @@ class Executor:
                 else:
                     data = fill_bytes(res, value, [None], plan_size)
                     regions = None
+                if res["name"] in self.inputs:
+                    data = _input_bytes(res, self.inputs[res["name"]], len(data))
                 buf = HostBuffer.create(self.device, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
                 buf.write(data)
                 self.host_buffers.append(buf)
@@ -343,6 +370,10 @@ class Executor:
             if submitted[s]:
                 self._collect_timestamps(s, samples, totals)
             v.vkResetFences(dev.handle, len(fences), fences)
+            if self.scene_gpu is not None:
+                self.scene_gpu.update(frame, s)
+            for p in self.updaters:
+                p.update(frame, s)
             for bi, batch in enumerate(self.batches):
                 self.log.context = f"frame {frame} submit of batch {bi} [{', '.join(p['name'] for p in batch.passes)}]"
                 submit = batch.submit[s]
@@ -483,6 +514,12 @@ class Executor:
             for p in reversed(self.passes):
                 p.destroy()
             self.passes = []
+            if self.scene_gpu is not None:
+                self.scene_gpu.destroy()
+                self.scene_gpu = None
+            for sampler in self.samplers.values():
+                v.vkDestroySampler(dev.handle, sampler, None)
+            self.samplers = {}
             for buf in reversed(self.host_buffers):
                 buf.destroy()
             self.host_buffers = []
@@ -498,22 +535,79 @@ class Executor:
         return self.instance.log.messages
 
 
+def _overrides_update(p: ImplPass) -> bool:
+    from rgraph.impl import PassImpl
+
+    return type(p.impl).update is not PassImpl.update
+
+
+def _input_bytes(res: dict, value: Any, expected: int) -> bytes:
+    """Bytes for an ``inputs`` entry: raw bytes, or an array of shader-visible values (images:
+    (h, w, c) or (layers, h, w, c) for mip 0 only, when the image has one mip)."""
+    import numpy as np
+
+    if isinstance(value, (bytes, bytearray)):
+        data = bytes(value)
+    elif res["kind"] == "image":
+        arr = np.asarray(value)
+        if res["mips"] != 1:
+            raise ExecutionError(f"input {res['name']!r}: arrays fill single-mip images only; give raw bytes")
+        layers = arr if arr.ndim == 4 else arr[None]
+        data = b"".join(encode(res["format"], layer) for layer in layers)
+    else:
+        data = np.asarray(value).tobytes()
+    if len(data) != expected:
+        raise ExecutionError(f"input {res['name']!r}: {len(data)} bytes given, the resource holds {expected}")
+    return data
+
+
+def decode_outputs(plan: dict, data: dict[tuple, bytes]) -> dict[str, Any]:
+    """Read-back bytes -> shader-visible arrays per resource (mip 0; all layers)."""
+    import numpy as np
+
+    out: dict[str, Any] = {}
+    for res in plan["resources"]:
+        if res["kind"] == "image" and (res["name"], 0, 0) in data:
+            w, h = mip_extent(res, 0)
+            try:
+                layers = [decode(res["format"], data[(res["name"], 0, layer)], w, h) for layer in range(res["layers"])]
+            except ValueError:
+                continue
+            out[res["name"]] = layers[0] if len(layers) == 1 else np.stack(layers)
+        elif (res["name"], None, None) in data:
+            out[res["name"]] = np.frombuffer(data[(res["name"], None, None)], dtype=np.uint8)
+    return out
+
+
 def execute_plan(plan: dict, *, validate: bool = False, frames: int = 1, device_index: int | None = None,
-                 check_data: bool | None = None, out_png: Path | None = None, verbose: bool = False) -> RunResult:
-    """Run ``plan`` for ``frames`` frames; check the probe's data flow (default: when validating)."""
+                 check_data: bool | None = None, out_png: Path | None = None, verbose: bool = False,
+                 inputs: dict[str, Any] | None = None, read_outputs: bool = False) -> RunResult:
+    """Run ``plan`` for ``frames`` frames; check the probe's data flow (default: when validating).
+
+    ``inputs`` fills imported/persistent resources before the first frame (raw bytes or arrays
+    of shader-visible values); ``read_outputs`` returns every output, persistent and imported
+    resource decoded in ``RunResult.outputs``. Plans with implemented passes (``impl``) have no
+    probe prediction: their data check is left to each pass's NumPy reference.
+    """
     if frames < 1:
         raise ExecutionError("--frames must be at least 1")
     check = validate if check_data is None else check_data
-    executor = Executor(plan, validate=validate, device_index=device_index, verbose=verbose)
+    implemented = [p["name"] for p in plan["passes"] if p.get("impl")]
+    executor = Executor(plan, validate=validate, device_index=device_index, verbose=verbose, inputs=inputs)
     timings: dict[str, Any] = {}
     mismatches: list[Mismatch] = []
     unchecked: list[str] = []
+    outputs: dict[str, Any] = {}
     data_ok: bool | None = None
     try:
         timings = executor.run_frames(frames)
-        if check or out_png is not None:
+        if check or read_outputs or out_png is not None:
             data = executor.read_back(frames)
-            if check:
+            outputs = decode_outputs(plan, data)
+            if check and implemented:
+                unchecked = [f"{r['name']} (written by implemented passes; see their references)"
+                             for r in plan["resources"] if r["lifetime"] == "output"]
+            elif check:
                 expected = simulate(plan, frames)
                 plan_size = tuple(plan.get("size") or (64, 64))
                 for key, raw in sorted(data.items(), key=lambda kv: (kv[0][0], kv[0][1] or 0, kv[0][2] or 0)):
@@ -531,13 +625,30 @@ def execute_plan(plan: dict, *, validate: bool = False, frames: int = 1, device_
                         mismatches += compare_buffer(res, raw, want, plan_size)
                 data_ok = not mismatches
             if out_png is not None:
-                outputs = [r for r in plan["resources"] if r["lifetime"] == "output" and r["kind"] == "image"]
-                if not outputs:
+                images = [r for r in plan["resources"] if r["lifetime"] == "output" and r["kind"] == "image"]
+                if not images:
                     raise ExecutionError("--out: the plan has no output image")
-                res = outputs[0]
+                res = images[0]
                 w, h = mip_extent(res, 0)
-                write_png(Path(out_png), image_to_rgba8(res, data[(res["name"], 0, 0)], w, h))
+                write_png(Path(out_png), _png_rgba(res, data[(res["name"], 0, 0)], w, h, bool(implemented)))
     finally:
         messages = executor.close()
     return RunResult(list(messages), timings, data_ok, executor.device.name if executor.device else "?",
-                     mismatches, unchecked)
+                     mismatches, unchecked, outputs)
+
+
+def _png_rgba(res: dict, raw: bytes, w: int, h: int, implemented: bool) -> Any:
+    """RGBA8 for a PNG: the stored bytes of an 8-bit colour image rendered by real passes,
+    else the probe's value visualisation."""
+    import numpy as np
+
+    fmt = res["format"].lower()
+    if implemented and fmt in ("r8g8b8a8_srgb", "r8g8b8a8_unorm"):
+        rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4).copy()
+        rgba[..., 3] = 255
+        return rgba
+    if implemented and fmt in ("b8g8r8a8_srgb", "b8g8r8a8_unorm"):
+        rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4)[..., [2, 1, 0, 3]].copy()
+        rgba[..., 3] = 255
+        return rgba
+    return image_to_rgba8(res, raw, w, h)

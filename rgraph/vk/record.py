@@ -6,6 +6,7 @@ push constants. It has no barrier calls: the graph owns synchronization.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -103,16 +104,28 @@ class RecordContext:
             v.vkCmdBindDescriptorSets(self._cb, v.VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0,
                                       len(descriptor_sets), descriptor_sets, 0, None)
 
+    def bind(self, pipeline: Any, descriptor_sets: Sequence[Any] = (), first_set: int = 0) -> None:
+        """Bind a ``rgraph.vk.passkit.Pipeline`` and descriptor sets from ``first_set``."""
+        v = vk()
+        v.vkCmdBindPipeline(self._cb, pipeline.bind_point, pipeline.pipeline)
+        if descriptor_sets:
+            v.vkCmdBindDescriptorSets(self._cb, pipeline.bind_point, pipeline.layout, first_set,
+                                      len(descriptor_sets), list(descriptor_sets), 0, None)
+
+    def push(self, pipeline: Any, data: bytes, offset: int = 0) -> None:
+        """Push constants to a ``Pipeline`` (all of its push stages)."""
+        self.push_constants(pipeline.layout, pipeline.push_stages, data, offset)
+
     def push_constants(self, layout: Any, stages: int, data: bytes, offset: int = 0) -> None:
         v = vk()
         buf = v.ffi.new("char[]", data)
         v.vkCmdPushConstants(self._cb, layout, stages, offset, len(data), buf)
 
-    def bind_vertex_buffers(self, buffers: list[Any], offsets: list[int]) -> None:
+    def bind_vertex_buffers(self, buffers: list[Any], offsets: list[int] | None = None) -> None:
         if buffers:
-            vk().vkCmdBindVertexBuffers(self._cb, 0, len(buffers), buffers, offsets)
+            vk().vkCmdBindVertexBuffers(self._cb, 0, len(buffers), buffers, offsets or [0] * len(buffers))
 
-    def bind_index_buffer(self, buffer: Any, offset: int) -> None:
+    def bind_index_buffer(self, buffer: Any, offset: int = 0) -> None:
         v = vk()
         v.vkCmdBindIndexBuffer(self._cb, buffer, offset, v.VK_INDEX_TYPE_UINT32)
 
@@ -130,11 +143,12 @@ class RecordContext:
         vk().vkCmdEndRenderPass(self._cb)
 
     # work
-    def draw(self, vertices: int, instances: int = 1) -> None:
-        vk().vkCmdDraw(self._cb, vertices, instances, 0, 0)
+    def draw(self, vertices: int, instances: int = 1, first_vertex: int = 0, first_instance: int = 0) -> None:
+        vk().vkCmdDraw(self._cb, vertices, instances, first_vertex, first_instance)
 
-    def draw_indexed(self, indices: int, instances: int = 1) -> None:
-        vk().vkCmdDrawIndexed(self._cb, indices, instances, 0, 0, 0)
+    def draw_indexed(self, indices: int, instances: int = 1, first_index: int = 0, vertex_offset: int = 0,
+                     first_instance: int = 0) -> None:
+        vk().vkCmdDrawIndexed(self._cb, indices, instances, first_index, vertex_offset, first_instance)
 
     def draw_indirect(self, buffer: Any, offset: int) -> None:
         vk().vkCmdDrawIndirect(self._cb, buffer, offset, 1, 16)

@@ -181,14 +181,17 @@ class ResourceSet:
             raise ExecutionError(f"resource {name!r}: [{offset}, {offset + r.size}) exceeds heap {heap['id']} "
                                  f"of {heap['bytes']} bytes")
 
-    def view(self, r: Resource, mips: tuple[int, int], layers: tuple[int, int], aspect: int | None = None) -> Any:
-        """A 2D-array view of an image range (cached)."""
+    def view(self, r: Resource, mips: tuple[int, int], layers: tuple[int, int], aspect: int | None = None,
+             array: bool = True) -> Any:
+        """A view of an image range (cached): 2D-array, or 2D when ``array`` is false and one layer."""
         v = vk()
         aspect = aspect if aspect is not None else names.aspect_mask(r.plan["format"])
-        key = (mips, layers, aspect)
+        array = array or layers[1] - layers[0] > 1
+        key = (mips, layers, aspect, array)
         if key not in r.views:
             info = v.VkImageViewCreateInfo(
-                image=r.handle, viewType=v.VK_IMAGE_VIEW_TYPE_2D_ARRAY, format=names.format_value(r.plan["format"]),
+                image=r.handle, viewType=v.VK_IMAGE_VIEW_TYPE_2D_ARRAY if array else v.VK_IMAGE_VIEW_TYPE_2D,
+                format=names.format_value(r.plan["format"]),
                 subresourceRange=v.VkImageSubresourceRange(
                     aspectMask=aspect, baseMipLevel=mips[0], levelCount=mips[1] - mips[0],
                     baseArrayLayer=layers[0], layerCount=layers[1] - layers[0]),

@@ -1,0 +1,1 @@
+"""Test pass implementations: a compute scale and a full-screen raster blit (real shaders)."""

@@ -8,6 +8,7 @@ COMMAND_MODULES = [
     "check",
     "run",
     "mutate",
+    "sweep",
     "place",
     "device_profile",
     "graphs",

@@ -1,0 +1,78 @@
+"""``rgraph sweep G --knob name=v1,v2 ... -o DIR``: what accuracy costs in GPU time."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
+from rgraph.errors import RGraphError
+
+PLOT_METRICS = ("flip", "ssim", "psnr", "hdr_flip", "hdr_rel_mse", "hdr_log_psnr")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    parser = sub.add_parser(
+        "sweep", help="render quality-knob settings; GPU time per pass and error against a reference",
+        description="Renders every setting (each knob alone from the defaults, or --grid), times each pass "
+                    "(median of --frames) and compares each image with the reference setting "
+                    "(defaults overridden by every --reference). Writes sweep.csv, sweep.md, "
+                    "pareto_<knob>.png, images/ and errors/ into -o DIR.")
+    add_graph_arguments(parser, size_default="640x360")
+    parser.add_argument("--knob", action="append", metavar="NAME=V1,V2,...", required=True,
+                        help="a graph param and the values to try (repeatable)")
+    parser.add_argument("--reference", action="append", metavar="NAME=VALUE",
+                        help="param of the reference setting (repeatable; default: the graph's defaults)")
+    parser.add_argument("--grid", action="store_true", help="every combination of the knobs' values")
+    parser.add_argument("--frames", type=int, default=8, help="frames per setting; times are medians (default 8)")
+    parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
+    parser.add_argument("--hdr", metavar="RESOURCE",
+                        help="also read back this intermediate image (kept as an extra output) for HDR metrics")
+    parser.add_argument("--metric", choices=PLOT_METRICS,
+                        help="error shown in the Pareto plots (default: flip, else ssim)")
+    parser.add_argument("--validate", action="store_true",
+                        help="run every setting under Khronos validation + syncval; exit 1 on any message")
+    parser.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from rgraph.sweep import flip
+    from rgraph.sweep.runner import SweepRequest, run_sweep
+    from rgraph.sweep.settings import parse_assignments, parse_knob
+    from rgraph.sweep.writers import plot_metric, write_all
+    from rgraph.vk.errors import ExecutionError, VulkanUnavailable
+
+    if args.frames < 1:
+        raise RGraphError.in_file("<command line>", f"--frames must be at least 1, got {args.frames}")
+    request = SweepRequest(
+        graph=args.graph, knobs=[parse_knob(k) for k in args.knob], scene=args.scene,
+        base=parse_params(args.param), reference=parse_assignments(args.reference, "--reference"),
+        grid=args.grid, size=parse_size(args.size), frames=args.frames, device=args.device,
+        policy=args.policy, hdr=args.hdr, validate=args.validate)
+    try:
+        result = run_sweep(request, args.out, progress=args.progress and sys.stderr.isatty())
+    except (VulkanUnavailable, ExecutionError) as exc:
+        print(f"rgraph: error: {exc}", file=sys.stderr)
+        return 2
+    note = flip.missing_note()
+    if note and note not in result.notes:
+        result.notes.append(note)
+    chosen = plot_metric(result, args.metric)
+    if args.metric and chosen != args.metric:
+        result.notes.append(f"--metric {args.metric}: no values; plots show {chosen or 'nothing'}")
+    written = write_all(result, args.out, chosen)
+    for line in result.notes:
+        print(f"rgraph: note: {line}", file=sys.stderr)
+    messages = result.messages()
+    for label, message in messages:
+        print(f"{label}: {message}", file=sys.stderr)
+    print(f"rgraph: {len(result.rows)} settings ({result.renderings} renderings) on {result.device}; "
+          f"wrote {written['csv']}, {written['md']} and {len(written) - 2} plot(s)", file=sys.stderr)
+    if args.validate:
+        print(f"rgraph: {len(messages)} validation message(s)", file=sys.stderr)
+        return 1 if messages else 0
+    return 0

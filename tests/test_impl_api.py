@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import impl_fixtures.passes  # noqa: F401 -- registers test_scale and test_blit
 import numpy as np
 import pytest
 
-import impl_fixtures.passes  # noqa: F401 -- registers test_scale and test_blit
 from rgraph import impl
 from rgraph.compile.pipeline import compile_graph
 from rgraph.vk.texels import decode, encode

@@ -97,3 +97,31 @@ def test_a_compiled_plan_file_reads_the_same_as_the_graph(capsys, tmp_path):
         _, from_file, _ = inspect(capsys, str(path), *view)
         _, from_graph, _ = inspect(capsys, "surgery", "--size", "640x360", *view)
         assert from_file == from_graph, view
+
+
+@pytest.mark.vulkan
+def test_culled_passes_show_the_milliseconds_they_saved(capsys, tmp_path):
+    """Timings of a real run of the full scene attribute GPU time to what a variant culls."""
+    import json
+
+    from rgraph.cli import main
+
+    timings = tmp_path / "full.json"
+    assert main(["run", "surgery", "--size", "32x32", "--frames", "2", "--timings", str(timings)]) == 0
+    measured = json.loads(timings.read_text())["passes"]
+    capsys.readouterr()
+    code, out, err = inspect(capsys, "surgery", "--scene", "graphs/scenes/cct_no_sss.yaml", "--size", "32x32",
+                             "--timings", str(timings))
+    assert code == 0, err
+    rows = {line.split()[0]: line.split() for line in out.splitlines() if line.strip()}
+    for name in ("sss_blur_h", "sss_blur_v"):
+        assert float(rows[name][-1]) == pytest.approx(measured[name], abs=5e-4)
+    saved = measured["sss_blur_h"] + measured["sss_blur_v"]
+    assert re.search(rf"culling saved .* and {saved:.3f} ms of GPU time per frame", out), out
+
+
+def test_bad_timings_file_is_a_located_error(capsys, tmp_path):
+    bad = tmp_path / "t.json"
+    bad.write_text('{"passes": ')
+    code, _, err = inspect(capsys, "surgery", "--timings", str(bad))
+    assert code == 2 and f"{bad}:1:" in err and "not JSON" in err

@@ -33,6 +33,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the pass graph as DOT (stdout; OUT.dot for text, OUT.svg renders with graphviz)",
     )
     parser.add_argument("--html", metavar="OUT", help="write a self-contained HTML report")
+    parser.add_argument("--timings", metavar="T.json",
+                        help="per-pass GPU times of a run that kept the culled passes (rgraph run --timings): "
+                             "shows the milliseconds culling saved")
     parser.add_argument("--scene", metavar="S", help="scene file or name (when compiling a graph)")
     parser.add_argument("-p", "--param", dest="params", metavar="K=V", action="append", default=[],
                         help="override a graph parameter (when compiling a graph)")
@@ -62,6 +65,21 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     plan = compile_graph(target, scene_path=args.scene, **options)
     check_plan(plan, target)
     return plan
+
+
+def load_timings(path: str) -> dict[str, Any]:
+    """A ``rgraph run --timings`` JSON file: {"device", "passes": {name: ms}, "total_ms", ...}."""
+    import json
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise RGraphError.in_file(path, f"cannot read: {exc.strerror or exc}") from None
+    except json.JSONDecodeError as exc:
+        raise RGraphError.in_file(path, f"not JSON: {exc.msg}", exc.lineno, exc.colno) from None
+    if not isinstance(data, dict) or not isinstance(data.get("passes"), dict):
+        raise RGraphError.in_file(path, "not a timings file: expected an object with 'passes' (rgraph run --timings)")
+    return data
 
 
 def _write(path: str, data: str | bytes) -> None:
@@ -101,14 +119,15 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     plan = obtain_plan(args)
     console = make_console(out)
     dot_to_stdout = args.dot == "-"
+    timings = load_timings(args.timings) if args.timings else None
     if not (args.barriers or args.memory or dot_to_stdout):
-        text.print_summary(console, plan)
+        text.print_summary(console, plan, timings)
     if args.barriers:
         text.print_barriers(console, plan)
     if args.memory:
         if args.barriers:
             console.print()
-        text.print_memory(console, plan)
+        text.print_memory(console, plan, timings)
     if args.dot is not None:
         emit_dot(plan, args.dot, out)
         if not dot_to_stdout:

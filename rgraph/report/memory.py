@@ -139,9 +139,20 @@ def culling_table(plan: Plan) -> TableData:
     )
 
 
-def culling_total_line(plan: Plan) -> str | None:
-    """The total saved by culling, or ``None`` when the plan gives no byte counts."""
+def culling_total_line(plan: Plan, timings: dict | None = None) -> str | None:
+    """The total saved by culling (bytes; GPU ms per frame when ``timings`` of a run of the
+    full scene are given), or ``None`` when there is nothing to report."""
+    from rgraph.report.summary import culled_ms
+
     counted = [c["bytes"] for c in plan.get("culled") or [] if c.get("bytes") is not None]
-    if not counted:
+    times = [culled_ms(timings, c["pass"]) for c in plan.get("culled") or []]
+    measured = [t for t in times if t is not None]
+    parts = []
+    if counted:
+        parts.append(bytes_exact(sum(counted)))
+    if measured:
+        device = (timings or {}).get("device") or "the timed device"
+        parts.append(f"{sum(measured):.3f} ms of GPU time per frame (measured on {device})")
+    if not parts:
         return None
-    return f"culling saved {bytes_exact(sum(counted))}"
+    return "culling saved " + " and ".join(parts)

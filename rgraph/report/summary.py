@@ -66,10 +66,26 @@ def schedule_table(plan: Plan) -> TableData:
     )
 
 
-def culled_table(plan: Plan) -> TableData:
-    """Passes the compiler removed, and why."""
-    rows = [(c["pass"], c.get("reason") or "-") for c in plan.get("culled") or []]
-    return TableData(f"Culled passes ({len(rows)})", ("pass", "reason"), rows)
+def culled_ms(timings: dict | None, pass_name: str) -> float | None:
+    """A culled pass's median GPU ms in ``timings`` (``rgraph run --timings`` of a scene that kept it)."""
+    if not timings:
+        return None
+    value = (timings.get("passes") or {}).get(pass_name)
+    return float(value) if isinstance(value, (int, float)) else None
+
+
+def culled_table(plan: Plan, timings: dict | None = None) -> TableData:
+    """Passes the compiler removed, and why (and their measured GPU ms, given ``timings``)."""
+    culled = plan.get("culled") or []
+    if timings is None:
+        rows = [(c["pass"], c.get("reason") or "-") for c in culled]
+        return TableData(f"Culled passes ({len(rows)})", ("pass", "reason"), rows)
+    rows = []
+    for c in culled:
+        ms = culled_ms(timings, c["pass"])
+        rows.append((c["pass"], c.get("reason") or "-", "-" if ms is None else f"{ms:.3f}"))
+    return TableData(f"Culled passes ({len(rows)})", ("pass", "reason", "GPU ms saved"), rows,
+                     right=frozenset({"GPU ms saved"}))
 
 
 def dropped_table(plan: Plan) -> TableData:

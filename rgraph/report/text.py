@@ -17,12 +17,18 @@ def _heading(console: Console, title: str) -> None:
     console.print(Text(title, style="bold underline"))
 
 
-def print_summary(console: Console, plan: Plan) -> None:
-    """Header, schedule, culled passes, dropped reads, stats."""
+def print_summary(console: Console, plan: Plan, timings: dict | None = None) -> None:
+    """Header, schedule, culled passes (with measured GPU ms given ``timings``), dropped reads, stats."""
     print_lines(console, summary.header_lines(plan))
     console.print()
     print_table(console, summary.schedule_table(plan))
-    print_table(console, summary.culled_table(plan))
+    print_table(console, summary.culled_table(plan, timings))
+    if timings is not None:
+        from rgraph.report.memory import culling_total_line
+
+        total = culling_total_line(plan, timings)
+        if total:
+            print_lines(console, [total])
     print_table(console, summary.dropped_table(plan))
     _heading(console, "Stats")
     print_lines(console, summary.stats_lines(plan))
@@ -35,7 +41,7 @@ def print_barriers(console: Console, plan: Plan) -> None:
     print_lines(console, [barriers.barrier_totals(plan)])
 
 
-def print_memory(console: Console, plan: Plan) -> None:
+def print_memory(console: Console, plan: Plan, timings: dict | None = None) -> None:
     """Resources, heaps, bytes per class and what culling saved."""
     print_table(console, memory.resources_table(plan))
     print_table(console, memory.heaps_table(plan))
@@ -43,6 +49,6 @@ def print_memory(console: Console, plan: Plan) -> None:
     print_lines(console, memory.class_lines(plan) or ["  (no heaps)"])
     console.print()
     print_table(console, memory.culling_table(plan))
-    total = memory.culling_total_line(plan)
+    total = memory.culling_total_line(plan, timings)
     if total:
         print_lines(console, [total])

@@ -1,0 +1,112 @@
+"""Bloom at reduced resolution: ``bloom_bright``, ``bloom_blur`` (h or v), ``bloom_combine``.
+
+Params: ``bloom.threshold`` (1.0), ``bloom.knee`` (0.5, soft-knee width as a fraction of the
+threshold), ``bloom.clamp`` (65504, what +Inf and larger values become before the Karis
+average), ``bloom.radius`` (4, Gaussian taps -r..r, at most 28), ``bloom.sigma`` (radius/2),
+``bloom.direction`` (``h`` or ``v``; pass-level, required by ``bloom_blur``),
+``bloom.intensity`` (0.05). Reference and the non-finite rule: ``bloom_ref``.
+"""
+
+from __future__ import annotations
+
+from rgraph.impl import PassImpl, register
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.passkit import Binding, pack
+
+from .bloom_ref import MAX_RADIUS, gaussian_weights
+from .post_common_ref import HALF_MAX
+
+
+def _one(setup, usage: str) -> str:
+    """The single resource this pass accesses with ``usage``."""
+    found = [a["resource"] for a in setup.plan_pass["accesses"] if a["usage"] == usage]
+    if len(found) != 1:
+        raise ExecutionError(f"pass {setup.name!r}: expects exactly one {usage} resource, has {found or 'none'}")
+    return found[0]
+
+
+def _factor(big: tuple[int, int], small: tuple[int, int]) -> tuple[int, int]:
+    return max(1, big[0] // small[0]), max(1, big[1] // small[1])
+
+
+def _groups(extent: tuple[int, int]) -> tuple[int, int]:
+    return -(-extent[0] // 8), -(-extent[1] // 8)
+
+
+@register("bloom_bright")
+class BloomBright(PassImpl):
+    """Reads its sampled source (``hdr``), writes its storage image (``bloom_a``) at reduced size."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        src, dst = _one(setup, "sampled"), _one(setup, "storage_write")
+        self.extent = setup.extent_of(dst)
+        fx, fy = _factor(setup.extent_of(src), self.extent)
+        threshold = float(setup.param("bloom.threshold", 1.0))
+        knee = float(setup.param("bloom.knee", 0.5))
+        clamp = float(setup.param("bloom.clamp", HALF_MAX))
+        if threshold < 0 or knee < 0 or not clamp > 0:
+            raise ExecutionError(f"pass {setup.name!r}: bloom.threshold and bloom.knee must be >= 0 and "
+                                 f"bloom.clamp > 0 (got {threshold}, {knee}, {clamp})")
+        self.push = pack("2i3f", fx, fy, threshold, knee, clamp)
+        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest"),
+                                       Binding(1, "storage_image", dst)])
+        self.pipeline = setup.compute_pipeline("post/bloom_bright.comp", [self.sets.layout],
+                                               push_constant_bytes=len(self.push))
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*_groups(self.extent))
+
+
+@register("bloom_blur")
+class BloomBlur(PassImpl):
+    """One separable Gaussian pass from its sampled source to its storage image (same size)."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        src, dst = _one(setup, "sampled"), _one(setup, "storage_write")
+        direction = setup.param("bloom.direction")
+        if direction not in ("h", "v"):
+            raise ExecutionError(f"pass {setup.name!r}: pass-level param bloom.direction must be 'h' or 'v', "
+                                 f"got {direction!r}")
+        radius = int(setup.param("bloom.radius", 4))
+        sigma = setup.param("bloom.sigma")
+        try:
+            weights = gaussian_weights(radius, None if sigma is None else float(sigma))
+        except ValueError as exc:
+            raise ExecutionError(f"pass {setup.name!r}: {exc}") from None
+        padded = list(weights) + [0.0] * (MAX_RADIUS + 1 - len(weights))
+        self.push = pack("3i29f", *((1, 0) if direction == "h" else (0, 1)), radius, *padded)
+        self.extent = setup.extent_of(dst)
+        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest"),
+                                       Binding(1, "storage_image", dst)])
+        self.pipeline = setup.compute_pipeline("post/bloom_blur.comp", [self.sets.layout],
+                                               push_constant_bytes=len(self.push))
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*_groups(self.extent))
+
+
+@register("bloom_combine")
+class BloomCombine(PassImpl):
+    """Adds ``bloom.intensity`` times its sampled bloom image (bilinear) to its blended attachment."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        src = _one(setup, "sampled")
+        _one(setup, "color_attachment_blend")
+        bw, bh = setup.extent_of(src)
+        fx, fy = _factor(setup.extent, (bw, bh))
+        self.push = pack("3f", 1.0 / (fx * bw), 1.0 / (fy * bh), float(setup.param("bloom.intensity", 0.05)))
+        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="linear")])
+        self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "post/bloom_combine.frag", [self.sets.layout],
+                                                push_constant_bytes=len(self.push), blend=["add"])
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.draw(3)

@@ -59,8 +59,16 @@ def pareto_plot(path: Path, *, knob: str, labels: list[str], ms: list[float | No
         if front:
             ax.step([ms[i] for i in front], [y[i] for i in front], where="post", color="tab:green",
                     linewidth=1.4, zorder=2, label="Pareto front")
-        if reference_ms is not None:
+        lo, hi = min(xs), max(xs)
+        pad = 0.08 * (hi - lo) if hi > lo else 0.05 * max(abs(hi), 1e-3)
+        if reference_ms is not None and lo - pad <= reference_ms <= hi + pad:
             ax.axvline(reference_ms, color="grey", linestyle="--", linewidth=1, label=f"reference {reference_ms:.3g} ms")
+        elif reference_ms is not None:  # far away: say where, keep the settings readable
+            ax.plot([], [], color="grey", linestyle="--", label=f"reference {reference_ms:.3g} ms (off axis)")
+        ax.set_xlim(lo - pad, hi + pad)
+        positive = [e for e in ys if e > 0]
+        if len(positive) == len(ys) and max(ys) >= 20 * min(ys):
+            ax.set_yscale("log")
         ax.set_xlabel("GPU time per frame (ms, median)")
         better = "lower" if LOWER_IS_BETTER.get(metric, True) else "higher"
         ax.set_ylabel(f"{METRIC_TITLES.get(metric, metric)} vs reference ({better} is better)")

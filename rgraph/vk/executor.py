@@ -292,13 +292,11 @@ class Executor:
                     if timestamps:
                         v.vkCmdResetQueryPool(cb, self.query_pools[s], 2 * i, 2)
                         v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
-                    barriers = build_barriers(dev, self.resources, s, p["barriers"], "barrier")
-                    if barriers:
+                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier"):
                         self.barrier_batches.append(barriers)
                         v.vkCmdPipelineBarrier2(cb, barriers.dependency)
                     self.passes[i].record(ctx, s)
-                    releases = build_barriers(dev, self.resources, s, p["releases"], "release")
-                    if releases:
+                    for releases in build_barriers(dev, self.resources, s, p["releases"], "release"):
                         self.barrier_batches.append(releases)
                         v.vkCmdPipelineBarrier2(cb, releases.dependency)
                     if timestamps:

@@ -6,7 +6,7 @@ push constants. It has no barrier calls: the graph owns synchronization.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -25,6 +25,84 @@ def _aspect_for_layout(format_name: str, layout: str) -> int:
     return names.aspect_mask(format_name)
 
 
+@dataclass(frozen=True)
+class BarrierSpec:
+    """One VkImageMemoryBarrier2 / VkBufferMemoryBarrier2 in plan names (pure data, no Vulkan).
+
+    ``src_family``/``dst_family``: a queue family index, or None for VK_QUEUE_FAMILY_IGNORED.
+    ``aspect_layout``: the layout that picks the image aspect (the plan barrier's dst layout,
+    else its src layout), so that every struct derived from one plan barrier names one aspect.
+    """
+
+    resource: str
+    subresource: dict | None
+    src_stages: tuple[str, ...]
+    src_access: tuple[str, ...]
+    dst_stages: tuple[str, ...]
+    dst_access: tuple[str, ...]
+    old_layout: str | None
+    new_layout: str | None
+    src_family: int | None = None
+    dst_family: int | None = None
+    aspect_layout: str | None = None
+
+
+def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int]) -> list[list[BarrierSpec]]:
+    """Plan barriers -> the vkCmdPipelineBarrier2 calls that execute them, in recording order.
+
+    ``role`` is "barrier" (before the pass) or "release" (after it); ``families`` maps plan
+    queues to queue family indices. Each inner list is one vkCmdPipelineBarrier2 (barriers in
+    one call are not ordered with each other; consecutive calls are, through their stages).
+
+    - Ordinary barriers (one queue) are one struct each, queue families IGNORED.
+    - An ownership pair whose two plan queues share a family: the release is skipped and the
+      acquire point executes one ordinary barrier (the semaphore orders the queues).
+    - A queue-family ownership transfer between distinct families carries NO layout change:
+      the release (source queue) and the acquire (destination queue) both keep the source
+      layout (oldLayout == newLayout), and the layout change is a separate ordinary barrier
+      recorded on the destination queue right after the acquire (a second call, its src scope
+      the acquire's dst stages, so the two chain). The acquire's src stages are its own dst
+      stages: they are the stages the pass's semaphore wait covers (the plan's wait stages hold
+      every stage of the pass's accesses that wait for another queue), so the acquire chains to
+      the wait and happens after the release. With src stages NONE (as before) the acquire and
+      its layout transition were ordered after nothing on the destination queue: syncval
+      reported the acquire's transition racing the release's (WRITE_RACING_WRITE), the reads
+      after it racing the release (READ_RACING_WRITE), and the acquire's transition racing the
+      previous frame's reads on the destination queue (WRITE_AFTER_READ). Keeping the layout
+      out of the pair also keeps a layer that does not model ownership transfers (1.3.239,
+      DESIGN.md) from counting one transition twice; release/acquire access masks follow the
+      spec (release: no dst access, acquire: no src access).
+    """
+    first: list[BarrierSpec] = []
+    after: list[BarrierSpec] = []
+    for b in barriers:
+        src, dst = b["src"], b["dst"]
+        sub = b.get("subresource")
+        crossing = src["queue"] != dst["queue"]
+        transfer = crossing and families[src["queue"]] != families[dst["queue"]]
+        aspect = dst["layout"] if dst["layout"] not in (None, "UNDEFINED") else src["layout"]
+        src_stages, src_access = tuple(src["stages"]), tuple(src["access"])
+        dst_stages, dst_access = tuple(dst["stages"]), tuple(dst["access"])
+        if not transfer:
+            if crossing and role == "release":
+                continue  # same family: executed once, at the acquire point
+            first.append(BarrierSpec(b["resource"], sub, src_stages, src_access, dst_stages, dst_access,
+                                     src["layout"], dst["layout"], None, None, aspect))
+            continue
+        families_pair = (families[src["queue"]], families[dst["queue"]])
+        held = src["layout"]  # the layout the resource keeps while it changes hands
+        if role == "release":
+            first.append(BarrierSpec(b["resource"], sub, src_stages, src_access, (), (), held, held,
+                                     *families_pair, aspect))
+            continue
+        first.append(BarrierSpec(b["resource"], sub, dst_stages, (), dst_stages, dst_access, held, held,
+                                 *families_pair, aspect))
+        if src["layout"] != dst["layout"]:
+            after.append(BarrierSpec(b["resource"], sub, dst_stages, (), dst_stages, dst_access, src["layout"],
+                                     dst["layout"], None, None, aspect))
+    return [group for group in (first, after) if group]
+
+
 @dataclass
 class BarrierBatch:
     """One vkCmdPipelineBarrier2's structs, kept alive until recorded."""
@@ -35,47 +113,36 @@ class BarrierBatch:
 
 
 def build_barriers(device: Device, resources: ResourceSet, set_index: int, barriers: list[dict],
-                   role: str) -> BarrierBatch | None:
-    """Sync2 structs for plan barriers. ``role``: "barrier" (before the pass) or "release" (after).
+                   role: str) -> list[BarrierBatch]:
+    """Sync2 structs for plan barriers (see ``lower_barriers``): one batch per
+    vkCmdPipelineBarrier2, to be recorded in order; [] when there is nothing to record."""
+    return [_dependency(resources, set_index, group)
+            for group in lower_barriers(barriers, role, device.families)]
 
-    A queue-family transfer whose two plan queues share a family becomes one ordinary barrier
-    at the acquire point; its release is skipped.
-    """
+
+def _family(index: int | None) -> int:
+    return vk().VK_QUEUE_FAMILY_IGNORED if index is None else index
+
+
+def _dependency(resources: ResourceSet, set_index: int, specs: list[BarrierSpec]) -> BarrierBatch:
     v = vk()
     images, buffers = [], []
-    for b in barriers:
-        src, dst = b["src"], b["dst"]
-        transfer = src["queue"] != dst["queue"] and not device.same_family(src["queue"], dst["queue"])
-        if src["queue"] != dst["queue"] and not transfer and role == "release":
-            continue  # same family: executed once at the acquire point
-        src_family = device.families[src["queue"]] if transfer else v.VK_QUEUE_FAMILY_IGNORED
-        dst_family = device.families[dst["queue"]] if transfer else v.VK_QUEUE_FAMILY_IGNORED
-        src_stages, src_access = names.stages(src["stages"]), names.accesses(src["access"])
-        dst_stages, dst_access = names.stages(dst["stages"]), names.accesses(dst["access"])
-        if transfer and role == "release":
-            dst_stages, dst_access = 0, 0
-        elif transfer:
-            src_stages, src_access = 0, 0
-        r = resources.get(b["resource"], set_index)
+    for b in specs:
+        r = resources.get(b.resource, set_index)
+        masks = {"srcStageMask": names.stages(b.src_stages), "srcAccessMask": names.accesses(b.src_access),
+                 "dstStageMask": names.stages(b.dst_stages), "dstAccessMask": names.accesses(b.dst_access),
+                 "srcQueueFamilyIndex": _family(b.src_family), "dstQueueFamilyIndex": _family(b.dst_family)}
         if r.is_image:
-            sub = b["subresource"]
+            sub = b.subresource
             rng = v.VkImageSubresourceRange(
-                aspectMask=_aspect_for_layout(r.plan["format"], dst["layout"] if dst["layout"] != "UNDEFINED"
-                                              else src["layout"]),
+                aspectMask=_aspect_for_layout(r.plan["format"], b.aspect_layout),
                 baseMipLevel=sub["mips"][0], levelCount=sub["mips"][1] - sub["mips"][0],
                 baseArrayLayer=sub["layers"][0], layerCount=sub["layers"][1] - sub["layers"][0])
             images.append(v.VkImageMemoryBarrier2(
-                srcStageMask=src_stages, srcAccessMask=src_access, dstStageMask=dst_stages, dstAccessMask=dst_access,
-                oldLayout=names.layout(src["layout"]), newLayout=names.layout(dst["layout"]),
-                srcQueueFamilyIndex=src_family, dstQueueFamilyIndex=dst_family, image=r.handle,
-                subresourceRange=rng))
+                oldLayout=names.layout(b.old_layout), newLayout=names.layout(b.new_layout), image=r.handle,
+                subresourceRange=rng, **masks))
         else:
-            buffers.append(v.VkBufferMemoryBarrier2(
-                srcStageMask=src_stages, srcAccessMask=src_access, dstStageMask=dst_stages, dstAccessMask=dst_access,
-                srcQueueFamilyIndex=src_family, dstQueueFamilyIndex=dst_family, buffer=r.handle, offset=0,
-                size=names.WHOLE_SIZE))
-    if not images and not buffers:
-        return None
+            buffers.append(v.VkBufferMemoryBarrier2(buffer=r.handle, offset=0, size=names.WHOLE_SIZE, **masks))
     dep = v.VkDependencyInfo(
         imageMemoryBarrierCount=len(images), pImageMemoryBarriers=images or None,
         bufferMemoryBarrierCount=len(buffers), pBufferMemoryBarriers=buffers or None)

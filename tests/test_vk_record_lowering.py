@@ -1,0 +1,113 @@
+"""Plan barriers -> sync2 structs (``rgraph.vk.record.lower_barriers``), pure: a fake device
+with a separate compute queue family (as on NVIDIA) checks the exact structs of ownership
+transfers, which lavapipe (one queue family) never records."""
+
+from __future__ import annotations
+
+import pytest
+
+from rgraph.compile.pipeline import compile_graph
+from rgraph.random_graph import random_graph, to_yaml
+from rgraph.vk.record import BarrierSpec, lower_barriers
+
+TWO_FAMILIES = {"graphics": 0, "compute": 1, "transfer": 2}
+ONE_FAMILY = {"graphics": 0, "compute": 0, "transfer": 0}
+WHOLE = {"mips": [0, 1], "layers": [0, 1]}
+
+
+@pytest.fixture(scope="module")
+def surgery() -> dict:
+    return compile_graph("surgery", size=(64, 64))
+
+
+def _pass(plan: dict, name: str) -> dict:
+    return next(p for p in plan["passes"] if p["name"] == name)
+
+
+def _only(specs: list[BarrierSpec], resource: str) -> BarrierSpec:
+    found = [s for s in specs if s.resource == resource]
+    assert len(found) == 1, found
+    return found[0]
+
+
+def test_depth_to_compute_release_and_acquire_carry_no_layout_change(surgery):
+    release = lower_barriers(_pass(surgery, "depth_prepass")["releases"], "release", TWO_FAMILIES)
+    assert len(release) == 1  # one vkCmdPipelineBarrier2 after depth_prepass
+    assert _only(release[0], "depth") == BarrierSpec(
+        "depth", WHOLE, ("EARLY_FRAGMENT_TESTS", "LATE_FRAGMENT_TESTS"), ("DEPTH_STENCIL_ATTACHMENT_WRITE",),
+        (), (), "DEPTH_ATTACHMENT_OPTIMAL", "DEPTH_ATTACHMENT_OPTIMAL", 0, 1, "DEPTH_READ_ONLY_OPTIMAL")
+    acquire, transition = lower_barriers(_pass(surgery, "hbao_downsample")["barriers"], "barrier", TWO_FAMILIES)
+    # the acquire: chained to the semaphore wait (src stages = the wait's stages), no src access
+    assert _pass(surgery, "hbao_downsample")["waits"][0]["stages"] == ["COMPUTE_SHADER"]
+    assert _only(acquire, "depth") == BarrierSpec(
+        "depth", WHOLE, ("COMPUTE_SHADER",), (), ("COMPUTE_SHADER",), ("SHADER_SAMPLED_READ",),
+        "DEPTH_ATTACHMENT_OPTIMAL", "DEPTH_ATTACHMENT_OPTIMAL", 0, 1, "DEPTH_READ_ONLY_OPTIMAL")
+    # then the layout change, an ordinary barrier on the compute queue chained to the acquire
+    assert transition == [BarrierSpec(
+        "depth", WHOLE, ("COMPUTE_SHADER",), (), ("COMPUTE_SHADER",), ("SHADER_SAMPLED_READ",),
+        "DEPTH_ATTACHMENT_OPTIMAL", "DEPTH_READ_ONLY_OPTIMAL", None, None, "DEPTH_READ_ONLY_OPTIMAL")]
+
+
+def test_ao_back_to_graphics(surgery):
+    forward = _pass(surgery, "forward")
+    release = lower_barriers(_pass(surgery, "hbao_upsample")["releases"], "release", TWO_FAMILIES)
+    assert [(s.resource, s.old_layout, s.new_layout, s.src_family, s.dst_family, s.dst_stages, s.dst_access)
+            for s in release[0]] == [
+        ("ao", "GENERAL", "GENERAL", 1, 0, (), ()),
+        ("depth", "DEPTH_READ_ONLY_OPTIMAL", "DEPTH_READ_ONLY_OPTIMAL", 1, 0, (), ()),
+    ]
+    groups = lower_barriers(forward["barriers"], "barrier", TWO_FAMILIES)
+    assert len(groups) == 2
+    wait_stages = {s for w in forward["waits"] for s in w["stages"]}
+    ao = _only(groups[0], "ao")
+    assert (ao.src_family, ao.dst_family, ao.old_layout, ao.new_layout, ao.src_access) == (1, 0, "GENERAL", "GENERAL", ())
+    assert ao.src_stages == ao.dst_stages == ("FRAGMENT_SHADER",)
+    assert set(ao.src_stages) <= wait_stages
+    # depth keeps its layout across the transfer: no second barrier for it
+    assert [(s.resource, s.old_layout, s.new_layout, s.src_family, s.src_stages) for s in groups[1]] == [
+        ("ao", "GENERAL", "SHADER_READ_ONLY_OPTIMAL", None, ("FRAGMENT_SHADER",))]
+
+
+def test_one_family_merges_each_pair_into_one_barrier_at_the_acquire(surgery):
+    assert lower_barriers(_pass(surgery, "depth_prepass")["releases"], "release", ONE_FAMILY) == []
+    (group,) = lower_barriers(_pass(surgery, "hbao_downsample")["barriers"], "barrier", ONE_FAMILY)
+    plan_barrier = next(b for b in _pass(surgery, "hbao_downsample")["barriers"] if b["resource"] == "depth")
+    assert _only(group, "depth") == BarrierSpec(
+        "depth", WHOLE, tuple(plan_barrier["src"]["stages"]), tuple(plan_barrier["src"]["access"]),
+        tuple(plan_barrier["dst"]["stages"]), tuple(plan_barrier["dst"]["access"]),
+        "DEPTH_ATTACHMENT_OPTIMAL", "DEPTH_READ_ONLY_OPTIMAL", None, None, "DEPTH_READ_ONLY_OPTIMAL")
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_every_acquire_chains_to_its_semaphore_wait(tmp_path, seed):
+    """On two families, in random graphs with async compute and transfer queues: releases keep
+    their layout and have no dst scope; every acquire keeps the layout, has no src access, and
+    its src stages meet the pass's wait on the releasing queue (or, for an acquire whose
+    release ran in the previous frame, the runtime's frame-start wait covers all commands);
+    a layout change follows as an ordinary barrier in the next call, chained to the acquire."""
+    from rgraph.compile.pipeline import compile_spec, frontend
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed, 14)))
+    plan = compile_spec(frontend(path, size=(16, 16)).spec, policy="aliased")
+    transfers = 0
+    for p in plan["passes"]:
+        for spec in (s for group in lower_barriers(p["releases"], "release", TWO_FAMILIES) for s in group):
+            assert spec.src_family != spec.dst_family
+            assert spec.old_layout == spec.new_layout and (spec.dst_stages, spec.dst_access) == ((), ())
+        groups = lower_barriers(p["barriers"], "barrier", TWO_FAMILIES)
+        acquires = [s for s in groups[0] if s.src_family is not None] if groups else []
+        transitions = groups[1] if len(groups) > 1 else []
+        for spec in acquires:
+            transfers += 1
+            assert spec.old_layout == spec.new_layout and spec.src_access == ()
+            src_queue = next(q for q, f in TWO_FAMILIES.items() if f == spec.src_family)
+            waits = {s for w in p["waits"] if w["queue"] == src_queue for s in w["stages"]}
+            if waits:
+                assert set(spec.src_stages) & waits, (p["name"], spec)
+        for spec in transitions:
+            acquire = next(a for a in acquires if a.resource == spec.resource and a.subresource == spec.subresource)
+            assert spec.src_stages == acquire.dst_stages and spec.old_layout == acquire.new_layout
+            assert (spec.src_family, spec.dst_family) == (None, None)
+    if seed == 0:
+        assert transfers, "seed 0 should exercise at least one ownership transfer"

@@ -178,6 +178,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
     e12 = v.VkPhysicalDeviceVulkan12Features(
         pNext=e13, timelineSemaphore=v.VK_TRUE, separateDepthStencilLayouts=v.VK_TRUE,
         hostQueryReset=v.VK_TRUE if f12.hostQueryReset else v.VK_FALSE,
+        shaderOutputLayer=v.VK_TRUE if f12.shaderOutputLayer else v.VK_FALSE,  # gl_Layer in vertex shaders
     )
     enabled = v.VkPhysicalDeviceFeatures2(pNext=e12, features=core_features)
     info = v.VkDeviceCreateInfo(
@@ -192,7 +193,8 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         queues={q: queues_by_family[f] for q, f in plan_families.items()},
         properties=props, memory_properties=v.vkGetPhysicalDeviceMemoryProperties(physical.handle),
         enabled_features=enabled_core | set(REQUIRED_12) | set(REQUIRED_13)
-        | ({"hostQueryReset"} if f12.hostQueryReset else set()),
+        | ({"hostQueryReset"} if f12.hostQueryReset else set())
+        | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},
     )

@@ -1,0 +1,206 @@
+"""Scene build: the parsed scene file -> meshes, draws, materials, lights, decals, camera.
+
+Everything here is float64 in world space; per-frame quantities (camera, camera-relative
+model matrices, deformed vertices) are functions of the frame index. ``rgraph.scene.packing``
+turns them into the GPU structs of ``shaders/scene/scene.glsl``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
+from rgraph.scene.deform import FRAME_SECONDS, Deformer
+from rgraph.scene.shapes import MeshData, make_shape
+from rgraph.spec.scene import Material, SceneFile, load_scene
+
+MAX_SHADOW_LIGHTS = 4
+LIGHT_TYPES = {"directional": 0, "point": 1, "spot": 2}
+#: Decal materials every scene knows (a scene's ``decal_materials`` or ``materials`` override them).
+BUILTIN_DECALS = {
+    "blood": Material(base_color=[0.30, 0.015, 0.02], roughness=0.15, metallic=0.0, opacity=0.92),
+}
+AMBIENT = (0.03, 0.03, 0.035)
+
+
+@dataclass
+class SceneMesh:
+    """One mesh of the scene file: its geometry and the world placement of each instance."""
+
+    name: str
+    data: MeshData
+    material: int
+    rotation: tuple[float, float, float]
+    scale: np.ndarray
+    positions: np.ndarray  # (instances, 3) world float64
+    deformer: Deformer | None = None
+    first_draw: int = 0
+
+    @property
+    def instances(self) -> int:
+        return len(self.positions)
+
+    def world_corners(self) -> np.ndarray:
+        """Corners of every instance's world bounding box (instances * 8, 3), deformation included."""
+        lo, hi = self.data.bounds()
+        if self.deformer is not None:
+            pad = self.deformer.max_displacement
+            lo, hi = lo - pad, hi + pad
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        out = []
+        for p in self.positions:
+            m = model_matrix(p, self.rotation, self.scale)
+            out.append(corners @ m[:3, :3].T + m[:3, 3])
+        return np.concatenate(out)
+
+
+@dataclass
+class SceneLightData:
+    type: int
+    position: np.ndarray  # world float64 (0 for directional)
+    direction: np.ndarray  # unit, the direction light travels
+    radiance: np.ndarray
+    intensity: float
+    radius: float
+    shadow_layer: int  # -1 without a shadow map
+
+
+@dataclass
+class DecalData:
+    position: np.ndarray  # world float64
+    size: np.ndarray
+    rotation: tuple[float, float, float]
+    material: Material
+
+
+@dataclass
+class SceneData:
+    name: str
+    model: SceneFile
+    extent: tuple[int, int]
+    meshes: list[SceneMesh]
+    material_names: list[str]
+    materials: list[Material]
+    lights: list[SceneLightData]
+    decals: list[DecalData]
+    world_corners: np.ndarray = field(repr=False)
+
+    # ------------------------------------------------------------- counts
+    @property
+    def draw_count(self) -> int:
+        return sum(m.instances for m in self.meshes)
+
+    @property
+    def shadow_lights(self) -> list[SceneLightData]:
+        return [li for li in self.lights if li.shadow_layer >= 0]
+
+    @property
+    def point_light_count(self) -> int:
+        return sum(1 for li in self.lights if li.type != LIGHT_TYPES["directional"])
+
+    @property
+    def deformable(self) -> list[SceneMesh]:
+        return [m for m in self.meshes if m.deformer is not None]
+
+    @property
+    def rigid(self) -> list[SceneMesh]:
+        return [m for m in self.meshes if m.deformer is None]
+
+    # ------------------------------------------------------------- per frame
+    @staticmethod
+    def seconds(frame: int) -> float:
+        return frame * FRAME_SECONDS
+
+    def camera(self, frame: int = 0) -> CameraState:
+        """The camera of ``frame`` (static: the scene file's)."""
+        c = self.model.camera
+        w, h = self.extent
+        return camera_state(c.position, c.look_at, c.up, c.fov_y, c.near, w / h)
+
+    def draw_models(self, camera_position: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, int, int, int]]:
+        """Per draw, in draw order: (camera-relative model, normal matrix, material, mesh index,
+        flags) in float64; translation = world position - camera, formed in float64."""
+        cam = np.asarray(camera_position, dtype=np.float64)
+        out = []
+        for k, mesh in enumerate(self.meshes):
+            flags = 1 if mesh.deformer is not None else 0
+            for p in mesh.positions:
+                m = model_matrix(p - cam, mesh.rotation, mesh.scale)
+                out.append((m, normal_matrix(m), mesh.material, k, flags))
+        return out
+
+    def bounds_rel(self, camera_position: np.ndarray) -> np.ndarray:
+        """Bounding-box corners of the whole scene, camera-relative (float64)."""
+        return self.world_corners - np.asarray(camera_position, dtype=np.float64)
+
+    def shadow_matrices(self, camera_position: np.ndarray) -> list[np.ndarray]:
+        pts = self.bounds_rel(camera_position)
+        return [shadow_view_proj(li.direction, pts) for li in self.shadow_lights]
+
+    def deformed(self, mesh: SceneMesh, frame: int) -> MeshData:
+        assert mesh.deformer is not None
+        return mesh.deformer.at_frame(frame)
+
+    def decal_matrices(self, camera_position: np.ndarray) -> list[np.ndarray]:
+        """Camera-relative world -> decal box [-0.5, 0.5]^3 (float64)."""
+        cam = np.asarray(camera_position, dtype=np.float64)
+        return [np.linalg.inv(model_matrix(d.position - cam, d.rotation, d.size)) for d in self.decals]
+
+
+def _vec(v) -> np.ndarray:
+    return np.asarray(v, dtype=np.float64).reshape(3)
+
+
+def _instance_positions(mesh) -> np.ndarray:
+    base = _vec(mesh.position)
+    if mesh.instances is None:
+        return base[None]
+    g = mesh.instances.grid
+    offs = [((i - (g[0] - 1) / 2) * mesh.instances.spacing, (j - (g[1] - 1) / 2) * mesh.instances.spacing,
+             (k - (g[2] - 1) / 2) * mesh.instances.spacing)
+            for i in range(g[0]) for j in range(g[1]) for k in range(g[2])]
+    return base + np.asarray(offs, dtype=np.float64).reshape(-1, 3)
+
+
+def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str | None = None) -> SceneData:
+    """Geometry and tables of a scene file for an output of ``extent`` (w, h)."""
+    material_names = list(model.materials)
+    materials = [model.materials[n] for n in material_names]
+    meshes, draw = [], 0
+    for i, m in enumerate(model.meshes):
+        try:
+            data = make_shape(m.shape, dict(m.params), seed=m.seed)
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"mesh {i} ({m.shape}): {exc}") from None
+        scale = np.broadcast_to(np.asarray(m.scale, dtype=np.float64), (3,)).copy()
+        mesh = SceneMesh(f"{i}:{m.shape}", data, material_names.index(m.material), tuple(m.rotation), scale,
+                         _instance_positions(m), Deformer(data) if m.deformable else None, draw)
+        draw += mesh.instances
+        meshes.append(mesh)
+    lights, layer = [], 0
+    for li in model.lights:
+        kind = LIGHT_TYPES[li.type]
+        direction = _vec(li.direction if li.direction is not None else (0, -1, 0))
+        norm = np.linalg.norm(direction)
+        direction = direction / norm if norm > 0 else np.array([0.0, -1.0, 0.0])
+        shadow = -1
+        if li.type == "directional" and li.shadows:
+            if layer >= MAX_SHADOW_LIGHTS:
+                raise ValueError(f"at most {MAX_SHADOW_LIGHTS} shadow-casting lights are supported")
+            shadow, layer = layer, layer + 1
+        lights.append(SceneLightData(kind, _vec(li.position if li.position is not None else (0, 0, 0)), direction,
+                                     _vec(li.color) * li.intensity, float(li.intensity), float(li.radius), shadow))
+    pool = {**BUILTIN_DECALS, **model.materials, **model.decal_materials}
+    decals = [DecalData(_vec(d.position), _vec(d.size), tuple(d.rotation), pool[d.material]) for d in model.decals]
+    corners = (np.concatenate([m.world_corners() for m in meshes]) if meshes
+               else np.zeros((1, 3)) + _vec(model.camera.look_at))
+    return SceneData(name or model.name or "scene", model, extent, meshes, material_names, materials, lights,
+                     decals, corners)
+
+
+def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64)) -> SceneData:
+    scene = load_scene(path)
+    return build_scene(scene.model, extent, scene.name)

@@ -1,0 +1,127 @@
+"""NumPy packing of the GPU structs declared in ``shaders/scene/scene.glsl`` (byte for byte).
+
+Matrices are written column-major (``M.T`` as float32), as GLSL reads them. Sizes and
+offsets here are the ones written in scene.glsl's comments; tests check both sides.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rgraph.scene.build import AMBIENT, LIGHT_TYPES, MAX_SHADOW_LIGHTS, SceneData
+from rgraph.scene.shapes import MeshData
+
+FRAME_BYTES = 800
+DRAW_BYTES = 144
+MATERIAL_BYTES = 64
+SCENE_LIGHT_BYTES = 64
+DECAL_BYTES = 96
+LIGHT_BYTES = 64  # the graph's `lights` buffer entries (light_setup output)
+VERTEX_BYTES = 24  # vec3 position, vec3 normal
+
+FRAME_OFFSETS = {
+    "view": 0, "proj": 64, "view_proj": 128, "inv_view_proj": 192, "inv_proj": 256, "inv_view": 320,
+    "shadow_view_proj": 384, "viewport": 640, "counts": 656, "counts2": 672, "time": 688, "sun_direction": 704,
+    "sun_radiance": 720, "ambient": 736, "camera_hi": 752, "camera_lo": 768, "scene_bounds": 784,
+}
+
+
+def mat(m: np.ndarray) -> np.ndarray:
+    """A 4x4 float64 matrix as 16 column-major float32 values."""
+    return np.asarray(m, dtype=np.float64).T.astype(np.float32).reshape(16)
+
+
+def split_hi_lo(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """float64 -> (float32 high part, float32 remainder): hi + lo == p to ~2^-48 relative."""
+    p = np.asarray(p, dtype=np.float64)
+    hi = p.astype(np.float32)
+    lo = (p - hi.astype(np.float64)).astype(np.float32)
+    return hi, lo
+
+
+def frame_bytes(scene: SceneData, frame: int) -> bytes:
+    cam = scene.camera(frame)
+    f = np.zeros(FRAME_BYTES // 4, dtype=np.float32)
+    i = f.view(np.int32)
+
+    def put(name: str, values) -> None:
+        o = FRAME_OFFSETS[name] // 4
+        arr = np.asarray(values, dtype=np.float32).reshape(-1)
+        f[o:o + len(arr)] = arr
+
+    put("view", mat(cam.view))
+    put("proj", mat(cam.proj))
+    put("view_proj", mat(cam.view_proj))
+    put("inv_view_proj", mat(cam.inv_view_proj))
+    put("inv_proj", mat(cam.inv_proj))
+    put("inv_view", mat(cam.inv_view))
+    shadows = scene.shadow_matrices(cam.position)
+    for k in range(MAX_SHADOW_LIGHTS):
+        o = FRAME_OFFSETS["shadow_view_proj"] // 4 + 16 * k
+        f[o:o + 16] = mat(shadows[k] if k < len(shadows) else np.eye(4))
+    w, h = scene.extent
+    put("viewport", (w, h, 1.0 / w, 1.0 / h))
+    o = FRAME_OFFSETS["counts"] // 4
+    directional = sum(1 for li in scene.lights if li.type == LIGHT_TYPES["directional"])
+    i[o:o + 8] = (len(scene.lights), len(scene.shadow_lights), len(scene.decals), scene.point_light_count,
+                  len(scene.materials), scene.draw_count, directional, len(scene.deformable))
+    put("time", (scene.seconds(frame), float(frame), cam.near, np.radians(cam.fov_y_deg)))
+    sun = next((li for li in scene.lights if li.type == LIGHT_TYPES["directional"]), None)
+    if sun is not None:
+        put("sun_direction", (*(-sun.direction), float(sun.shadow_layer)))
+        put("sun_radiance", (*sun.radiance, 0.0))
+    else:
+        put("sun_direction", (0.0, 1.0, 0.0, -1.0))
+    put("ambient", (*AMBIENT, 0.0))
+    hi, lo = split_hi_lo(cam.position)
+    put("camera_hi", (*hi, 0.0))
+    put("camera_lo", (*lo, 0.0))
+    pts = scene.bounds_rel(cam.position)
+    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
+    put("scene_bounds", (*centre, float(np.linalg.norm(pts - centre, axis=1).max())))
+    return f.tobytes()
+
+
+def draws_bytes(scene: SceneData, frame: int) -> bytes:
+    draws = scene.draw_models(scene.camera(frame).position)
+    out = np.zeros((max(len(draws), 1), DRAW_BYTES // 4), dtype=np.float32)
+    ints = out.view(np.uint32)
+    for k, (model, normal, material, mesh, flags) in enumerate(draws):
+        out[k, 0:16] = mat(model)
+        out[k, 16:32] = mat(normal)
+        ints[k, 32:36] = (material, mesh, flags, 0)
+    return out.tobytes()
+
+
+def materials_bytes(scene: SceneData) -> bytes:
+    out = np.zeros((max(len(scene.materials), 1), MATERIAL_BYTES // 4), dtype=np.float32)
+    for k, m in enumerate(scene.materials):
+        out[k] = (*m.base_color, m.opacity, m.roughness, m.metallic, m.sss, m.reflective,
+                  m.refractive, m.ior, m.baked_ao, 0.0, *m.emissive, 0.0)
+    return out.tobytes()
+
+
+def scene_lights_bytes(scene: SceneData) -> bytes:
+    out = np.zeros((max(len(scene.lights), 1), SCENE_LIGHT_BYTES // 4), dtype=np.float32)
+    for k, li in enumerate(scene.lights):
+        hi, lo = split_hi_lo(li.position)
+        out[k] = (*hi, li.type, *lo, li.radius, *li.direction, li.shadow_layer, *li.radiance, li.intensity)
+    return out.tobytes()
+
+
+def decals_bytes(scene: SceneData, frame: int) -> bytes:
+    out = np.zeros((max(len(scene.decals), 1), DECAL_BYTES // 4), dtype=np.float32)
+    for k, (d, m) in enumerate(zip(scene.decals, scene.decal_matrices(scene.camera(frame).position), strict=True)):
+        out[k, 0:16] = mat(m)
+        out[k, 16:24] = (*d.material.base_color, d.material.opacity, d.material.roughness, d.material.metallic, 0, 0)
+    return out.tobytes()
+
+
+def vertex_bytes(mesh: MeshData) -> bytes:
+    v = np.concatenate([mesh.positions, mesh.normals], axis=1).astype(np.float32)
+    return np.ascontiguousarray(v).tobytes()
+
+
+def unpack_lights(data: bytes, count: int) -> np.ndarray:
+    """The `lights` buffer (light_setup output) as (count, 16) float32."""
+    return np.frombuffer(bytes(data[:count * LIGHT_BYTES]), dtype=np.float32).reshape(count, 16)

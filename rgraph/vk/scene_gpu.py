@@ -1,0 +1,288 @@
+"""The scene on the GPU: descriptor set 0 of scene passes (``shaders/scene/scene.glsl``) and geometry.
+
+Built once per run from ``plan["scene_source"]`` by the executor (``Executor._scene``):
+
+- rigid geometry (every mesh's vertices; all indices), the materials and the authored lights
+  live in device-local buffers, filled once through a host staging buffer and
+  ``vkCmdCopyBuffer`` followed by a buffer barrier COPY/TRANSFER_WRITE -> ALL_COMMANDS/MEMORY_READ
+  in the same command buffer (a fence wait alone does not make device writes visible);
+- per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
+  uniform, the Draws and Decals storage buffers (camera-relative, float64 on the CPU), and the
+  deformable meshes' vertices (deformed on the CPU every frame).
+
+Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(frame_set)``,
+``vertex_input`` and ``draw(rec, frame_set)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from rgraph.scene import packing
+from rgraph.scene.build import SceneData, load_scene_data
+from rgraph.vk import names
+from rgraph.vk.device import Device
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.loader import vk
+from rgraph.vk.passkit import VertexInput
+from rgraph.vk.resources import HostBuffer, memory_type
+
+BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS = range(5)
+
+
+@dataclass(frozen=True)
+class DrawCall:
+    deformable: bool
+    index_count: int
+    first_index: int
+    vertex_offset: int
+    instances: int
+    first_instance: int
+
+
+@dataclass
+class _DeviceBuffer:
+    handle: Any
+    memory: Any
+    size: int
+
+
+class SceneGPU:
+    """See the module docstring. ``submit_once(queue, record_fn)`` records ``record_fn(cb)``,
+    submits it on the plan queue and waits for it."""
+
+    def __init__(self, device: Device, plan: dict, sets: int, submit_once: Any) -> None:
+        source = plan.get("scene_source")
+        if not source:
+            raise ExecutionError("the plan names no scene file (scene_source); scene passes need one")
+        self.device = device
+        self.sets = sets
+        self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
+        try:
+            self.data: SceneData = load_scene_data(source, self.extent)
+        except (OSError, ValueError) as exc:
+            raise ExecutionError(f"scene {source}: {exc}") from None
+        self._device_buffers: list[_DeviceBuffer] = []
+        self._host: list[HostBuffer] = []
+        self._pool = None
+        self.set_layout = None
+        self._sets: list[Any] = []
+        try:
+            self._build(submit_once)
+        except BaseException:
+            self.destroy()
+            raise
+
+    # ----------------------------------------------------------------- python-side accessors
+    @property
+    def lights(self) -> int:
+        return len(self.data.lights)
+
+    @property
+    def shadow_lights(self) -> int:
+        return len(self.data.shadow_lights)
+
+    @property
+    def point_lights(self) -> int:
+        return self.data.point_light_count
+
+    @property
+    def decals(self) -> int:
+        return len(self.data.decals)
+
+    @property
+    def draw_count(self) -> int:
+        return self.data.draw_count
+
+    def camera(self, frame: int = 0):
+        """The float64 ``rgraph.scene.camera.CameraState`` of ``frame``."""
+        return self.data.camera(frame)
+
+    @property
+    def vertex_input(self) -> VertexInput:
+        return VertexInput(stride=packing.VERTEX_BYTES,
+                           attributes=[(0, "r32g32b32_sfloat", 0), (1, "r32g32b32_sfloat", 12)])
+
+    @property
+    def position_input(self) -> VertexInput:
+        """Positions only (depth-only shaders, ``SCENE_POSITION_ONLY``): same buffers and stride."""
+        return VertexInput(stride=packing.VERTEX_BYTES, attributes=[(0, "r32g32b32_sfloat", 0)])
+
+    def descriptor_set(self, frame_set: int) -> Any:
+        return self._sets[frame_set]
+
+    # ----------------------------------------------------------------- creation
+    def _device_buffer(self, size: int, usage: int) -> _DeviceBuffer:
+        v = vk()
+        dev = self.device.handle
+        handle = v.vkCreateBuffer(dev, v.VkBufferCreateInfo(size=max(size, 16), usage=usage | v.VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                            sharingMode=v.VK_SHARING_MODE_EXCLUSIVE), None)
+        req = v.vkGetBufferMemoryRequirements(dev, handle)
+        index = memory_type(self.device, req.memoryTypeBits, v.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)
+        memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(allocationSize=req.size, memoryTypeIndex=index), None)
+        v.vkBindBufferMemory(dev, handle, memory, 0)
+        buf = _DeviceBuffer(handle, memory, max(size, 16))
+        self._device_buffers.append(buf)
+        return buf
+
+    def _host_buffer(self, size: int, usage: int) -> HostBuffer:
+        buf = HostBuffer.create(self.device, size, usage)
+        self._host.append(buf)
+        return buf
+
+    def _build(self, submit_once: Any) -> None:
+        import numpy as np
+
+        v = vk()
+        data = self.data
+        # geometry: rigid vertices in one device-local buffer, deformable ones per set in host memory
+        rigid_vertices, indices, calls = [], [], []
+        rigid_base = deform_base = first_index = 0
+        self._deform_layout: list[tuple[Any, int]] = []  # (mesh, vertex offset) in the per-set buffers
+        for mesh in data.meshes:
+            count = mesh.data.triangle_count * 3
+            indices.append(mesh.data.indices.reshape(-1))
+            if mesh.deformer is None:
+                rigid_vertices.append(packing.vertex_bytes(mesh.data))
+                calls.append(DrawCall(False, count, first_index, rigid_base, mesh.instances, mesh.first_draw))
+                rigid_base += mesh.data.vertex_count
+            else:
+                self._deform_layout.append((mesh, deform_base))
+                calls.append(DrawCall(True, count, first_index, deform_base, mesh.instances, mesh.first_draw))
+                deform_base += mesh.data.vertex_count
+            first_index += count
+        self.calls = calls
+        index_bytes = np.concatenate(indices).astype(np.uint32).tobytes() if indices else b""
+        vertex_bytes = b"".join(rigid_vertices)
+        materials = packing.materials_bytes(data)
+        scene_lights = packing.scene_lights_bytes(data)
+        uploads = []
+        storage = v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
+        self.index_buffer = self._device_buffer(len(index_bytes), v.VK_BUFFER_USAGE_INDEX_BUFFER_BIT)
+        uploads.append((self.index_buffer, index_bytes))
+        self.vertex_buffer = self._device_buffer(len(vertex_bytes), v.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT)
+        uploads.append((self.vertex_buffer, vertex_bytes))
+        self.materials_buffer = self._device_buffer(len(materials), storage)
+        uploads.append((self.materials_buffer, materials))
+        self.scene_lights_buffer = self._device_buffer(len(scene_lights), storage)
+        uploads.append((self.scene_lights_buffer, scene_lights))
+        self._upload(submit_once, [(b, d) for b, d in uploads if d])
+
+        self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
+                              for _ in range(self.sets)]
+        draws_size = len(packing.draws_bytes(data, 0))
+        self.draw_buffers = [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
+        decals_size = max(len(data.decals), 1) * packing.DECAL_BYTES
+        self.decal_buffers = [self._host_buffer(decals_size, storage) for _ in range(self.sets)]
+        self.deform_buffers = ([self._host_buffer(deform_base * packing.VERTEX_BYTES, v.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT)
+                                for _ in range(self.sets)] if deform_base else [])
+        self._make_descriptors(materials_size=len(materials), lights_size=len(scene_lights), draws_size=draws_size,
+                               decals_size=decals_size)
+        for s in range(self.sets):
+            self.update(0, s)
+
+    def _upload(self, submit_once: Any, uploads: list[tuple[_DeviceBuffer, bytes]]) -> None:
+        v = vk()
+        offsets, total = [], 0
+        for _buf, payload in uploads:
+            offsets.append(total)
+            total += (len(payload) + 15) // 16 * 16
+        staging = HostBuffer.create(self.device, max(total, 16), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
+        try:
+            for (_buf, payload), off in zip(uploads, offsets, strict=True):
+                staging.write(payload, off)
+
+            def record(cb: Any) -> None:
+                keep: list[Any] = []
+                for (buf, payload), off in zip(uploads, offsets, strict=True):
+                    region = v.VkBufferCopy(srcOffset=off, dstOffset=0, size=len(payload))
+                    keep.append(region)
+                    v.vkCmdCopyBuffer(cb, staging.handle, buf.handle, 1, [region])
+                barriers = [v.VkBufferMemoryBarrier2(
+                    srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                    dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT,
+                    srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                    buffer=buf.handle, offset=0, size=names.WHOLE_SIZE) for buf, _payload in uploads]
+                dep = v.VkDependencyInfo(bufferMemoryBarrierCount=len(barriers), pBufferMemoryBarriers=barriers)
+                keep.append((barriers, dep))
+                v.vkCmdPipelineBarrier2(cb, dep)
+
+            if uploads:
+                submit_once("graphics", record)
+        finally:
+            staging.destroy()
+
+    def _make_descriptors(self, *, materials_size: int, lights_size: int, draws_size: int, decals_size: int) -> None:
+        v = vk()
+        dev = self.device.handle
+        ubo, ssbo = v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+        kinds = [(BINDING_FRAME, ubo), (BINDING_DRAWS, ssbo), (BINDING_MATERIALS, ssbo),
+                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo)]
+        bindings = [v.VkDescriptorSetLayoutBinding(binding=b, descriptorType=t, descriptorCount=1,
+                                                   stageFlags=v.VK_SHADER_STAGE_ALL) for b, t in kinds]
+        self.set_layout = v.vkCreateDescriptorSetLayout(dev, v.VkDescriptorSetLayoutCreateInfo(
+            bindingCount=len(bindings), pBindings=bindings), None)
+        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=self.sets),
+                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=4 * self.sets)]
+        self._pool = v.vkCreateDescriptorPool(dev, v.VkDescriptorPoolCreateInfo(
+            maxSets=self.sets, poolSizeCount=len(sizes), pPoolSizes=sizes), None)
+        self._sets = list(v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
+            descriptorPool=self._pool, descriptorSetCount=self.sets, pSetLayouts=[self.set_layout] * self.sets)))
+        for s in range(self.sets):
+            sources = [(BINDING_FRAME, ubo, self.frame_buffers[s].handle, packing.FRAME_BYTES),
+                       (BINDING_DRAWS, ssbo, self.draw_buffers[s].handle, draws_size),
+                       (BINDING_MATERIALS, ssbo, self.materials_buffer.handle, materials_size),
+                       (BINDING_SCENE_LIGHTS, ssbo, self.scene_lights_buffer.handle, lights_size),
+                       (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size)]
+            infos = [v.VkDescriptorBufferInfo(buffer=h, offset=0, range=size) for _b, _t, h, size in sources]
+            writes = [v.VkWriteDescriptorSet(dstSet=self._sets[s], dstBinding=b, descriptorCount=1, descriptorType=t,
+                                             pBufferInfo=[info])
+                      for (b, t, _h, _size), info in zip(sources, infos, strict=True)]
+            v.vkUpdateDescriptorSets(dev, len(writes), writes, 0, None)
+
+    # ----------------------------------------------------------------- per frame
+    def update(self, frame: int, frame_set: int) -> None:
+        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished)."""
+        data = self.data
+        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame))
+        self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
+        if data.decals:
+            self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
+        for mesh, base in self._deform_layout:
+            self.deform_buffers[frame_set].write(packing.vertex_bytes(data.deformed(mesh, frame)),
+                                                 base * packing.VERTEX_BYTES)
+
+    def draw(self, rec: Any, frame_set: int) -> None:
+        """Bind vertex and index buffers and record one drawIndexed per mesh
+        (instances = the mesh's instances, firstInstance = its first draw index)."""
+        if not self.calls:
+            return
+        rec.bind_index_buffer(self.index_buffer.handle)
+        bound = None
+        for call in self.calls:
+            want = self.deform_buffers[frame_set].handle if call.deformable else self.vertex_buffer.handle
+            if want is not bound:
+                rec.bind_vertex_buffers([want])
+                bound = want
+            rec.draw_indexed(call.index_count, call.instances, call.first_index, call.vertex_offset,
+                             call.first_instance)
+
+    # ----------------------------------------------------------------- teardown
+    def destroy(self) -> None:
+        v = vk()
+        dev = self.device.handle
+        if self._pool is not None:
+            v.vkDestroyDescriptorPool(dev, self._pool, None)
+            self._pool = None
+            self._sets = []
+        if self.set_layout is not None:
+            v.vkDestroyDescriptorSetLayout(dev, self.set_layout, None)
+            self.set_layout = None
+        for buf in reversed(self._host):
+            buf.destroy()
+        self._host = []
+        for buf in reversed(self._device_buffers):
+            v.vkDestroyBuffer(dev, buf.handle, None)
+            v.vkFreeMemory(dev, buf.memory, None)
+        self._device_buffers = []

@@ -1,0 +1,90 @@
+"""HBAO on the async compute queue: quarter-res depth, horizon-based AO, bilateral upsample.
+
+Three implementations (``impl:`` names), each reading the resources surgery.yaml declares:
+
+- ``hbao_downsample``: ``depth`` (sampled) -> ``depth_quarter`` (storage_write);
+- ``hbao``: ``depth_quarter`` (sampled) -> ``ao_quarter`` (storage_write);
+- ``hbao_upsample``: ``ao_quarter`` (sampled), ``depth`` (sampled), ``depth_quarter``
+  (storage_read) -> ``ao`` (storage_write).
+
+Params: ``hbao.directions``, ``hbao.steps`` (compile-time loop counts), ``hbao.radius``
+(world units), ``hbao.angle_bias``, ``hbao.strength``, ``hbao.max_radius_px``,
+``hbao.upsample_sharpness``; the camera from ``passes.screenspace_ref.screen_camera``.
+What each computes, exactly: ``passes/hbao_ref.py``.
+"""
+
+from __future__ import annotations
+
+from rgraph.impl import PassImpl, register
+from rgraph.vk.passkit import Binding, pack
+
+from .hbao_ref import HBAOSettings
+from .screenspace_ref import screen_camera
+
+
+def _groups(extent: tuple[int, int]) -> tuple[int, int]:
+    return -(-extent[0] // 8), -(-extent[1] // 8)
+
+
+def _proj(setup) -> bytes:
+    cam = screen_camera(setup.plan, setup.params, setup.size)
+    return pack("4f", cam.p00, cam.p11, cam.near, 0.0)
+
+
+@register("hbao_downsample")
+class HBAODownsample(PassImpl):
+    """Nearest-surface (max reversed-Z) depth of each 4x4 block."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest"),
+                                       Binding(1, "storage_image", "depth_quarter")])
+        self.pipeline = setup.compute_pipeline("hbao/downsample.comp", [self.sets.layout])
+        self.groups = _groups(setup.extent_of("depth_quarter"))
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.dispatch(*self.groups)
+
+
+@register("hbao")
+class HBAO(PassImpl):
+    """Horizon-based AO at quarter resolution."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        s = HBAOSettings.from_params(setup.params)
+        if s.directions < 1 or s.steps < 1:
+            raise ValueError(f"pass {setup.name!r}: hbao.directions and hbao.steps must be >= 1")
+        self.sets = setup.descriptors([Binding(0, "sampled", "depth_quarter", sampler="nearest"),
+                                       Binding(1, "storage_image", "ao_quarter")])
+        self.pipeline = setup.compute_pipeline("hbao/hbao.comp", [self.sets.layout], push_constant_bytes=32,
+                                               defines={"DIRECTIONS": s.directions, "STEPS": s.steps})
+        self.push = _proj(setup) + pack("4f", s.radius, s.angle_bias, s.strength, s.max_radius_px)
+        self.groups = _groups(setup.extent_of("ao_quarter"))
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*self.groups)
+
+
+@register("hbao_upsample")
+class HBAOUpsample(PassImpl):
+    """Depth-aware (joint bilateral) upsample of the quarter AO to full resolution."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        s = HBAOSettings.from_params(setup.params)
+        self.sets = setup.descriptors([Binding(0, "sampled", "ao_quarter", sampler="nearest"),
+                                       Binding(1, "sampled", "depth", sampler="nearest"),
+                                       Binding(2, "storage_image", "depth_quarter"),
+                                       Binding(3, "storage_image", "ao")])
+        self.pipeline = setup.compute_pipeline("hbao/upsample.comp", [self.sets.layout], push_constant_bytes=32)
+        self.push = _proj(setup) + pack("4f", s.upsample_sharpness, 0.0, 0.0, 0.0)
+        self.groups = _groups(setup.extent_of("ao"))
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*self.groups)

@@ -1,0 +1,19 @@
+#version 460
+// Quarter-resolution depth: the NEAREST surface of each 4x4 block, i.e. the largest
+// reversed-Z value (see passes/hbao_ref.py for why this is the conservative choice).
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform sampler2D depth;
+layout(set = 0, binding = 1, r32f) uniform writeonly image2D depth_quarter;
+
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(q, imageSize(depth_quarter)))) return;
+    ivec2 size = textureSize(depth, 0);
+    ivec2 lo = min(q * 4, size - 1);
+    ivec2 hi = min(q * 4 + 4, size);
+    float nearest = 0.0;
+    for (int y = lo.y; y < hi.y; ++y)
+        for (int x = lo.x; x < hi.x; ++x)
+            nearest = max(nearest, texelFetch(depth, ivec2(x, y), 0).r);
+    imageStore(depth_quarter, q, vec4(nearest));
+}

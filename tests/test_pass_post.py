@@ -61,3 +61,13 @@ def test_post_chain_as_in_surgery_matches_reference_and_stays_finite():
     assert diff.max() <= tonemap_ref.TOLERANCE_SRGB_CODES, diff.max()  # float16 stages are mirrored
     assert color[0, 0, :3].tolist() == [0.0, 0.0, 0.0]  # the NaN texel is black
     assert color[0, 1, 1] == 1.0 and color[1, 1, :3].tolist() == [1.0, 1.0, 1.0]  # Inf is white
+
+
+def test_references_import_without_vulkan():
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.modules['vulkan'] = None\n"
+            "from rgraph.passes import bloom_ref, composite_ref, tonemap_ref, post_common_ref\n"
+            "assert not any(m.startswith('rgraph.vk') for m in sys.modules), sorted(sys.modules)\n")
+    subprocess.run([sys.executable, "-c", code], check=True)

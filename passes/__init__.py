@@ -10,7 +10,14 @@ import importlib
 import pkgutil
 
 
-def load_all() -> None:
+def load_all() -> dict[str, Exception]:
+    """Import every module; returns the modules that failed (name -> exception) so that one
+    broken module does not hide the others' implementations."""
+    failed: dict[str, Exception] = {}
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
         if not info.name.startswith("_"):
-            importlib.import_module(f"{__name__}.{info.name}")
+            try:
+                importlib.import_module(f"{__name__}.{info.name}")
+            except Exception as exc:  # noqa: BLE001 -- reported by rgraph.impl.lookup
+                failed[f"{__name__}.{info.name}"] = exc
+    return failed

@@ -25,6 +25,7 @@ from typing import Any, ClassVar, TypeVar
 
 _REGISTRY: dict[str, type[PassImpl]] = {}
 _LOADED = False
+_FAILED: dict[str, Exception] = {}  # module -> why it could not be imported
 
 T = TypeVar("T", bound="type[PassImpl]")
 
@@ -80,9 +81,13 @@ def load_implementations() -> None:
     _LOADED = True
     from rgraph.resources import builtin_passes
 
-    builtin_passes().load_all()
+    _FAILED.update(builtin_passes().load_all())
     for ep in entry_points(group="rgraph.passes"):
-        import_module(ep.value.split(":")[0])
+        module = ep.value.split(":")[0]
+        try:
+            import_module(module)
+        except Exception as exc:  # noqa: BLE001 -- reported by lookup
+            _FAILED[module] = exc
 
 
 def lookup(name: str) -> type[PassImpl]:
@@ -91,8 +96,9 @@ def lookup(name: str) -> type[PassImpl]:
     try:
         return _REGISTRY[name]
     except KeyError:
+        broken = "".join(f"; module {m} failed to import: {type(e).__name__}: {e}" for m, e in sorted(_FAILED.items()))
         raise KeyError(f"no pass implementation named {name!r}; known: {', '.join(sorted(_REGISTRY)) or '(none)'}"
-                       ) from None
+                       f"{broken}") from None
 
 
 def names() -> list[str]:

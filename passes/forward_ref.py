@@ -34,7 +34,7 @@ def ggx_alpha(perceptual_roughness: np.ndarray | float) -> np.ndarray:
 
 def d_ggx(noh: np.ndarray, one_minus_noh2: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     a = noh * alpha
-    k = alpha / (one_minus_noh2 + a * a)
+    k = alpha / np.maximum(one_minus_noh2 + a * a, alpha * alpha)
     return k * k / np.pi
 
 

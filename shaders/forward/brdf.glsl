@@ -29,10 +29,12 @@ float ggx_alpha(float perceptual_roughness) {
     return r * r;
 }
 
-// GGX / Trowbridge-Reitz normal distribution; one_minus_noh2 = |N x H|^2.
+// GGX / Trowbridge-Reitz normal distribution; one_minus_noh2 = |N x H|^2. For unit N, H the
+// denominator is >= alpha^2 (its value at N.H = 1); the max() keeps that bound, so D <= the peak
+// 1 / (pi alpha^2) even for H ~ -N, where the clamped N.H and |N x H|^2 disagree.
 float d_ggx(float noh, float one_minus_noh2, float alpha) {
     float a = noh * alpha;
-    float k = alpha / (one_minus_noh2 + a * a);
+    float k = alpha / max(one_minus_noh2 + a * a, alpha * alpha);
     return k * k * (1.0 / PI);
 }
 

@@ -1,0 +1,87 @@
+"""Forward PBR shading: ``forward_pbr`` (the ``forward`` pass of surgery.yaml).
+
+GGX Cook-Torrance (Smith height-correlated visibility, Schlick Fresnel; shaders/forward/brdf.glsl)
+for every light of the graph buffer ``lights`` (directional and point; spot lights shade as
+points), PCF shadows on shadow-casting directional lights, split-sum IBL from ``brdf_lut`` and
+``env_map`` (passes/ibl.py) and ambient occlusion combine(screen-space ``ao``, the material's
+baked AO). Writes ``diffuse`` and ``specular`` (HDR, separate) and ``normal_sss``
+(rgb = 0.5 * n + 0.5 of the unit world-space normal, a = the material's sss). Depth is
+``depth_read``: GREATER_OR_EQUAL against the prepass (reversed-Z), no depth writes.
+
+Optional reads: without ``ao`` (HBAO culled) the screen-space AO is 1.0, without
+``shadow_maps`` (no shadow lights) lights are unshadowed, both by compile-time defines.
+
+Params: ``forward.ibl_intensity`` (scale of the environment, default 0.5),
+``forward.ao_combine`` (0 min (default), 1 max, 2 multiply), ``shadow.pcf_taps`` (PCF taps,
+default 16), ``depth_prepass.cull`` (shared with the prepass so both rasterize the same
+triangles). NumPy reference of the shading: passes/forward_ref.py.
+"""
+
+from __future__ import annotations
+
+from rgraph.impl import PassImpl, register
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.passkit import Binding, PassSetup
+
+COLOR_OUTPUTS = ("diffuse", "specular", "normal_sss")
+LIGHT_BYTES = 64
+
+
+def color_locations(setup: PassSetup, names: tuple[str, ...]) -> dict[str, int]:
+    """Fragment output location of each colour attachment (the plan's colour access order)."""
+    colors = [a["resource"] for a in setup.plan_pass["accesses"] if a["usage"].startswith("color_attachment")]
+    missing = [n for n in names if n not in colors]
+    if missing:
+        raise ExecutionError(f"pass {setup.name!r}: expected colour attachments {list(names)}, "
+                             f"the plan has {colors}")
+    if len(colors) != len(names):
+        raise ExecutionError(f"pass {setup.name!r}: colour attachments {colors}, expected exactly {list(names)}")
+    return {n: colors.index(n) for n in names}
+
+
+def ao_combine_mode(setup: PassSetup) -> int:
+    mode = int(setup.param("forward.ao_combine", 0))
+    if mode not in (0, 1, 2):
+        raise ExecutionError(f"pass {setup.name!r}: forward.ao_combine must be 0 (min), 1 (max) or 2 (multiply)")
+    return mode
+
+
+@register("forward_pbr")
+class ForwardPBR(PassImpl):
+    """See the module docstring."""
+
+    clear_values = {"diffuse": (0.0, 0.0, 0.0, 0.0), "specular": (0.0, 0.0, 0.0, 0.0),
+                    "normal_sss": (0.5, 0.5, 0.5, 0.0)}
+
+    def __init__(self, setup: PassSetup) -> None:
+        super().__init__(setup)
+        self.scene = scene = setup.scene
+        loc = color_locations(setup, COLOR_OUTPUTS)
+        _handle, light_bytes = setup.buffer("lights", 0)
+        self.has_ao = setup.has("ao")
+        self.has_shadows = setup.has("shadow_maps") and scene.shadow_lights > 0
+        env_mips = int(setup.resource_plan("env_map")["mips"])
+        bindings = [Binding(0, "uniform_buffer", "lights"), Binding(1, "sampled", "brdf_lut"),
+                    Binding(2, "sampled", "env_map")]
+        if self.has_ao:
+            bindings.append(Binding(3, "sampled", "ao"))
+        if self.has_shadows:
+            bindings.append(Binding(4, "sampled", "shadow_maps", array=True, sampler="nearest"))
+        self.sets = setup.descriptors(bindings)
+        cull = str(setup.param("depth_prepass.cull", "back")).upper()
+        defines = {
+            "LOC_DIFFUSE": loc["diffuse"], "LOC_SPECULAR": loc["specular"], "LOC_NORMAL_SSS": loc["normal_sss"],
+            "LIGHT_COUNT": max(1, light_bytes // LIGHT_BYTES), "ENV_MIPS": env_mips,
+            "HAS_AO": int(self.has_ao), "HAS_SHADOWS": int(self.has_shadows),
+            "PCF_TAPS": int(setup.param("shadow.pcf_taps", 16)),
+            "IBL_INTENSITY": float(setup.param("forward.ibl_intensity", 0.5)),
+            "AO_COMBINE": ao_combine_mode(setup),
+        }
+        self.pipeline = setup.graphics_pipeline(
+            "forward/forward.vert", "forward/forward.frag", [scene.set_layout, self.sets.layout], defines=defines,
+            vertex_input=scene.vertex_input, cull=cull, front_face="COUNTER_CLOCKWISE", depth_test=True,
+            depth_write=False, depth_compare="GREATER_OR_EQUAL")
+
+    def record(self, rec, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
+        self.scene.draw(rec, frame_set)

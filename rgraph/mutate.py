@@ -409,8 +409,14 @@ class Report:
 def mutation_report(plan: dict, *, oracles: Iterable[str] = ORACLES, kinds: Iterable[str] = KINDS,
                     frames: int = 2, device_index: int | None = None,
                     progress: Callable[[int, int, Outcome], None] | None = None) -> Report:
-    """Run every mutant of ``plan`` through ``oracles``; the unmutated plan runs first as a baseline."""
+    """Run every mutant of ``plan`` through ``oracles``; the unmutated plan runs first as a baseline.
+
+    Every pass runs the probe implementation (any ``impl`` is set aside): the probe performs
+    each declared access and writes values the CPU simulation predicts, which is what makes
+    the data-flow oracle see a missing barrier.
+    """
     oracles = [o for o in ORACLES if o in set(oracles)]
+    plan = probe_only(plan)
     t0 = time.perf_counter()
     runner: Runner | None = None
     device_name: str | None = None
@@ -442,6 +448,13 @@ def mutation_report(plan: dict, *, oracles: Iterable[str] = ORACLES, kinds: Iter
 
 
 _device_name_cache: dict[str, str] = {}
+
+
+def probe_only(plan: dict) -> dict:
+    """``plan`` with every pass on the probe implementation (no ``impl``)."""
+    if not any(p.get("impl") for p in plan["passes"]):
+        return plan
+    return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
 
 
 def _same_family(plan: dict, device_index: int | None) -> bool:

@@ -1,0 +1,66 @@
+"""Separable screen-space subsurface scattering: ``sss_blur`` (raster, full-screen triangle).
+
+One implementation for both passes of surgery.yaml:
+
+- ``sss_blur_h``: reads ``diffuse``, ``depth``, ``normal_sss`` (sampled), writes ``sss_tmp``;
+- ``sss_blur_v``: reads ``sss_tmp``, ``depth``, ``normal_sss`` (sampled), writes ``diffuse``.
+
+The direction is the pass param ``sss.direction`` (``h`` or ``v``) when given, else it
+follows from the resources (reading ``sss_tmp`` means vertical). Params: ``sss.samples``
+(11, 17 or 25), ``sss.width`` (world units of the kernel's [-3, 3] at SSS strength 1),
+``sss.follow_depth`` (world depth difference that fully rejects a tap). The SSS strength is
+``normal_sss.a``; the camera projection comes from ``passes.screenspace_ref.screen_camera``.
+What it computes, exactly: ``passes/sss_ref.py``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rgraph.impl import PassImpl, register
+from rgraph.vk.passkit import Binding
+
+from .screenspace_ref import screen_camera
+from .sss_ref import SSSSettings, kernel
+
+
+def direction_of(setup) -> str:
+    """``h`` or ``v``: the ``sss.direction`` param, else from which colour resource is read."""
+    given = setup.params.get("sss.direction")
+    if given is not None:
+        if str(given) not in ("h", "v"):
+            raise ValueError(f"pass {setup.name!r}: sss.direction must be 'h' or 'v', not {given!r}")
+        return str(given)
+    return "v" if setup.has("sss_tmp") and setup.access("sss_tmp")["usage"] == "sampled" else "h"
+
+
+@register("sss_blur")
+class SSSBlur(PassImpl):
+    """One direction of the separable SSS blur, written to the pass's colour attachment."""
+
+    def __init__(self, setup):
+        super().__init__(setup)
+        s = SSSSettings.from_params(setup.params)
+        self.direction = direction_of(setup)
+        source = "sss_tmp" if self.direction == "v" else "diffuse"
+        target = next(a["resource"] for a in setup.plan_pass["accesses"] if a["usage"].startswith("color_attachment"))
+        width, height = setup.extent_of(target)
+        cam = screen_camera(setup.plan, setup.params, setup.size)
+        scale, size = (abs(cam.p00), width) if self.direction == "h" else (abs(cam.p11), height)
+        taps = kernel(s.samples, s.strength, s.falloff).astype(np.float32)
+        params = np.array([s.width, s.follow_depth, scale * size / 2.0 / 3.0, cam.near], np.float32)
+        data = np.concatenate([taps.reshape(-1), params]).tobytes()
+        self.uniform = setup.host_buffer(len(data))
+        self.uniform.write(data)
+        self.sets = setup.descriptors([
+            Binding(0, "sampled", source, sampler="linear"),
+            Binding(1, "sampled", "depth", sampler="nearest"),
+            Binding(2, "sampled", "normal_sss", sampler="nearest"),
+            Binding(3, "uniform_buffer", buffers=((self.uniform.handle, len(data)),))])
+        self.pipeline = setup.graphics_pipeline(
+            "lib/fullscreen.vert", "sss/blur.frag", [self.sets.layout],
+            defines={"SAMPLES": s.samples, "HORIZONTAL": int(self.direction == "h")})
+
+    def record(self, rec, frame_set):
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.draw(3)

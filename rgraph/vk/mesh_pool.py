@@ -42,13 +42,14 @@ ROW_BYTES = 16
 
 
 class AllocationLimitError(ExecutionError):
-    """More live VkDeviceMemory objects than the device's maxMemoryAllocationCount."""
+    """More live VkDeviceMemory objects than the device's maxMemoryAllocationCount (or a lower
+    limit given for a rehearsal)."""
 
-    def __init__(self, needed: int, limit: int, what: str = "") -> None:
+    def __init__(self, needed: int, limit: int, what: str = "", limit_name: str = "the device's maxMemoryAllocationCount") -> None:
         self.needed = needed
         self.limit = limit
-        super().__init__(f"{what}{needed} live device-memory allocations needed, but the device allows "
-                         f"maxMemoryAllocationCount = {limit}; use a block size > 0 (suballocation)")
+        super().__init__(f"{what}{needed} live device-memory allocations needed, but the limit is {limit} "
+                         f"({limit_name}); use a block size > 0 (suballocation)")
 
 
 class MemoryBackend(Protocol):
@@ -104,6 +105,7 @@ class SubAllocator:
         self.backend = backend
         self.max_allocations = max_allocations
         self.enforce_limit = enforce_limit
+        self.limit_name = "the device's maxMemoryAllocationCount"  # how the limit is named in errors
         self.blocks: dict[int, list[MemoryBlock]] = {}  # shared blocks per memory type, in creation order
         self.dedicated_blocks: dict[int, MemoryBlock] = {}  # id -> block (O(1) release)
         self.stats = AllocatorStats()
@@ -121,7 +123,7 @@ class SubAllocator:
             offset = None
             for block in self.blocks.get(type_index, ()):
                 assert block.tlsf is not None
-                offset = block.tlsf.allocate(size, alignment)
+                offset = _fit(block.tlsf, size, alignment)
                 if offset is not None:
                     break
             else:
@@ -164,7 +166,7 @@ class SubAllocator:
         """Raise ``AllocationLimitError`` if ``extra`` more memory objects would pass the limit."""
         if self.enforce_limit and self.max_allocations is not None \
                 and self.stats.allocations + extra > self.max_allocations:
-            raise AllocationLimitError(self.stats.allocations + extra, self.max_allocations, what)
+            raise AllocationLimitError(self.stats.allocations + extra, self.max_allocations, what, self.limit_name)
 
     # ---------------------------------------------------------------- internals
     def _new_memory(self, type_index: int, size: int, shared: bool) -> MemoryBlock:
@@ -197,6 +199,19 @@ class SubAllocator:
         self.stats.vk_free_s += time.perf_counter() - t0
         self.stats.allocations -= 1
         self.stats.allocated_bytes -= block.size
+
+
+def _fit(tlsf: Tlsf, size: int, alignment: int) -> int | None:
+    """TLSF good fit, then first fit over the free ranges: TLSF searches for size + alignment - 1
+    bytes, so it misses a free range that is already aligned and exactly large enough (the last
+    hole of a nearly full block)."""
+    offset = tlsf.allocate(size, alignment)
+    if offset is not None or alignment == 1:
+        return offset
+    for start, length in tlsf.free_by_start.items():
+        if align_up(start, alignment) + size <= start + length:
+            return tlsf._carve(start, size, alignment)  # noqa: SLF001 -- the same module family's allocator
+    return None
 
 
 def choose_memory_type(type_bits: int, type_flags: Sequence[int], required: int, avoid: int = 0) -> int:
@@ -288,6 +303,9 @@ class MeshPool:
         limit = self.device_limit if max_allocations is None else min(self.device_limit, int(max_allocations))
         self.backend = _VulkanBackend(device)
         self.allocator = SubAllocator(block_size, self.backend, limit, enforce_limit)
+        if limit < self.device_limit:
+            self.allocator.limit_name = (f"lowered for a rehearsal; the device's maxMemoryAllocationCount "
+                                         f"is {self.device_limit}")
         self.buffers: list[PoolBuffer] = []
         self.times = PoolTimes()
         self.used_bytes = 0

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-INSTALL_HINT = "pip install flip-evaluator (or rgraph[sweep])"
+INSTALL_HINT = "pip install flip-evaluator, or rgraph[sweep]"
 
 
 @cache

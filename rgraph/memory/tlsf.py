@@ -97,7 +97,8 @@ class Tlsf:
     def _grow_for(self, size: int, alignment: int) -> int:
         """Extend the range at its top so that a free range there can hold the request."""
         start = self.free_by_end.get(self.size, self.size)
-        needed_end = align_up(start, alignment) + size
+        # a top free range that already fits (missed by the bin search's rounding) must not shrink the heap
+        needed_end = max(align_up(start, alignment) + size, self.size)
         if start in self.free_by_start:
             self._remove_free(start)
         self._insert_free(start, needed_end - start)

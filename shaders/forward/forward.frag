@@ -1,0 +1,91 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Forward PBR: GGX direct lighting (directional with PCF shadows, point), split-sum IBL, AO.
+// Set 0: the scene (scene.glsl); set 1: this pass. Defines (passes/forward.py):
+// LOC_DIFFUSE/LOC_SPECULAR/LOC_NORMAL_SSS, LIGHT_COUNT, ENV_MIPS, HAS_AO, HAS_SHADOWS,
+// PCF_TAPS, IBL_INTENSITY, AO_COMBINE.
+#include "scene/scene.glsl"
+#include "forward/brdf.glsl"
+#include "ibl/environment.glsl"
+#if HAS_SHADOWS
+#include "scene/shadow.glsl"
+#endif
+
+layout(location = 0) in vec3 in_world;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) flat in uint in_material;
+
+layout(location = LOC_DIFFUSE) out vec4 out_diffuse;
+layout(location = LOC_SPECULAR) out vec4 out_specular;
+layout(location = LOC_NORMAL_SSS) out vec4 out_normal_sss;
+
+layout(set = 1, binding = 0, std140) uniform LightsBlock { Light lights[LIGHT_COUNT]; };
+layout(set = 1, binding = 1) uniform sampler2D brdf_lut;
+layout(set = 1, binding = 2) uniform sampler2D env_map;
+#if HAS_AO
+layout(set = 1, binding = 3) uniform sampler2D ao_map;
+#endif
+#if HAS_SHADOWS
+layout(set = 1, binding = 4) uniform sampler2DArray shadow_maps;
+#endif
+
+// Point-light falloff: inverse square, windowed to reach 0 at the radius (Karis 2013);
+// inv_r2 = 1 / radius^2 (Light.view.w); distance^2 floored at 1 mm^2.
+float point_falloff(float dist2, float inv_r2) {
+    float x = dist2 * inv_r2;
+    float window = clamp(1.0 - x * x, 0.0, 1.0);
+    return window * window / max(dist2, 1e-6);
+}
+
+void main() {
+    vec3 to_view = -in_world;  // the camera is at the origin
+    // Geometric normal from screen derivatives (the fallback for a zero shading normal), facing the viewer.
+    vec3 geo = cross(dFdx(in_world), dFdy(in_world));
+    geo = dot(geo, to_view) < 0.0 ? -geo : geo;
+    vec3 n_in = gl_FrontFacing ? in_normal : -in_normal;  // two-sided when the prepass culls nothing
+    Material m = materials[in_material];
+    Surface s = make_surface(n_in, to_view, geo, m.base_color.rgb, m.surface.x, m.surface.y);
+
+    vec3 diffuse = vec3(0.0);
+    vec3 specular = vec3(0.0);
+    int count = min(frame.counts.x, LIGHT_COUNT);
+    for (int i = 0; i < count; ++i) {
+        Light light = lights[i];
+        int type = int(light.to_light.w + 0.5);
+        vec3 l;
+        vec3 radiance = light.radiance.rgb;
+        if (type == LIGHT_DIRECTIONAL) {
+            l = safe_normalize(light.to_light.xyz, s.n);
+#if HAS_SHADOWS
+            int layer = int(floor(light.radiance.w + 0.5));
+            if (layer >= 0 && layer < frame.counts.y) {
+                radiance *= shadow_pcf(shadow_maps, in_world, layer, PCF_TAPS);
+            }
+#endif
+        } else {
+            vec3 d = light.position.xyz - in_world;
+            float dist2 = dot(d, d);
+            l = safe_normalize(d, s.n);
+            radiance *= point_falloff(dist2, light.view.w);
+        }
+        eval_light(s, l, radiance, diffuse, specular);
+    }
+
+#if HAS_AO
+    float screen_ao = texture(ao_map, gl_FragCoord.xy * frame.viewport.zw).r;
+#else
+    float screen_ao = 1.0;
+#endif
+    float ao = combine_ao(screen_ao, m.optics.z);
+    vec3 r = reflect(-s.v, s.n);
+    float top = float(ENV_MIPS - 1);
+    vec3 prefiltered = textureLod(env_map, equirect_uv(r), s.roughness * top).rgb * IBL_INTENSITY;
+    vec3 irradiance = textureLod(env_map, equirect_uv(s.n), top).rgb * IBL_INTENSITY + frame.ambient.rgb;
+    vec2 lut = texture(brdf_lut, vec2(s.nov, s.roughness)).rg;
+    eval_ibl(s, lut, prefiltered, irradiance, ao, diffuse, specular);
+    specular += m.emissive.rgb;  // emission is not blurred by the SSS passes
+
+    out_diffuse = vec4(hdr_clamp(diffuse), 1.0);
+    out_specular = vec4(hdr_clamp(specular), 1.0);
+    out_normal_sss = vec4(encode_normal(s.n), clamp(m.surface.z, 0.0, 1.0));
+}

@@ -1,0 +1,17 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Forward PBR vertex stage: the shared invariant scene transform (bit-identical to the depth
+// prepass, so the GREATER_OR_EQUAL depth_read test passes on exactly the visible surfaces).
+#include "scene/scene_vertex.glsl"
+
+layout(location = 0) out vec3 out_world;         // camera-relative world position
+layout(location = 1) out vec3 out_normal;        // world normal, not renormalised
+layout(location = 2) flat out uint out_material;
+
+void main() {
+    uint d = uint(gl_InstanceIndex);
+    out_world = scene_world_position(in_position, d).xyz;
+    out_normal = mat3(draws[d].normal_matrix) * in_normal;
+    out_material = draws[d].info.x;
+    gl_Position = scene_clip_position(in_position, d);
+}

@@ -23,7 +23,7 @@ class Deformer:
     rest: MeshData
     breath_amplitude: float = 0.04  # relative radial change
     breath_period: float = 4.0  # seconds
-    press_depth: float = 0.35  # fraction of the mesh radius at the deepest press... scaled below
+    press_depth: float = 0.35  # deepest press = 0.1 * press_depth * the mesh radius
     press_period: float = 1.7
     press_width: float = 0.25  # fraction of the mesh radius
     _radius: float = field(init=False, default=1.0)
@@ -34,7 +34,9 @@ class Deformer:
         radial = np.hypot(p[:, 0], p[:, 2])
         self._radius = float(radial.max()) if len(p) else 1.0
         lo, hi = self.rest.bounds() if len(p) else (np.zeros(3), np.zeros(3))
-        self._centre = np.array([0.0, lo[1] + 0.35 * (hi[1] - lo[1]), self._radius])
+        target = np.array([0.0, lo[1] + 0.35 * (hi[1] - lo[1]), self._radius])
+        # the press centre: the surface vertex nearest the front point below the middle
+        self._centre = p[int(np.argmin(((p - target) ** 2).sum(axis=1)))].copy() if len(p) else target
 
     @property
     def max_displacement(self) -> float:

@@ -64,11 +64,10 @@ def test_equirect_round_trip_and_onb_at_poles():
 
 def test_lut_truth_agrees_with_independent_quadrature():
     truth_samples = 16384
-    for nov in (0.1, 0.5, 0.9):
-        for rough in (0.25, 0.5, 1.0):
-            mc = ibl_ref.brdf_lut_single(nov, rough, truth_samples)
-            quad = ibl_ref.brdf_lut_quadrature(nov, rough)
-            assert np.abs(mc - quad).max() <= 2e-3, (nov, rough, mc, quad)
+    for nov, rough in ((0.1, 0.25), (0.5, 0.5), (0.9, 1.0), (0.3, 0.7)):
+        mc = ibl_ref.brdf_lut_single(nov, rough, truth_samples)
+        quad = ibl_ref.brdf_lut_quadrature(nov, rough)
+        assert np.abs(mc - quad).max() <= 2e-3, (nov, rough, mc, quad)
 
 
 def test_lut_smooth_limit():

@@ -17,7 +17,7 @@ from rgraph.vk.passkit import Binding, pack
 SCENE_FRONT_FACE = "COUNTER_CLOCKWISE"
 #: Shadow depth bias (constant, slope) for reversed depth: negative pushes stored depth away
 #: from the light.
-SHADOW_BIAS = (-2.0, -2.5)
+SHADOW_BIAS = (-2.0, -1.5)
 
 
 @register("depth_prepass")

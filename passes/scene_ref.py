@@ -107,7 +107,8 @@ def light_setup_reference(scene: SceneData, frame: int) -> np.ndarray:
         else:
             rel = li.position - cam.position
             out[k, 0:4] = (*rel, li.radius)
-            out[k, 4:8] = (0, 0, 0, li.type)
+            axis = -li.direction if li.type == LIGHT_TYPES["spot"] else np.zeros(3)
+            out[k, 4:8] = (*axis, li.type)
             out[k, 12:16] = (*(rot @ rel), 1.0 / max(li.radius, 1e-6) ** 2)
         out[k, 8:12] = (*li.radiance, li.shadow_layer)
     return out

@@ -85,7 +85,7 @@ def test_depth_shadow_and_lights_match_references():
         assert ((got > 0) != (sref > 0)).sum() <= 0.02 * (sref > 0).sum()
         m = same_owner(sowner) & (got > 0)
         assert np.abs(got - sref)[m].max() <= 1e-5
-    lights = unpack_lights(result.outputs["lights"].tobytes(), 3)
+    lights = unpack_lights(result.outputs["lights"].tobytes(), 4)
     want = scene_ref.light_setup_reference(scene, 2)
     tol = 1e-6 * (1 + np.linalg.norm(want[:, :3], axis=1, keepdims=True))
     assert np.all(np.abs(lights - want) <= tol)
@@ -151,8 +151,8 @@ def test_large_world_renders_like_the_origin(tmp_path, offset):
     a, b = near.outputs["depth"][..., 0], far.outputs["depth"][..., 0]
     m = same_owner(owner) & (a > 0) & (b > 0)
     assert (np.abs(a - b)[m] / a[m]).max() < 1e-5
-    la = unpack_lights(near.outputs["lights"].tobytes(), 3)
-    lb = unpack_lights(far.outputs["lights"].tobytes(), 3)
+    la = unpack_lights(near.outputs["lights"].tobytes(), 4)
+    lb = unpack_lights(far.outputs["lights"].tobytes(), 4)
     np.testing.assert_allclose(lb, la, atol=2e-6)  # hi/lo light positions survive the offset
 
 

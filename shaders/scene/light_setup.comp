@@ -32,7 +32,7 @@ void main() {
         vec3 rel = (s.position_hi.xyz - frame.camera_hi.xyz) + (s.position_lo.xyz - frame.camera_lo.xyz);
         float r = max(s.position_lo.w, 1e-6);
         o.position = vec4(rel, s.position_lo.w);
-        o.to_light = vec4(0.0, 0.0, 0.0, float(type));
+        o.to_light = vec4(type == LIGHT_SPOT ? -dir : vec3(0.0), float(type));  // spot: minus its axis
         o.view = vec4(mat3(frame.view) * rel, 1.0 / (r * r));
     }
     o.radiance = vec4(s.radiance.rgb, s.direction.w);

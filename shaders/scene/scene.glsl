@@ -89,7 +89,8 @@ layout(set = 0, binding = 4, std430) readonly buffer Decals { Decal decals[]; };
 // with LIGHT_COUNT = max(scene.lights, 1) (the buffer holds exactly that many).
 struct Light {
     vec4 position;        //   0  xyz: camera-relative world position (0 for directional); w: radius
-    vec4 to_light;        //  16  xyz: unit vector towards the light (directional only, else 0); w: type
+    vec4 to_light;        //  16  xyz: unit vector towards the light (directional), minus the spot axis
+                          //      (spot), 0 (point); w: type (LIGHT_*)
     vec4 radiance;        //  32  rgb: color * intensity; w: shadow layer or -1
     vec4 view;            //  48  xyz: view-space position (point/spot) or view-space to_light (directional);
                           //      w: 1 / radius^2 (point/spot), 0 (directional)

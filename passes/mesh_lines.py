@@ -10,14 +10,14 @@ larger), ``alloc.segments``, ``alloc.deformable_fraction`` (spread evenly over t
 Memory (``rgraph.vk.mesh_pool.MeshPool``, block size ``alloc.block_mib`` MiB, 0 = one
 VkDeviceMemory per buffer): rigid meshes get one device-local buffer filled once through a
 staging buffer; deformable ones one host-visible coherent buffer per frame-in-flight set of
-capacity size x ``alloc.load_factor``, rewritten by the CPU in ``update`` (a sine wobble of
-every deformable mesh). Recording: one ``vkCmdBindVertexBuffers`` and one ``vkCmdDraw`` per
+capacity size x ``alloc.load_factor``, rewritten by the CPU in ``update`` (a sine wobble in x
+of every deformable mesh: one float per vertex per frame, see ``_Wobble``). Recording: one ``vkCmdBindVertexBuffers`` and one ``vkCmdDraw`` per
 mesh, in mesh order (per frame-in-flight set, recorded once).
 
 Figures (``MeshLines.last_report``, and the JSON file ``alloc.report`` when set): pool
 statistics, ``load_ms`` (wall clock from pool creation through allocation, binding, uploads
-and the first fill of dynamic buffers), ``geometry_ms`` (NumPy, not part of load_ms),
-``record_ms``, per-frame ``update_ms``.
+and the first fill of dynamic buffers), ``geometry_ms`` and ``wobble_setup_ms`` (NumPy, not
+part of load_ms), ``record_ms`` (both sets), per-frame ``update_ms`` (median).
 """
 
 from __future__ import annotations
@@ -163,7 +163,13 @@ def view_projection(camera: Any | None, aspect: float) -> np.ndarray:
 
 # ===================================================================== the pass
 class _Wobble:
-    """Per-frame CPU deformation of the deformable meshes, written through the pool's mappings."""
+    """Per-frame CPU deformation of the deformable meshes, written through the pool's mappings.
+
+    Only x moves, so a frame writes one float per vertex. Writes go through strided NumPy views
+    of the mapped memory, one per *run*: meshes consecutive in mesh order, of one vertex count,
+    in one memory object at a constant row stride (what a block holds when buffers of one
+    capacity are placed one after the other). A dedicated allocation is a run of one mesh.
+    """
 
     def __init__(self, base: list[np.ndarray], layout: MeshLayout, meshes: np.ndarray) -> None:
         self.counts = np.array([len(b) for b in base], dtype=np.int64)
@@ -172,36 +178,43 @@ class _Wobble:
         along = np.concatenate([np.linspace(0, 1, c) for c in self.counts]) if base else np.zeros(0)
         self.phase = (along * 3 * math.pi + np.repeat(layout.phase[meshes], self.counts)).astype(np.float32)
         self.amplitude = np.repeat(layout.radius[meshes] * WOBBLE_AMPLITUDE, self.counts).astype(np.float32)
-        self.groups: dict[int, list[tuple[np.ndarray, Any, Any]]] = {}  # frame_set -> writes
+        self.runs: dict[int, list[tuple[np.ndarray, np.ndarray, slice]]] = {}  # set -> (full view, x view, src)
 
-    def bind(self, frame_set: int, pool: MeshPool, buffers: list[PoolBuffer]) -> None:
-        """Group this set's copies by memory object: one scatter per block, a slice per dedicated."""
-        by_block: dict[int, tuple[Any, list[int]]] = {}
-        for k, buf in enumerate(buffers):
-            by_block.setdefault(id(buf.allocation.block), (buf, []))[1].append(k)
-        writes = []
-        for buf, ks in by_block.values():
-            rows = pool.rows(buf)
-            if len(ks) == 1:
-                k = ks[0]
-                first = buffers[k].first_row
-                writes.append((rows, slice(first, first + self.counts[k]),
-                               slice(self.starts[k], self.starts[k] + self.counts[k])))
-            else:
-                dst = np.concatenate([buffers[k].first_row + np.arange(self.counts[k]) for k in ks])
-                src = np.concatenate([self.starts[k] + np.arange(self.counts[k]) for k in ks])
-                writes.append((rows, dst, src))
-        self.groups[frame_set] = writes
+    def bind(self, frame_set: int, pool: Any, buffers: list[PoolBuffer]) -> None:
+        """Cut this set's buffers (in mesh order) into runs and make their views."""
+        runs = []
+        k = 0
+        while k < len(buffers):
+            block, first, count = buffers[k].allocation.block, buffers[k].first_row, int(self.counts[k])
+            stride, end = count, k + 1
+            if end < len(buffers) and buffers[end].allocation.block is block \
+                    and buffers[end].first_row - first >= count:
+                stride = buffers[end].first_row - first
+                while (end < len(buffers) and buffers[end].allocation.block is block
+                       and int(self.counts[end]) == count
+                       and buffers[end].first_row == first + (end - k) * stride):
+                    end += 1
+            rows = pool.rows(buffers[k])
+            n = end - k
+            full = np.lib.stride_tricks.as_strided(rows[first:], shape=(n, count, 4),
+                                                   strides=(stride * rows.strides[0], *rows.strides))
+            runs.append((full, full[..., 0], slice(int(self.starts[k]), int(self.starts[k]) + n * count)))
+            k = end
+        self.runs[frame_set] = runs
 
-    def vertices(self, frame: int) -> np.ndarray:
-        out = self.base.copy()
-        out[:, 0] += self.amplitude * np.sin(self.phase + np.float32(frame * 0.15))
-        return out
+    def x(self, frame: int) -> np.ndarray:
+        """The x coordinate of every deformable vertex at ``frame`` (float32, mesh order)."""
+        return self.base[:, 0] + self.amplitude * np.sin(self.phase + np.float32(frame * 0.15))
+
+    def fill(self, frame_set: int) -> None:
+        """Write whole vertices (the first fill)."""
+        for full, _x, src in self.runs[frame_set]:
+            full[...] = self.base[src].reshape(full.shape)
 
     def write(self, frame: int, frame_set: int) -> None:
-        new = self.vertices(frame)
-        for rows, dst, src in self.groups[frame_set]:
-            rows[dst] = new[src]
+        x = self.x(frame)
+        for _full, xs, src in self.runs[frame_set]:
+            xs[...] = x[src].reshape(xs.shape)
 
 
 @register("mesh_lines")
@@ -289,11 +302,17 @@ class MeshLines(PassImpl):
                                for _ in range(self.sets)]
         pool.upload(list(zip(self.rigid_buffers, rigid_vertices, strict=True)),
                     setup.device.queues["graphics"], setup.device.families["graphics"])
+        loaded = time.perf_counter() - t0
+        t1 = time.perf_counter()  # NumPy index tables of the per-frame writes: not load time
         self.wobble = _Wobble(deform_vertices, self.layout, self.deformable)
         for s in range(self.sets):
             self.wobble.bind(s, pool, self.deform_buffers[s])
+        t2 = time.perf_counter()
+        for s in range(self.sets):  # the first fill of the dynamic buffers
+            self.wobble.fill(s)
             self.wobble.write(0, s)
-        self.report["load_ms"] = (time.perf_counter() - t0) * 1e3
+        self.report["load_ms"] = (loaded + time.perf_counter() - t2) * 1e3
+        self.report["wobble_setup_ms"] = (t2 - t1) * 1e3
         self.report.update(pool.stats())
         # draw order: mesh order; per set the VkBuffer of each mesh
         rigid_at = {int(m): k for k, m in enumerate(self.rigid)}

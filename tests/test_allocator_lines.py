@@ -88,6 +88,44 @@ def test_view_projection_centres_the_target_with_reversed_depth():
     assert above[1] / above[3] < 0  # Vulkan clip space: up is -y
 
 
+def test_wobble_writes_every_mesh_through_strided_runs_and_nothing_else():
+    """The per-frame writer against plain per-mesh slices, over runs, gaps, odd strides and blocks."""
+    from rgraph.vk.mesh_pool import Allocation, MemoryBlock, PoolBuffer
+
+    m = module()
+    layout = m.build_layout(None, meshes=9, segments=3, deformable_fraction=1.0)
+    layout.segments[6:] = 5  # a different vertex count breaks a run
+    meshes = np.arange(9)
+    base = m.helix_vertices(layout, meshes)
+    blocks = [MemoryBlock(handle=i, size=4096, type_index=0, tlsf=None) for i in range(3)]
+    mapped = {id(b): np.full((256, 4), -7.0, np.float32) for b in blocks}
+    #         block, first row: a run of 3 at stride 9, a gap, a run of 2 at stride 6, a lone mesh, another block
+    where = [(0, 0), (0, 9), (0, 18), (0, 40), (0, 46), (1, 3), (1, 20), (2, 0), (2, 10)]
+    buffers = [PoolBuffer(handle=k, allocation=Allocation(blocks[b], row * 16, 160), capacity=160, used=0,
+                          dynamic=True) for k, (b, row) in enumerate(where)]
+
+    class Pool:
+        def rows(self, buf):
+            return mapped[id(buf.allocation.block)]
+
+    wobble = m._Wobble(base, layout, meshes)
+    wobble.bind(0, Pool(), buffers)
+    assert len(wobble.runs[0]) < 9  # some meshes share a strided run
+    wobble.fill(0)
+    wobble.write(5, 0)
+    x = wobble.x(5)
+    written = {id(b): np.zeros(256, bool) for b in blocks}
+    for k, (b, row) in enumerate(where):
+        want = base[k].copy()
+        want[:, 0] = x[wobble.starts[k]:wobble.starts[k] + len(want)]
+        got = mapped[id(blocks[b])][row:row + len(want)]
+        np.testing.assert_array_equal(got, want)
+        written[id(blocks[b])][row:row + len(want)] = True
+    for b in blocks:
+        assert np.all(mapped[id(b)][~written[id(b)]] == -7.0)  # gaps between buffers untouched
+    assert not np.allclose(wobble.x(5), wobble.x(6))
+
+
 def reference_mask(layout, vertices, size, vp, dilate):
     """Pixels within ``dilate`` of any point sampled along the lines (projected by NumPy)."""
     w, h = size

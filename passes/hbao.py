@@ -1,4 +1,9 @@
-"""HBAO on the async compute queue: quarter-res depth, horizon-based AO, bilateral upsample.
+"""HBAO on the async compute queue: reduced-res depth, horizon-based AO, bilateral upsample.
+
+The working resolution is ``hbao.scale`` (default 0.25; ``1 / k`` for an integer ``k``, 1 =
+full resolution, where the downsample is a copy and the upsample the identity). The graph
+must size ``depth_quarter`` and ``ao_quarter`` with ``{scale: "${params.hbao.scale}"}``;
+a size that disagrees with the param is an error at setup.
 
 Three implementations (``impl:`` names), each reading the resources surgery.yaml declares:
 
@@ -8,7 +13,7 @@ Three implementations (``impl:`` names), each reading the resources surgery.yaml
   (storage_read) -> ``ao`` (storage_write).
 
 Params: ``hbao.directions``, ``hbao.steps`` (compile-time loop counts), ``hbao.radius``
-(world units), ``hbao.angle_bias``, ``hbao.strength``, ``hbao.max_radius_px``,
+(world units), ``hbao.angle_bias``, ``hbao.strength``, ``hbao.max_radius_px`` (full-res px),
 ``hbao.upsample_sharpness``; the camera from ``passes.screenspace_ref.screen_camera``.
 What each computes, exactly: ``passes/hbao_ref.py``.
 """
@@ -18,12 +23,28 @@ from __future__ import annotations
 from rgraph.impl import PassImpl, register
 from rgraph.vk.passkit import Binding, pack
 
-from .hbao_ref import HBAOSettings
+from .hbao_ref import HBAOSettings, quarter_extent
 from .screenspace_ref import screen_camera
 
 
 def _groups(extent: tuple[int, int]) -> tuple[int, int]:
     return -(-extent[0] // 8), -(-extent[1] // 8)
+
+
+def _settings(setup) -> HBAOSettings:
+    """The pass's settings; checks that the working images have the size ``hbao.scale`` gives."""
+    try:
+        s = HBAOSettings.from_params(setup.params)
+        s.factor  # noqa: B018 - validates hbao.scale
+    except ValueError as exc:
+        raise ValueError(f"pass {setup.name!r}: {exc}") from None
+    full = setup.extent_of("depth") if setup.has("depth") else setup.size
+    want = quarter_extent(*full, s.scale)
+    for name in ("depth_quarter", "ao_quarter"):
+        if setup.has(name) and tuple(setup.extent_of(name)) != want:
+            raise ValueError(f"pass {setup.name!r}: {name} is {setup.extent_of(name)} but hbao.scale={s.scale:g} "
+                             f"gives {want}; size it {{scale: \"${{params.hbao.scale}}\"}}")
+    return s
 
 
 def _proj(setup) -> bytes:
@@ -33,34 +54,37 @@ def _proj(setup) -> bytes:
 
 @register("hbao_downsample")
 class HBAODownsample(PassImpl):
-    """Nearest-surface (max reversed-Z) depth of each 4x4 block."""
+    """Nearest-surface (max reversed-Z) depth of each k x k block (a copy at k = 1)."""
 
     def __init__(self, setup):
         super().__init__(setup)
+        self.push = pack("i", _settings(setup).factor)
         self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest"),
                                        Binding(1, "storage_image", "depth_quarter")])
-        self.pipeline = setup.compute_pipeline("hbao/downsample.comp", [self.sets.layout])
+        self.pipeline = setup.compute_pipeline("hbao/downsample.comp", [self.sets.layout],
+                                               push_constant_bytes=len(self.push))
         self.groups = _groups(setup.extent_of("depth_quarter"))
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
         rec.dispatch(*self.groups)
 
 
 @register("hbao")
 class HBAO(PassImpl):
-    """Horizon-based AO at quarter resolution."""
+    """Horizon-based AO at the working resolution."""
 
     def __init__(self, setup):
         super().__init__(setup)
-        s = HBAOSettings.from_params(setup.params)
+        s = _settings(setup)
         if s.directions < 1 or s.steps < 1:
             raise ValueError(f"pass {setup.name!r}: hbao.directions and hbao.steps must be >= 1")
         self.sets = setup.descriptors([Binding(0, "sampled", "depth_quarter", sampler="nearest"),
                                        Binding(1, "storage_image", "ao_quarter")])
         self.pipeline = setup.compute_pipeline("hbao/hbao.comp", [self.sets.layout], push_constant_bytes=32,
                                                defines={"DIRECTIONS": s.directions, "STEPS": s.steps})
-        self.push = _proj(setup) + pack("4f", s.radius, s.angle_bias, s.strength, s.max_radius_px)
+        self.push = _proj(setup) + pack("4f", s.radius, s.angle_bias, s.strength, s.max_radius_px * s.scale)
         self.groups = _groups(setup.extent_of("ao_quarter"))
 
     def record(self, rec, frame_set):
@@ -71,11 +95,11 @@ class HBAO(PassImpl):
 
 @register("hbao_upsample")
 class HBAOUpsample(PassImpl):
-    """Depth-aware (joint bilateral) upsample of the quarter AO to full resolution."""
+    """Depth-aware (joint bilateral) upsample of the working-res AO to full resolution."""
 
     def __init__(self, setup):
         super().__init__(setup)
-        s = HBAOSettings.from_params(setup.params)
+        s = _settings(setup)
         self.sets = setup.descriptors([Binding(0, "sampled", "ao_quarter", sampler="nearest"),
                                        Binding(1, "sampled", "depth", sampler="nearest"),
                                        Binding(2, "storage_image", "depth_quarter"),

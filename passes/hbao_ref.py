@@ -1,6 +1,10 @@
 """NumPy float64 references of the three HBAO passes (``passes/hbao.py``); no Vulkan.
 
-1. ``downsample``: each quarter texel takes the NEAREST surface of its 4x4 block, i.e. the
+The AO working resolution is ``hbao.scale`` (0.25 by default: quarter resolution; any
+``1 / k`` with an integer reduction factor ``k``, 1 included: full resolution). "Quarter"
+below means "working resolution"; ``k x k`` blocks are 4x4 at the default.
+
+1. ``downsample``: each quarter texel takes the NEAREST surface of its k x k block, i.e. the
    smallest view distance, which with reversed-Z is the LARGEST stored depth value. This is
    the conservative choice for AO: no occluder disappears at quarter resolution (a 1-3 px
    instrument shaft still occludes what is behind it) and sky (depth 0) only survives
@@ -10,20 +14,27 @@
 2. ``hbao``: horizon-based AO (Bavoil and Sainz 2008) on the quarter depth: per pixel,
    ``directions`` screen directions (rotated per pixel by a 4x4 Bayer pattern), ``steps``
    texel-snapped samples each within ``radius`` (world units, projected to quarter pixels,
-   at most ``max_radius_px``); along each direction the horizon angle, measured from the
+   at most ``max_radius_px`` FULL-resolution pixels, i.e. ``max_radius_px * scale`` quarter
+   pixels, so every scale approximates the same screen-space footprint); along each direction the horizon angle, measured from the
    tangent plane (``sin h = N.V / |V|``), starts at ``angle_bias`` and every sample that
    raises it adds ``W(r) (sin h_new - sin h_old)`` with ``W(r) = 1 - r^2 / R^2``
    (horizon integration of the paper; measuring elevation from the tangent plane rather
    than the eye-space xy plane keeps texel snapping from self-occluding flat surfaces).
    AO = 1 - strength * mean over directions, clamped to [0, 1]. Sky pixels are 1 (no
-   occlusion); sky samples never occlude. ``N = normalize(dP/dy x dP/dx)`` (facing the
-   camera) from the quarter depth: per axis, the neighbour difference with the smaller
+   occlusion); sky samples never occlude. ``N = normalize(dP/dy x dP/dx)``, flipped when
+   ``N.P > 0`` (P the view position) so that it faces the camera, also on walls seen
+   edge-on, from the quarter depth: per axis, the neighbour difference with the smaller
    |dz|, ignoring sky and out-of-image neighbours.
 3. ``upsample``: joint bilateral upsample: the 2x2 nearest quarter texels (the bilinear
    footprint, clamped to the image) weighted by bilinear weight times
    ``exp(-sharpness * (rel_i - min rel))`` with ``rel = |z_full - z_quarter| / z_full``
    (view distances), so the best-matching texel keeps its bilinear weight and texels across
    a depth edge vanish; sky quarter texels get weight 0; full-res sky pixels are 1.
+   At k = 1 the footprint is the pixel itself with bilinear weight 1 (the others 0) and
+   the same depth, so the upsample is the identity; the downsample is a copy.
+
+The reference setting of ``rgraph sweep`` (the truth the knobs approximate):
+``hbao.scale=1 hbao.directions=32 hbao.steps=32``.
 """
 
 from __future__ import annotations
@@ -45,8 +56,9 @@ class HBAOSettings:
     radius: float = 0.02          # world units (metres)
     angle_bias: float = 0.3       # radians added to the tangent elevation
     strength: float = 1.0
-    max_radius_px: float = 32.0   # quarter-resolution pixels
+    max_radius_px: float = 128.0  # full-resolution pixels (32 quarter pixels at scale 0.25)
     upsample_sharpness: float = 32.0
+    scale: float = 0.25           # working resolution: 1 / factor, factor a positive integer
 
     @classmethod
     def from_params(cls, params: dict) -> HBAOSettings:
@@ -57,24 +69,42 @@ class HBAOSettings:
                    angle_bias=float(params.get("hbao.angle_bias", d.angle_bias)),
                    strength=float(params.get("hbao.strength", d.strength)),
                    max_radius_px=float(params.get("hbao.max_radius_px", d.max_radius_px)),
-                   upsample_sharpness=float(params.get("hbao.upsample_sharpness", d.upsample_sharpness)))
+                   upsample_sharpness=float(params.get("hbao.upsample_sharpness", d.upsample_sharpness)),
+                   scale=float(params.get("hbao.scale", d.scale)))
+
+    @property
+    def factor(self) -> int:
+        """The integer reduction factor ``k = 1 / scale``."""
+        return reduction_factor(self.scale)
 
 
-def quarter_extent(width: int, height: int) -> tuple[int, int]:
-    """The quarter size the graph's ``{scale: 0.25}`` gives (floor, at least 1)."""
-    return max(1, width // 4), max(1, height // 4)
+def reduction_factor(scale: float) -> int:
+    """``1 / scale`` as a positive integer; ValueError when it is not one."""
+    if not 0 < scale <= 1:
+        raise ValueError(f"hbao.scale must be in (0, 1], got {scale}")
+    k = round(1.0 / scale)
+    if abs(1.0 / scale - k) > 1e-6 * k:
+        raise ValueError(f"hbao.scale must be 1 / k for an integer k (1, 0.5, 0.25, ...), got {scale}")
+    return k
 
 
-def downsample(depth: np.ndarray, qsize: tuple[int, int]) -> np.ndarray:
-    """(qh, qw) nearest-surface (max reversed-Z) depth of each 4x4 block (clamped to the image)."""
+def quarter_extent(width: int, height: int, scale: float = 0.25) -> tuple[int, int]:
+    """The working size the graph's ``{scale: s}`` gives (floor, at least 1)."""
+    return max(1, int(width * scale)), max(1, int(height * scale))
+
+
+def downsample(depth: np.ndarray, qsize: tuple[int, int], factor: int = 4) -> np.ndarray:
+    """(qh, qw) nearest-surface (max reversed-Z) depth of each ``factor`` x ``factor`` block
+    (clamped to the image); a copy at factor 1."""
     h, w = depth.shape[:2]
     d = np.asarray(depth, np.float64).reshape(h, w)
     qw, qh = qsize
+    k = factor
     out = np.zeros((qh, qw))
     for j in range(qh):
         for i in range(qw):
-            y0, x0 = min(4 * j, h - 1), min(4 * i, w - 1)
-            out[j, i] = d[y0:min(4 * j + 4, h), x0:min(4 * i + 4, w)].max()
+            y0, x0 = min(k * j, h - 1), min(k * i, w - 1)
+            out[j, i] = d[y0:min(k * j + k, h), x0:min(k * i + k, w)].max()
     return out
 
 
@@ -117,8 +147,8 @@ def hbao(dq: np.ndarray, cam: Camera, s: HBAOSettings) -> np.ndarray:
             n = np.cross(ddy, ddx)
             length = float(np.linalg.norm(n))
             n = np.array([0.0, 0.0, 1.0]) if length < 1e-30 else n / length
-            n = -n if n[2] < 0 else n
-            radius_px = min(s.radius * px_per_ndc / -p[2], s.max_radius_px)
+            n = -n if float(n @ p) > 0 else n  # face the camera (V = -p), also for walls seen edge-on
+            radius_px = min(s.radius * px_per_ndc / -p[2], s.max_radius_px * s.scale)
             step = max(radius_px / (s.steps + 1), 1.0)
             rot, jitter = BAYER4[j % 4, i % 4], BAYER4[(j + 2) % 4, (i + 1) % 4]
             total = 0.0
@@ -198,6 +228,6 @@ def bilinear_upsample(ao_q: np.ndarray, size: tuple[int, int]) -> np.ndarray:
 def reference(depth: np.ndarray, cam: Camera, s: HBAOSettings) -> dict[str, np.ndarray]:
     """All three stages: ``depth_quarter``, ``ao_quarter`` and ``ao`` from full-res ``depth``."""
     h, w = np.shape(depth)[:2]
-    dq = downsample(depth, quarter_extent(w, h))
+    dq = downsample(depth, quarter_extent(w, h, s.scale), s.factor)
     ao_q = hbao(dq, cam, s)
     return {"depth_quarter": dq, "ao_quarter": ao_q, "ao": upsample(ao_q, dq, depth, cam, s.upsample_sharpness)}

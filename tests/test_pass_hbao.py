@@ -145,3 +145,56 @@ def test_upsample_edge_stays_sharp_on_gpu():
     assert np.abs(out[:, :16] - 64 / 255).max() <= 1 / 255 and np.all(out[:, 16:] == 1.0)
     lin = ref.bilinear_upsample(ao_q, (w, h))
     assert np.abs(out - lin)[:, 14:18].min() > 0.05  # where a plain bilinear upsample would blur
+
+
+# ----------------------------------------------------------------------------- hbao.scale
+
+
+def test_reduction_factor_accepts_only_integer_reciprocals():
+    assert [ref.reduction_factor(s) for s in (1, 0.5, 0.25, 1 / 3)] == [1, 2, 4, 3]
+    for bad in (0.3, 0.0, 1.5, -0.25):
+        with pytest.raises(ValueError, match="hbao.scale"):
+            ref.reduction_factor(bad)
+
+
+def test_downsample_at_factor_1_is_a_copy_and_upsample_the_identity():
+    w, h = 24, 16
+    cam = camera(w, h)
+    d = corner_scene(w, h)
+    out = ref.reference(d, cam, ref.HBAOSettings(scale=1.0, radius=0.6, directions=4, steps=3))
+    np.testing.assert_array_equal(out["depth_quarter"], d)
+    np.testing.assert_allclose(out["ao"], out["ao_quarter"], atol=1e-12)
+
+
+@pytest.mark.vulkan
+@pytest.mark.parametrize("size,scale", [((40, 30), 1.0), ((66, 46), 0.5)])
+def test_hbao_chain_at_factor_1_and_2_matches_reference(size, scale):
+    """Full resolution (the sweep's reference) and half resolution through the same three passes."""
+    w, h = size
+    cam = camera(w, h)
+    d = corner_scene(w, h)
+    settings = ref.HBAOSettings(directions=6, steps=5, radius=0.6, strength=1.5, scale=scale)
+    out = run("hbao.yaml", size, {"depth": d}, {"hbao.directions": 6, "hbao.steps": 5, "hbao.radius": 0.6,
+                                               "hbao.strength": 1.5, "hbao.scale": scale})
+    dq = out["depth_quarter"]
+    assert dq.shape == (int(h * scale), int(w * scale))
+    np.testing.assert_array_equal(dq, ref.downsample(d, (dq.shape[1], dq.shape[0]), settings.factor))
+    want_q = ref.hbao(dq, cam, settings)
+    assert np.abs(out["ao_quarter"] - want_q).max() <= AO_TOL
+    assert want_q.min() < 0.8
+    want = ref.upsample(out["ao_quarter"], dq, d, cam, settings.upsample_sharpness)
+    assert np.abs(out["ao"] - want).max() <= AO_TOL
+    if scale == 1.0:  # a copy and the identity, bit for bit
+        np.testing.assert_array_equal(dq, d)
+        np.testing.assert_array_equal(out["ao"], out["ao_quarter"])
+
+
+@pytest.mark.vulkan
+def test_working_size_that_disagrees_with_hbao_scale_is_an_error():
+    from rgraph.vk.executor import execute_plan
+
+    plan = compile_graph(GRAPHS / "hbao_fixed_size.yaml", size=(32, 16), params={"hbao.scale": "0.5"})
+    with pytest.raises(Exception, match=r"depth_quarter is \(8, 4\) but hbao.scale=0.5 gives \(16, 8\)"):
+        execute_plan(plan, validate=False, inputs={"depth": np.ones((16, 32, 1), np.float32),
+                                                   "depth_quarter": np.ones((4, 8, 1), np.float32),
+                                                   "ao_quarter": np.ones((4, 8, 1), np.float32)})

@@ -1,5 +1,5 @@
 #version 460
-// Horizon-based ambient occlusion (Bavoil and Sainz 2008) on quarter-resolution depth.
+// Horizon-based ambient occlusion (Bavoil and Sainz 2008) on working-resolution depth.
 // The NumPy reference passes/hbao_ref.py:hbao documents every step; keep them in sync.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
@@ -16,7 +16,7 @@ layout(set = 0, binding = 0) uniform sampler2D depth_quarter;
 layout(set = 0, binding = 1, r8) uniform writeonly image2D ao_quarter;
 layout(push_constant) uniform Push {
     vec4 proj;   // P00, P11, near, -
-    vec4 knobs;  // radius (world), angle bias (rad), strength, max radius (quarter px)
+    vec4 knobs;  // radius (world), angle bias (rad), strength, max radius (working-res px)
 } pc;
 
 const float PI = 3.14159265358979;
@@ -54,7 +54,7 @@ void main() {
     vec3 n = cross(ddy, ddx);
     float len = length(n);
     n = len < 1e-30 ? vec3(0, 0, 1) : n / len;
-    if (n.z < 0.0) n = -n;
+    if (dot(n, p) > 0.0) n = -n;  // face the camera (V = -p), also for walls seen edge-on
     float sin_bias = sin(pc.knobs.y);
 
     float radius = pc.knobs.x;

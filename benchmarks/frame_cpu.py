@@ -1,8 +1,15 @@
 """Per-frame CPU cost of resubmitting a compiled plan, and GPU busy fraction at 1920x1080.
 
 CPU: main-thread CPU time (time.thread_time) between consecutive frame starts of one run of
-the surgery plan (no validation), median over many frames; target <= 50 us. The driver's own
-worker threads are not counted, so this is what Python, the binding and the submit calls cost.
+the surgery plan (no validation), median over many frames; target <= 50 us for the runtime's
+own work. The driver's worker threads are not counted, so this is what Python, the binding,
+the submit calls and (with ``--passes real``) the per-frame scene/pass updates cost. Each
+frame is split into: waiting (fence wait, timestamp read, fence reset), updates (scene
+animation and pass ``update`` hooks: the pass implementations' cost, not the runtime's) and
+submit (timeline values and vkQueueSubmit2 calls).
+
+``--passes probe`` (default) runs every pass with the probe implementation, so the figure is
+the runtime's resubmission cost alone; ``--passes real`` keeps the graph's implementations.
 
 GPU busy (GPU devices only): per frame, the GPU time of the passes (timestamps) over the frame's
 wall time (perf_counter over many pipelined frames). Two figures: the span from the first
@@ -10,12 +17,12 @@ pass's start to the last pass's end (gaps between passes count as busy), and the
 per-pass times capped at the span (gaps excluded when passes do not overlap); target >= 95%.
 
     python benchmarks/frame_cpu.py [--frames 2000] [--busy-frames 300] [--size 64x64]
+        [--policy P] [--passes probe|real]
 """
 
 from __future__ import annotations
 
 import argparse
-import re
 import statistics
 import time
 
@@ -26,12 +33,14 @@ from rgraph.vk.instance import create_instance
 from rgraph.vk.memreq import DeviceMemoryRequirements
 
 
-def compile_for_device(size: tuple[int, int], policy: str | None = None) -> tuple[dict, str, bool]:
+def compile_for_device(size: tuple[int, int], policy: str | None = None, graph: str = "surgery",
+                       sync: str | None = None) -> tuple[dict, str, bool]:
     instance = create_instance(validate=False)
     try:
         device = create_device(instance, None, verbose=False)
         try:
-            plan = compile_graph("surgery", size=size, policy=policy, memory=DeviceMemoryRequirements(device))
+            plan = compile_graph(graph, size=size, policy=policy, memory=DeviceMemoryRequirements(device),
+                                 **({"sync": sync} if sync else {}))
             return plan, device.name, device.physical.device_type != "cpu"
         finally:
             device.destroy()
@@ -39,26 +48,27 @@ def compile_for_device(size: tuple[int, int], policy: str | None = None) -> tupl
         instance.destroy()
 
 
-def frame_cpu_us(plan: dict, frames: int) -> list[float]:
-    """Main-thread CPU microseconds of each frame (frame start to next frame start)."""
+def probe_only(plan: dict) -> dict:
+    """The plan with every pass run by the probe implementation (no per-frame pass updates)."""
+    return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
+
+
+def frame_cpu_us(plan: dict, frames: int) -> dict[str, list[float]]:
+    """Main-thread CPU microseconds per frame (frame start to next frame start) and its parts."""
     executor = Executor(plan, validate=False, device_index=None, verbose=False)
     marks: list[float] = []
-    log = executor.log
-    base = type(log)
-
-    class Marking(base):  # type: ignore[misc, valid-type]
-        def __setattr__(self, name, value):
-            if name == "context" and isinstance(value, str) and re.fullmatch(r"frame \d+", value):
-                marks.append(time.thread_time())
-            base.__setattr__(self, name, value)
-
-    log.__class__ = Marking
     try:
-        executor.run_frames(frames)
+        executor.run_frames(frames, marks=marks)
     finally:
-        log.__class__ = base
         executor.close()
-    return [(b - a) * 1e6 for a, b in zip(marks, marks[1:], strict=False)][10:]  # skip warm-up
+    starts, waited, updated = marks[0::3], marks[1::3], marks[2::3]
+    skip = 10  # warm-up
+    return {
+        "frame": [(b - a) * 1e6 for a, b in zip(starts, starts[1:], strict=False)][skip:],
+        "waiting": [(b - a) * 1e6 for a, b in zip(starts, waited, strict=False)][skip:-1],
+        "updates": [(b - a) * 1e6 for a, b in zip(waited, updated, strict=False)][skip:-1],
+        "submit": [(b - a) * 1e6 for a, b in zip(updated, starts[1:], strict=False)][skip:],
+    }
 
 
 def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
@@ -76,26 +86,39 @@ def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
             "sum_fraction": summed / wall_ms, "cpu_submit_ms": timings["cpu_submit_ms"]}
 
 
+def _summary(values: list[float]) -> str:
+    deciles = statistics.quantiles(values, n=10)
+    return f"median {statistics.median(values):.1f} us, p10 {deciles[0]:.1f} us, p90 {deciles[-1]:.1f} us"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=2000)
     parser.add_argument("--busy-frames", type=int, default=300)
     parser.add_argument("--size", default="64x64", help="size for the CPU measurement (default 64x64)")
     parser.add_argument("--policy", default=None, help="memory placement policy (default: the compiler's)")
+    parser.add_argument("--passes", choices=("probe", "real"), default="probe",
+                        help="probe: every pass by the probe (the runtime's own cost); real: the graph's passes")
     args = parser.parse_args()
     w, h = (int(x) for x in args.size.lower().split("x"))
     plan, device, is_gpu = compile_for_device((w, h), args.policy)
-    per_frame = frame_cpu_us(plan, args.frames)
+    if args.passes == "probe":
+        plan = probe_only(plan)
+    parts = frame_cpu_us(plan, args.frames)
     passes = len(plan["passes"])
     print(f"device: {device}")
-    print(f"surgery {w}x{h}: {passes} passes, {sum(len(p['barriers']) for p in plan['passes'])} barriers")
-    print(f"frame CPU (main thread, {len(per_frame)} frames): median {statistics.median(per_frame):.1f} us, "
-          f"p10 {statistics.quantiles(per_frame, n=10)[0]:.1f} us, p90 {statistics.quantiles(per_frame, n=10)[-1]:.1f} us"
-          f" (target <= 50 us)")
+    print(f"surgery {w}x{h} ({args.passes} passes): {passes} passes, "
+          f"{sum(len(p['barriers']) for p in plan['passes'])} barriers")
+    print(f"frame CPU (main thread, {len(parts['frame'])} frames): {_summary(parts['frame'])} (target <= 50 us)")
+    print(f"  waiting (fence wait, timestamp read, fence reset): {_summary(parts['waiting'])}")
+    print(f"  updates (scene, pass update hooks):                {_summary(parts['updates'])}")
+    print(f"  submit (timeline values, vkQueueSubmit2):          {_summary(parts['submit'])}")
     if not is_gpu:
         print("GPU busy fraction: skipped (CPU device: lavapipe runs the frame on CPU threads)")
         return
     plan1080, _, _ = compile_for_device((1920, 1080), args.policy)
+    if args.passes == "probe":
+        plan1080 = probe_only(plan1080)
     busy = gpu_busy(plan1080, args.busy_frames)
     print(f"surgery 1920x1080, {args.busy_frames} frames: wall {busy['wall_ms']:.3f} ms/frame, GPU span "
           f"{busy['span_ms']:.3f} ms, GPU pass sum {busy['sum_ms']:.3f} ms, submit CPU {busy['cpu_submit_ms']:.3f} ms")

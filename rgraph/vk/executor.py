@@ -9,7 +9,6 @@ plan order. Frames are paced by fences (the validation layer understands fence w
 
 from __future__ import annotations
 
-import statistics
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,11 +50,18 @@ class Batch:
     queue: str  # plan queue of the first pass (all passes share its VkQueue)
     passes: list[dict]
     command_buffers: list[Any] = field(default_factory=list)  # per set
-    waits: list[Any] = field(default_factory=list)  # per set: VkSemaphoreSubmitInfo list
-    signals: list[Any] = field(default_factory=list)
-    submit: list[Any] = field(default_factory=list)  # per set: VkSubmitInfo2
-    wait_values: list[tuple[Any, str, int, bool]] = field(default_factory=list)  # (info, queue, value, frame_start)
-    signal_values: list[tuple[Any, str, int, bool]] = field(default_factory=list)
+
+
+@dataclass
+class SubmitCall:
+    """One vkQueueSubmit2 of a frame: ``count`` prebuilt VkSubmitInfo2 in ``infos``."""
+
+    queue: Any
+    count: int
+    infos: Any
+    fence: Any  # VkFence or ffi.NULL
+    context: str  # for validation messages
+    keep: list[Any]  # cffi arrays the infos point into
 
 
 def make_batches(plan: dict, device: Device, one_per_pass: bool = False) -> list[Batch]:
@@ -92,6 +98,9 @@ class Executor:
         self.pools: dict[tuple[int, int], Any] = {}
         self.query_pools: list[Any] = []
         self.fences: list[list[Any]] = []
+        self.fence_arrays: list[Any] = []
+        self.submit_calls: list[list[SubmitCall]] = []
+        self.value_slots: list[list[tuple[Any, int, int]]] = []
         self.sampler = None
         self.host_buffers: list[HostBuffer] = []
         self.batches: list[Batch] = []
@@ -307,116 +316,178 @@ class Executor:
         self._build_submits()
 
     def _build_submits(self) -> None:
-        """Prebuilt VkSubmitInfo2 per batch and set; only semaphore values change per frame."""
+        """Prebuilt submit arrays per set; per frame only the semaphore values change.
+
+        Each batch is one VkSubmitInfo2 (its semaphores order it against the other queues).
+        Without validation, consecutive batches on one VkQueue (plan order) go in one
+        vkQueueSubmit2 call with an array of VkSubmitInfo2; under validation each batch is its
+        own call so that messages name the batch. Plan order keeps every wait submitted after
+        its signal (no wait-before-signal). Timeline value = frame * span[queue] + offset,
+        written straight into the cffi structs.
+        """
         v = vk()
+        ffi = v.ffi
         dev = self.device
         queues = list(dict.fromkeys(p["queue"] for p in self.plan["passes"]))
         self.frame_span = {q: 1 + max([s["value"] for p in self.plan["passes"] for s in p["signals"]
                                        if s["queue"] == q] + [0]) for q in queues}
-        distinct = len({int(v.ffi.cast("uintptr_t", dev.queues[q])) for q in queues}) > 1
+        handle_of = {q: int(ffi.cast("uintptr_t", dev.queues[q])) for q in queues}
+        distinct = len(set(handle_of.values())) > 1
         first_of: dict[str, int] = {}
         last_of: dict[int, int] = {}
+        last_by_plan_queue: dict[str, int] = {}
         for bi, batch in enumerate(self.batches):
             first_of.setdefault(batch.queue, bi)
-            last_of[int(v.ffi.cast("uintptr_t", dev.queues[batch.queue]))] = bi
-        last_by_plan_queue = {}
-        for bi, batch in enumerate(self.batches):
+            last_of[handle_of[batch.queue]] = bi
             last_by_plan_queue[batch.queue] = bi
-        self.fence_batches = sorted(set(last_of.values()))
+        fence_batches = sorted(set(last_of.values()))
+        # calls: runs of consecutive batches on one VkQueue (one batch each under validation)
+        runs: list[list[int]] = []
         for bi, batch in enumerate(self.batches):
-            first, last = batch.passes[0], batch.passes[-1]
-            wait_specs = [(w["queue"], w["value"], names.stages(w["stages"]), False) for w in first["waits"]]
-            if distinct and first_of[batch.queue] == bi:
-                wait_specs += [(q, self.frame_span[q], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, True)
-                               for q in queues if q != batch.queue]
-            signal_specs = [(s["queue"], s["value"], names.stages(s["stages"]), False) for s in last["signals"]]
-            if last_by_plan_queue[batch.queue] == bi:
-                signal_specs.append((batch.queue, self.frame_span[batch.queue], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                                     True))
-            for s in range(FRAMES_IN_FLIGHT):
-                waits = [v.VkSemaphoreSubmitInfo(semaphore=dev.timelines[q], value=0, stageMask=st)
-                         for q, _val, st, _fs in wait_specs]
-                signals = [v.VkSemaphoreSubmitInfo(semaphore=dev.timelines[q], value=0, stageMask=st)
-                           for q, _val, st, _fs in signal_specs]
-                cbi = [v.VkCommandBufferSubmitInfo(commandBuffer=batch.command_buffers[s])]
-                submit = v.VkSubmitInfo2(
-                    waitSemaphoreInfoCount=len(waits), pWaitSemaphoreInfos=waits or None,
-                    commandBufferInfoCount=1, pCommandBufferInfos=cbi,
-                    signalSemaphoreInfoCount=len(signals), pSignalSemaphoreInfos=signals or None)
-                batch.waits.append((waits, wait_specs))
-                batch.signals.append((signals, signal_specs, cbi))
-                batch.submit.append(submit)
-        for _ in range(FRAMES_IN_FLIGHT):
-            self.fences.append([v.vkCreateFence(dev.handle, v.VkFenceCreateInfo(
-                flags=v.VK_FENCE_CREATE_SIGNALED_BIT), None) for _ in self.fence_batches])
+            if (runs and not self.instance.validate
+                    and handle_of[self.batches[runs[-1][-1]].queue] == handle_of[batch.queue]):
+                runs[-1].append(bi)
+            else:
+                runs.append([bi])
+        self.fences = [[v.vkCreateFence(dev.handle, v.VkFenceCreateInfo(flags=v.VK_FENCE_CREATE_SIGNALED_BIT), None)
+                        for _ in fence_batches] for _ in range(FRAMES_IN_FLIGHT)]
+        self.fence_arrays = [ffi.new("VkFence[]", fences) if fences else ffi.NULL for fences in self.fences]
+        self.submit_calls = []
+        self.value_slots = []
+        for s in range(FRAMES_IN_FLIGHT):
+            calls: list[SubmitCall] = []
+            slots: list[tuple[Any, int, int]] = []
+            for run in runs:
+                infos = ffi.new("VkSubmitInfo2[]", len(run))
+                keep: list[Any] = [infos]
+                for j, bi in enumerate(run):
+                    batch = self.batches[bi]
+                    first, last = batch.passes[0], batch.passes[-1]
+                    waits = [(w["queue"], w["value"], names.stages(w["stages"])) for w in first["waits"]]
+                    if distinct and first_of[batch.queue] == bi:  # frame start: the previous frame is done
+                        waits += [(q, 0, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) for q in queues if q != batch.queue]
+                    signals = [(sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in last["signals"]]
+                    if last_by_plan_queue[batch.queue] == bi:
+                        signals.append((batch.queue, self.frame_span[batch.queue], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT))
+                    info = infos[j]
+                    info.sType = v.VK_STRUCTURE_TYPE_SUBMIT_INFO_2
+                    for count_field, array_field, specs in (("waitSemaphoreInfoCount", "pWaitSemaphoreInfos", waits),
+                                                            ("signalSemaphoreInfoCount", "pSignalSemaphoreInfos",
+                                                             signals)):
+                        if not specs:
+                            continue
+                        array = ffi.new("VkSemaphoreSubmitInfo[]", len(specs))
+                        keep.append(array)
+                        for k, (q, offset, stage_mask) in enumerate(specs):
+                            array[k].sType = v.VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO
+                            array[k].semaphore = dev.timelines[q]
+                            array[k].stageMask = stage_mask
+                            slots.append((array[k], self.frame_span[q], offset))
+                        setattr(info, count_field, len(specs))
+                        setattr(info, array_field, array)
+                    cbi = ffi.new("VkCommandBufferSubmitInfo[]", 1)
+                    cbi[0].sType = v.VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO
+                    cbi[0].commandBuffer = batch.command_buffers[s]
+                    keep.append(cbi)
+                    info.commandBufferInfoCount = 1
+                    info.pCommandBufferInfos = cbi
+                fence_index = next((fence_batches.index(bi) for bi in run if bi in fence_batches), None)
+                fence = self.fences[s][fence_index] if fence_index is not None else ffi.NULL
+                context = "submit of " + ", ".join(f"batch {bi} [{', '.join(p['name'] for p in self.batches[bi].passes)}]"
+                                                   for bi in run)
+                calls.append(SubmitCall(dev.queues[self.batches[run[0]].queue], len(run), infos, fence, context, keep))
+            self.submit_calls.append(calls)
+            self.value_slots.append(slots)
 
     # ----------------------------------------------------------------- frames
-    def run_frames(self, frames: int) -> dict[str, Any]:
+    def run_frames(self, frames: int, marks: list[float] | None = None) -> dict[str, Any]:
+        """Submit ``frames`` frames; per-pass GPU medians from timestamps. ``marks`` (if given)
+        gets the main thread's CPU time (time.thread_time) three times per frame: at its start,
+        after its fence wait, timestamp read and fence reset, and after the per-frame updates
+        (scene and pass ``update`` hooks).
+
+        The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
+        wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
+        timeline values, and one vkQueueSubmit2 per run of batches.
+        """
+        import numpy as np
+
         v = vk()
+        lib, ffi = v.lib, v.ffi
         dev = self.device
+        log = self.log
+        validate = self.instance.validate
         n = len(self.plan["passes"])
-        samples: list[list[float | None]] = [[] for _ in range(n)]
-        totals: list[float] = []
-        cpu_ms: list[float] = []
-        submitted: list[bool] = [False] * FRAMES_IN_FLIGHT
+        handle = dev.handle
+        fence_counts = [len(f) for f in self.fences]
+        fence_arrays = self.fence_arrays
+        pools = self.query_pools
+        timestamps = n > 0 and all(dev.timestamp_valid_bits.get(p["queue"], 0) > 0 for p in self.plan["passes"])
+        query_buffer = ffi.new("uint64_t[]", max(2 * n, 1))
+        query_view = np.frombuffer(ffi.buffer(query_buffer), dtype=np.uint64)
+        rows = np.zeros((frames, 2 * n), dtype=np.uint64)
+        collected = 0
+        query_flags = v.VK_QUERY_RESULT_64_BIT
+        cpu_s = np.zeros(frames)
+        submitted = [False] * FRAMES_IN_FLIGHT
+        scene, updaters = self.scene_gpu, self.updaters
+        wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
+        get_queries = lib.vkGetQueryPoolResults
+        timeout = 10**11
+        perf, thread_time = time.perf_counter, time.thread_time
         for frame in range(frames):
             s = frame % FRAMES_IN_FLIGHT
-            self.log.context = f"frame {frame}"
-            fences = self.fences[s]
-            t0 = time.perf_counter()
-            v.vkWaitForFences(dev.handle, len(fences), fences, v.VK_TRUE, 10**11)
-            if submitted[s]:
-                self._collect_timestamps(s, samples, totals)
-            v.vkResetFences(dev.handle, len(fences), fences)
-            if self.scene_gpu is not None:
-                self.scene_gpu.update(frame, s)
-            for p in self.updaters:
+            if marks is not None:
+                marks.append(thread_time())
+            log.context = f"frame {frame}"  # also a hook: tests/test_soak.py samples RSS on it
+            t0 = perf()
+            if fence_counts[s]:
+                _check(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
+                if submitted[s] and timestamps:
+                    if get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
+                        rows[collected] = query_view
+                        collected += 1
+                _check(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
+            if marks is not None:
+                marks.append(thread_time())
+            if scene is not None:
+                scene.update(frame, s)
+            for p in updaters:
                 p.update(frame, s)
-            for bi, batch in enumerate(self.batches):
-                self.log.context = f"frame {frame} submit of batch {bi} [{', '.join(p['name'] for p in batch.passes)}]"
-                submit = batch.submit[s]
-                _waits, wait_specs = batch.waits[s]
-                for k, (q, value, _st, frame_start) in enumerate(wait_specs):
-                    # frame-start waits: every other queue finished the previous frame
-                    submit.pWaitSemaphoreInfos[k].value = (
-                        frame * self.frame_span[q] if frame_start else frame * self.frame_span[q] + value)
-                _signals, signal_specs, _cbi = batch.signals[s]
-                for k, (q, value, _st, _fs) in enumerate(signal_specs):
-                    submit.pSignalSemaphoreInfos[k].value = frame * self.frame_span[q] + value
-                fence = fences[self.fence_batches.index(bi)] if bi in self.fence_batches else None
-                v.vkQueueSubmit2(dev.queues[batch.queue], 1, [batch.submit[s]], fence)
+            if marks is not None:
+                marks.append(thread_time())
+            for slot, span, offset in self.value_slots[s]:
+                slot.value = frame * span + offset
+            for call in self.submit_calls[s]:
+                if validate:
+                    log.context = f"frame {frame} {call.context}"
+                _check(submit2(call.queue, call.count, call.infos, call.fence), "vkQueueSubmit2")
             submitted[s] = True
-            cpu_ms.append((time.perf_counter() - t0) * 1000.0)
-        self.log.context = "finishing"
+            cpu_s[frame] = perf() - t0
+        log.context = "finishing"
         for s in range(FRAMES_IN_FLIGHT):
-            if submitted[s]:
-                v.vkWaitForFences(dev.handle, len(self.fences[s]), self.fences[s], v.VK_TRUE, 10**11)
-                self._collect_timestamps(s, samples, totals)
-        period = dev.timestamp_period_ns / 1e6
-        per_pass = {}
-        for i, p in enumerate(self.plan["passes"]):
-            vals = [x for x in samples[i] if x is not None]
-            per_pass[p["name"]] = statistics.median(vals) * period if vals else None
-        return {"passes": per_pass, "total_ms": statistics.median(totals) * period if totals else None,
-                "frames": frames, "cpu_submit_ms": statistics.median(cpu_ms) if cpu_ms else None}
+            if submitted[s] and fence_counts[s]:
+                _check(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
+                if timestamps and get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
+                    rows[collected] = query_view
+                    collected += 1
+        return self._timings(rows[:collected], frames, cpu_s)
 
-    def _collect_timestamps(self, s: int, samples: list[list[float | None]], totals: list[float]) -> None:
-        v = vk()
-        n = len(self.plan["passes"])
-        data = v.ffi.new("uint64_t[]", 2 * n)
-        flags = v.VK_QUERY_RESULT_64_BIT | v.VK_QUERY_RESULT_WAIT_BIT
-        try:
-            v.vkGetQueryPoolResults(self.device.handle, self.query_pools[s], 0, 2 * n, 16 * n, data, 8, flags)
-        except v.VkError:
-            return
-        starts, ends = [], []
-        for i in range(n):
-            a, b = int(data[2 * i]), int(data[2 * i + 1])
-            samples[i].append(float(b - a))
-            starts.append(a)
-            ends.append(b)
-        if starts:
-            totals.append(float(max(ends) - min(starts)))
+    def _timings(self, rows: Any, frames: int, cpu_s: Any) -> dict[str, Any]:
+        """Medians (ms) from timestamp rows (per frame: start, end of each pass)."""
+        import numpy as np
+
+        period = self.device.timestamp_period_ns / 1e6
+        per_pass: dict[str, float | None] = {p["name"]: None for p in self.plan["passes"]}
+        total = None
+        if len(rows):
+            stamps = rows.astype(np.float64)
+            starts, ends = stamps[:, 0::2], stamps[:, 1::2]
+            for i, p in enumerate(self.plan["passes"]):
+                per_pass[p["name"]] = float(np.median(ends[:, i] - starts[:, i])) * period
+            total = float(np.median(ends.max(axis=1) - starts.min(axis=1))) * period
+        return {"passes": per_pass, "total_ms": total, "frames": frames,
+                "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None}
 
     # ----------------------------------------------------------------- readback
     def read_back(self, frames: int) -> dict[tuple, bytes]:
@@ -531,6 +602,20 @@ class Executor:
         if self.instance is not None and self.instance.handle is not None:
             self.instance.destroy()
         return self.instance.log.messages
+
+
+def _check(result: int, call: str) -> None:
+    if result != 0:
+        raise ExecutionError(f"{call} failed: {names_of_result(result)}")
+
+
+def names_of_result(result: int) -> str:
+    v = vk()
+    for name in dir(v):
+        if name.startswith("VK_") and not name.startswith("VK_STRUCTURE") and getattr(v, name) == result and (
+                name.startswith("VK_ERROR_") or name in ("VK_TIMEOUT", "VK_NOT_READY", "VK_INCOMPLETE")):
+            return name
+    return f"VkResult {result}"
 
 
 def _overrides_update(p: ImplPass) -> bool:

@@ -2,7 +2,8 @@
 
 Params: ``bloom.threshold`` (1.0), ``bloom.knee`` (0.5, soft-knee width as a fraction of the
 threshold), ``bloom.clamp`` (65504, what +Inf and larger values become before the Karis
-average), ``bloom.radius`` (4, Gaussian taps -r..r, at most 28), ``bloom.sigma`` (radius/2),
+average), ``bloom.radius`` (16, truncation radius in HDR pixels: round(radius / f) taps each
+side at reduction factor f, at most 28), ``bloom.sigma`` (radius/2, HDR pixels),
 ``bloom.direction`` (``h`` or ``v``; pass-level, required by ``bloom_blur``),
 ``bloom.intensity`` (0.05). Reference and the non-finite rule: ``bloom_ref``.
 """
@@ -13,7 +14,7 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
-from .bloom_ref import MAX_RADIUS, gaussian_weights
+from .bloom_ref import MAX_RADIUS, gaussian_weights, working_blur
 from .post_common_ref import HALF_MAX
 
 
@@ -62,7 +63,8 @@ class BloomBright(PassImpl):
 
 @register("bloom_blur")
 class BloomBlur(PassImpl):
-    """One separable Gaussian pass from its sampled source to its storage image (same size)."""
+    """One separable Gaussian pass from its sampled source to its storage image (same size);
+    radius and sigma given in HDR pixels, divided by the reduction factor along its axis."""
 
     def __init__(self, setup):
         super().__init__(setup)
@@ -71,15 +73,17 @@ class BloomBlur(PassImpl):
         if direction not in ("h", "v"):
             raise ExecutionError(f"pass {setup.name!r}: pass-level param bloom.direction must be 'h' or 'v', "
                                  f"got {direction!r}")
-        radius = int(setup.param("bloom.radius", 4))
         sigma = setup.param("bloom.sigma")
+        self.extent = setup.extent_of(dst)
+        factor = _factor(setup.size, self.extent)[0 if direction == "h" else 1]
         try:
-            weights = gaussian_weights(radius, None if sigma is None else float(sigma))
+            radius, sigma_texels = working_blur(float(setup.param("bloom.radius", 16)),
+                                                None if sigma is None else float(sigma), factor)
+            weights = gaussian_weights(radius, sigma_texels)
         except ValueError as exc:
-            raise ExecutionError(f"pass {setup.name!r}: {exc}") from None
+            raise ExecutionError(f"pass {setup.name!r}: {exc} (at reduction factor {factor})") from None
         padded = list(weights) + [0.0] * (MAX_RADIUS + 1 - len(weights))
         self.push = pack("3i29f", *((1, 0) if direction == "h" else (0, 1)), radius, *padded)
-        self.extent = setup.extent_of(dst)
         self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest"),
                                        Binding(1, "storage_image", dst)])
         self.pipeline = setup.compute_pipeline("post/bloom_blur.comp", [self.sets.layout],

@@ -12,7 +12,19 @@ with the Karis average ``sum(w c) / sum(w)``, ``w = 1 / (1 + luma(c))``, so that
     out  = a * max(soft, br - threshold) / max(br, 1e-5)
 
 ``blur``    (``bloom_blur``): separable Gaussian along ``direction`` with taps ``-r..r``,
-weights ``exp(-i^2 / (2 sigma^2))`` normalized to sum 1, clamp-to-edge.
+weights ``exp(-i^2 / (2 sigma^2))`` normalized to sum 1, clamp-to-edge, ``r`` and ``sigma``
+in texels of the reduced image. The graph params are in HDR (full-resolution) pixels so
+that every ``bloom.scale`` approximates the same filter: ``bloom.radius`` (default 16) is
+the truncation radius and ``bloom.sigma`` (default radius / 2) the standard deviation; at
+reduction factor ``f`` (``hdr extent // bloom extent`` along the blur's axis) the pass uses
+``r = round(radius / f)`` taps each side (half up) and ``sigma / f`` (``working_blur``).
+At the default quarter size that is the former 4 taps with sigma 2.
+
+Reference setting of ``rgraph sweep``: ``bloom.scale=1``. There the bright pass averages
+one texel (the Karis average of a single texel is the texel: only the sanitizing and the
+soft threshold act), and the separable Gaussian IS the full-resolution 2D Gaussian
+convolution (a 2D Gaussian factors exactly into two 1D ones), so the chain computes the
+truth that quarter resolution approximates, up to the truncation at ``bloom.radius``.
 ``combine`` (``bloom_combine``): ``hdr + intensity * bilinear(bloom)`` where full-resolution
 pixel ``p`` samples the bloom image at texel coordinate ``(p + 0.5) / f - 0.5`` (clamp to edge).
 
@@ -44,8 +56,18 @@ def gaussian_weights(radius: int, sigma: float | None = None) -> np.ndarray:
     return w / (w[0] + 2.0 * w[1:].sum())
 
 
-def default_sigma(radius: int) -> float:
+def default_sigma(radius: float) -> float:
     return max(radius, 1) / 2.0
+
+
+def working_blur(radius: float, sigma: float | None, factor: int) -> tuple[int, float]:
+    """(taps each side, sigma) in reduced-image texels for a blur given in HDR pixels."""
+    if factor < 1:
+        raise ValueError(f"bloom reduction factor must be >= 1, got {factor}")
+    if not radius >= 0:
+        raise ValueError(f"bloom.radius must be >= 0, got {radius}")
+    sigma = default_sigma(radius) if sigma is None else float(sigma)
+    return int(math.floor(radius / factor + 0.5)), sigma / factor
 
 
 def bright(hdr: np.ndarray, out_size: tuple[int, int], threshold: float = 1.0, knee: float = 0.5,
@@ -114,10 +136,13 @@ def combine(hdr: np.ndarray, bloom: np.ndarray, intensity: float) -> np.ndarray:
 
 
 def chain(hdr: np.ndarray, bloom_size: tuple[int, int], *, threshold: float = 1.0, knee: float = 0.5,
-          clamp: float = HALF_MAX, radius: int = 4, sigma: float | None = None,
+          clamp: float = HALF_MAX, radius: float = 16, sigma: float | None = None,
           intensity: float = 0.05) -> dict[str, np.ndarray]:
-    """The whole chain as the surgery graph runs it: bright -> blur h -> blur v -> combine."""
+    """The whole chain as the surgery graph runs it: bright -> blur h -> blur v -> combine.
+    ``radius`` and ``sigma`` in HDR pixels (see ``working_blur``)."""
+    h, w = hdr.shape[:2]
+    fx, fy = max(1, w // bloom_size[0]), max(1, h // bloom_size[1])
     a = bright(hdr, bloom_size, threshold, knee, clamp)
-    b = blur(a, "h", radius, sigma)
-    a2 = blur(b, "v", radius, sigma)
+    b = blur(a, "h", *working_blur(radius, sigma, fx))
+    a2 = blur(b, "v", *working_blur(radius, sigma, fy))
     return {"bright": a, "blur_h": b, "bloom": a2, "hdr": combine(hdr, a2, intensity)}

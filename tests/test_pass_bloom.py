@@ -65,8 +65,8 @@ def test_reference_chain_keeps_a_nan_local():
 
 # ----------------------------------------------------------------------------- on the device
 @pytest.mark.vulkan
-@pytest.mark.parametrize("params", [{}, {"bloom.knee": 0.0, "bloom.radius": 2, "bloom.threshold": 0.5}],
-                         ids=["defaults", "hard-threshold-r2"])
+@pytest.mark.parametrize("params", [{}, {"bloom.knee": 0.0, "bloom.radius": 8, "bloom.threshold": 0.5}],
+                         ids=["defaults", "hard-threshold-r8"])
 def test_bright_and_blur_stages_match_reference(params):
     hdr = _scene(2)
     out = run_graph("bloom_stages", (W, H), {"hdr": hdr}, params)
@@ -76,7 +76,9 @@ def test_bright_and_blur_stages_match_reference(params):
     assert within(out["bloom_a"], bright, bloom_ref.RTOL, bloom_ref.ATOL) <= 1.0
     assert (out["bloom_a"][..., :3] > 0).any() and (out["bloom_a"][..., :3] == 0).any()  # thresholding acts
     # blur the GPU's own bright image, so each stage is checked on its own
-    blurred = bloom_ref.blur(out["bloom_a"], "h", params.get("bloom.radius", 4))
+    taps, sigma = bloom_ref.working_blur(params.get("bloom.radius", 16), None, 4)
+    assert (taps, sigma) == ((4, 2.0) if not params else (2, 1.0))  # HDR pixels / 4
+    blurred = bloom_ref.blur(out["bloom_a"], "h", taps, sigma)
     assert within(out["bloom_b"], blurred, bloom_ref.RTOL, bloom_ref.ATOL) <= 1.0
 
 
@@ -133,3 +135,65 @@ def test_blur_without_direction_is_a_clear_error():
     blur["params"].pop("bloom.direction")
     with pytest.raises(ExecutionError, match="bloom.direction must be 'h' or 'v'"):
         execute_plan(plan, inputs={"hdr": np.zeros((16, 16, 4), np.float32)})
+
+
+# ----------------------------------------------------------------------------- bloom.scale
+
+
+def test_working_blur_divides_hdr_pixels_by_the_factor():
+    assert bloom_ref.working_blur(16, None, 4) == (4, 2.0)
+    assert bloom_ref.working_blur(16, None, 1) == (16, 8.0)
+    assert bloom_ref.working_blur(16, 6.0, 2) == (8, 3.0)
+    assert bloom_ref.working_blur(10, None, 4) == (3, 1.25)  # 2.5 rounds half up
+
+
+def test_full_resolution_chain_is_the_2d_gaussian_convolution():
+    """At factor 1 the bright pass is per texel and blur h then v equals the 2D Gaussian
+    (clamp to edge), up to the float16 rounding between the passes."""
+    hdr = _scene(5)
+    radius, sigma = 8, 3.0
+    out = bloom_ref.chain(hdr, (W, H), threshold=0.0, knee=0.0, radius=radius, sigma=sigma)
+    np.testing.assert_array_equal(out["bright"][..., :3], half(hdr[..., :3]))  # Karis over one texel
+    g = np.exp(-np.arange(-radius, radius + 1) ** 2 / (2 * sigma * sigma))
+    kernel = np.outer(g, g) / np.outer(g, g).sum()
+    src = np.asarray(out["bright"], np.float64)
+    conv = np.zeros_like(src)
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            ys, xs = np.clip(np.arange(H) + dy, 0, H - 1), np.clip(np.arange(W) + dx, 0, W - 1)
+            conv += kernel[dy + radius, dx + radius] * src[ys][:, xs]
+    assert within(out["bloom"][..., :3], conv[..., :3], 2e-3, 1e-4) <= 1.0
+
+
+def test_quarter_resolution_approximates_the_full_resolution_filter():
+    """Radius and sigma in HDR pixels: the quarter-size bloom approximates the full-size one;
+    the same taps in quarter texels (the old meaning) would be a 4x wider filter."""
+    hdr = _scene(6)
+    full = bloom_ref.chain(hdr, (W, H), intensity=1.0)["hdr"] - hdr
+    quarter = bloom_ref.chain(hdr, (QW, QH), intensity=1.0)["hdr"] - hdr
+    wider = bloom_ref.chain(hdr, (QW, QH), radius=64, intensity=1.0)["hdr"] - hdr
+
+    def rel(a: np.ndarray) -> float:
+        return float(np.linalg.norm((a - full)[..., :3]) / np.linalg.norm(full[..., :3]))
+
+    assert rel(quarter) < 0.35 and rel(quarter) < rel(wider) / 3  # 0.23 vs 0.87 here
+
+
+@pytest.mark.vulkan
+def test_chain_at_full_resolution_matches_reference():
+    hdr = _scene(7)
+    params = {"bloom.scale": 1, "bloom.radius": 10, "bloom.intensity": 0.2}
+    out = run_graph("bloom_chain", (W, H), {"hdr": hdr}, params)
+    ref = bloom_ref.chain(hdr, (W, H), radius=10, intensity=0.2)
+    assert out["bloom_a"].shape == (H, W, 4)
+    assert within(out["bloom_b"], ref["blur_h"], bloom_ref.RTOL, bloom_ref.ATOL) <= 1.0
+    assert within(out["bloom_a"], ref["bloom"], bloom_ref.RTOL, bloom_ref.ATOL) <= 1.0
+    assert within(out["hdr"], ref["hdr"], bloom_ref.RTOL, bloom_ref.ATOL) <= 1.0
+    assert (out["bloom_a"][..., :3] > 0).any()
+
+
+@pytest.mark.vulkan
+def test_bright_pass_at_factor_1_is_per_texel():
+    hdr = _scene(8)
+    out = run_graph("bloom_stages", (W, H), {"hdr": hdr}, {"bloom.scale": 1, "bloom.threshold": 0, "bloom.knee": 0})
+    assert within(out["bloom_a"][..., :3], hdr[..., :3], 1e-3, 1e-4) <= 1.0

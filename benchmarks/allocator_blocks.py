@@ -22,7 +22,8 @@ timings (timestamp queries):
 
     python benchmarks/allocator_blocks.py [--meshes N] [--segments S] [--frames F] [--device I]
         [--sizes 0,4,16,64,256] [--mix rigid,deformable,mixed] [--size WxH] [--validate]
-        [--over-limit error|try] [--max-allocations N] [--out-json P] [--plot P]
+        [--over-limit error|try] [--max-allocations N] [--dynamic-memory host|device_local]
+        [--out-json P] [--plot P]
 """
 
 from __future__ import annotations
@@ -53,6 +54,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     ap.add_argument("--load-factor", type=float, default=1.5, help="deformable capacity / size (default 1.5)")
     ap.add_argument("--over-limit", choices=("error", "try"), default="error",
                     help="past maxMemoryAllocationCount: report (error) or let the driver decide (try)")
+    ap.add_argument("--dynamic-memory", choices=("host", "device_local"), default="host",
+                    help="deformable buffers in host memory or device-local host-visible memory (BAR)")
     ap.add_argument("--max-allocations", type=int, default=0, help="lower the allocation limit (0: the device's)")
     ap.add_argument("--validate", action="store_true", help="run under the validation layers (slower)")
     ap.add_argument("--out-json", type=Path, default=None, help="write rows and the command as JSON here")
@@ -75,7 +78,7 @@ def compile_plan(args: argparse.Namespace, block_mib: int, mix: str, memory: Any
     params = {"alloc.block_mib": str(block_mib), "alloc.meshes": str(args.meshes),
               "alloc.segments": str(args.segments), "alloc.deformable_fraction": str(MIXES[mix]),
               "alloc.load_factor": str(args.load_factor), "alloc.over_limit": args.over_limit,
-              "alloc.max_allocations": str(args.max_allocations)}
+              "alloc.max_allocations": str(args.max_allocations), "alloc.dynamic_memory": args.dynamic_memory}
     return compile_graph(GRAPH, params=params, size=args.size, memory=memory)
 
 
@@ -148,21 +151,22 @@ def plot(rows: list[dict[str, Any]], sizes: list[int], path: Path, title: str) -
         if not pts:
             continue
         line = ax_load.plot([x for x, _ in pts], [r["load_ms"] for _, r in pts], "o-", label=f"{mix}: load")[0]
-        ax_load.plot([x for x, _ in pts], [r["vk_allocate_ms"] for _, r in pts], "x:", color=line.get_color(),
-                     label=f"{mix}: in vkAllocateMemory")
+        ax_load.plot([x for x, _ in pts], [max(r["vk_allocate_ms"], 0.01) for _, r in pts], "x:",
+                     color=line.get_color(), label=f"{mix}: in vkAllocateMemory")
         line = ax_frame.plot([x for x, _ in pts], [r["frame_ms"] for _, r in pts], "o-", label=f"{mix}: CPU frame")[0]
         ax_frame.plot([x for x, _ in pts], [r["gpu_ms"] for _, r in pts], "s--", color=line.get_color(),
                       label=f"{mix}: GPU pass")
         failed = [x for x, s in zip(xs, sizes, strict=True)
                   if any(r["mix"] == mix and r["block_mib"] == s and "error" in r for r in rows)]
         for x in failed:
-            ax_load.annotate("over\nlimit", (x, 0), textcoords="offset points", xytext=(0, 8), ha="center",
+            ax_load.annotate("over limit", (x, 0.95), xycoords=("data", "axes fraction"), ha="center",
                              color=line.get_color(), fontsize=8)
-    for ax, what in ((ax_load, "load time (ms)"), (ax_frame, "frame time (ms)")):
+    ax_load.set_yscale("log")
+    ax_frame.set_ylim(bottom=0)
+    for ax, what in ((ax_load, "load time (ms, log scale)"), (ax_frame, "frame time (ms)")):
         ax.set_xticks(xs, labels)
         ax.set_xlabel("default block size")
         ax.set_ylabel(what)
-        ax.set_ylim(bottom=0)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     fig.suptitle(title, fontsize=10)

@@ -11,7 +11,8 @@ Memory (``rgraph.vk.mesh_pool.MeshPool``, block size ``alloc.block_mib`` MiB, 0 
 VkDeviceMemory per buffer): rigid meshes get one device-local buffer filled once through a
 staging buffer; deformable ones one host-visible coherent buffer per frame-in-flight set of
 capacity size x ``alloc.load_factor``, rewritten by the CPU in ``update`` (a sine wobble in x
-of every deformable mesh: one float per vertex per frame, see ``_Wobble``). Recording: one ``vkCmdBindVertexBuffers`` and one ``vkCmdDraw`` per
+of every deformable mesh: one float per vertex per frame, see ``_Wobble``); ``alloc.dynamic_memory:
+device_local`` puts them in device-local host-visible memory (resizable BAR) where there is some. Recording: one ``vkCmdBindVertexBuffers`` and one ``vkCmdDraw`` per
 mesh, in mesh order (per frame-in-flight set, recorded once).
 
 Figures (``MeshLines.last_report``, and the JSON file ``alloc.report`` when set): pool
@@ -237,6 +238,10 @@ class MeshLines(PassImpl):
         over = str(p("alloc.over_limit", "error"))
         if over not in ("error", "try"):
             raise ExecutionError(f"mesh_lines: alloc.over_limit must be 'error' or 'try', not {over!r}")
+        self.dynamic_memory = str(p("alloc.dynamic_memory", "host"))
+        if self.dynamic_memory not in ("host", "device_local"):
+            raise ExecutionError(f"mesh_lines: alloc.dynamic_memory must be 'host' or 'device_local', "
+                                 f"not {self.dynamic_memory!r}")
         self.report_path = str(p("alloc.report", "") or "")
         scene_path = setup.plan.get("scene_source")
         scene = None
@@ -264,7 +269,7 @@ class MeshLines(PassImpl):
         self.report: dict[str, Any] = {
             "block_mib": self.block_mib, "meshes": len(self.layout), "rigid": len(self.rigid),
             "deformable": len(self.deformable), "segments": int(self.layout.segments.max(initial=0)),
-            "load_factor": self.load_factor, "sets": self.sets, "device": setup.device.name,
+            "load_factor": self.load_factor, "sets": self.sets, "dynamic_memory": self.dynamic_memory, "device": setup.device.name,
             "geometry_ms": geometry_ms, "vertex_bytes": int(sum(v.nbytes for v in rigid_vertices)
                                                              + sum(v.nbytes for v in deform_vertices)),
         }
@@ -290,7 +295,7 @@ class MeshLines(PassImpl):
               max_alloc: int | None, enforce: bool) -> None:
         t0 = time.perf_counter()
         pool = self.pool = MeshPool(setup.device, self.block_mib * MIB, max_allocations=max_alloc,
-                                    enforce_limit=enforce)
+                                    enforce_limit=enforce, dynamic_device_local=self.dynamic_memory == "device_local")
         if self.block_mib == 0:  # say it before allocating thousands of objects
             needed = len(rigid_vertices) + self.sets * len(deform_vertices) + (1 if rigid_vertices else 0)
             self.report["allocations_needed"] = needed

@@ -290,10 +290,12 @@ class MeshPool:
     ``block_size`` 0: one allocation per buffer. ``max_allocations`` lowers the device's
     ``maxMemoryAllocationCount`` (to rehearse the NVIDIA limit on lavapipe); ``enforce_limit``
     False lets the driver decide past the limit (invalid usage: the validation layer reports it).
+    ``dynamic_device_local`` puts dynamic buffers in DEVICE_LOCAL | HOST_VISIBLE | HOST_COHERENT
+    memory (resizable BAR) when a type has those flags, else in the first host-visible one.
     """
 
     def __init__(self, device: Any, block_size: int, *, max_allocations: int | None = None,
-                 enforce_limit: bool = True) -> None:
+                 enforce_limit: bool = True, dynamic_device_local: bool = False) -> None:
         from rgraph.vk.loader import vk
 
         v = vk()
@@ -313,6 +315,9 @@ class MeshPool:
         self._static_usage = self._usage | v.VK_BUFFER_USAGE_TRANSFER_DST_BIT
         self._device_local = v.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
         self._host = v.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | v.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+        # dynamic buffers: plain host memory (the first host-visible coherent type), or, when
+        # asked, device-local host-visible memory (resizable BAR) where the device has it
+        self._dynamic_prefer = self._device_local if dynamic_device_local else 0
 
     @property
     def limit(self) -> int | None:
@@ -333,7 +338,7 @@ class MeshPool:
         flags = self.backend.type_flags
         try:
             if dynamic:
-                type_index = choose_memory_type(req.memoryTypeBits, flags, self._host)
+                type_index = self._dynamic_type(req.memoryTypeBits)
                 alignment = max(int(req.alignment), ROW_BYTES)  # rows of the NumPy mapping view
             else:
                 type_index = choose_memory_type(req.memoryTypeBits, flags, self._device_local)
@@ -350,6 +355,15 @@ class MeshPool:
         self.buffers.append(buf)
         self.used_bytes += buf.used
         return buf
+
+    def _dynamic_type(self, type_bits: int) -> int:
+        flags = self.backend.type_flags
+        if self._dynamic_prefer:
+            try:
+                return choose_memory_type(type_bits, flags, self._host | self._dynamic_prefer)
+            except ExecutionError:
+                pass  # no resizable BAR: plain host memory
+        return choose_memory_type(type_bits, flags, self._host)
 
     def rows(self, buf: PoolBuffer) -> np.ndarray:
         """The float32 (rows, 4) mapping of ``buf``'s memory block (dynamic buffers only)."""

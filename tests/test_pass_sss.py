@@ -133,3 +133,99 @@ def test_constant_image_stays_constant_on_gpu(samples):
     out = run((w, h), depth, color, nsss, {"sss.samples": samples, "sss.width": 0.05})
     np.testing.assert_allclose(out["diffuse"], color, rtol=1e-3, atol=0)
     np.testing.assert_allclose(out["sss_tmp"], color, rtol=1e-3, atol=0)
+
+
+# ----------------------------------------------------------------------------- sss.kernel = 2d
+
+
+def disc_inputs(n: int = 64, z: float = 0.3):
+    """A small bright disc (radially symmetric) on a flat, fully-SSS surface facing the camera."""
+    yy, xx = np.mgrid[0:n, 0:n] + 0.5
+    r = np.hypot(xx - n / 2, yy - n / 2)
+    color = np.zeros((n, n, 4))
+    color[..., 3] = 1.0
+    color[..., :3] = np.where(r < 2.5, 4.0, 0.0)[..., None]
+    depth = np.full((n, n), np.float32(NEAR / z)).astype(np.float64)
+    nsss = np.ones((n, n, 4))
+    return depth, color, nsss, r, np.degrees(np.arctan2(yy - n / 2, xx - n / 2)) % 90
+
+
+def diagonal_over_axis(img: np.ndarray, r: np.ndarray, angle: np.ndarray, lo: float = 5, hi: float = 9) -> np.ndarray:
+    """Per channel: mean over the ring lo <= r < hi near the diagonals / near the axes (1 = isotropic)."""
+    ring = (r >= lo) & (r < hi)
+    diag, axis = ring & (np.abs(angle - 45) < 12), ring & ((angle < 12) | (angle > 78))
+    return np.array([img[..., c][diag].mean() / img[..., c][axis].mean() for c in range(3)])
+
+
+@pytest.mark.parametrize("samples", ref.SAMPLE_COUNTS)
+def test_2d_kernel_is_normalized_symmetric_and_radial(samples):
+    k = ref.kernel_2d(samples)
+    np.testing.assert_allclose(k[:, :3].sum(axis=0), 1.0, atol=1e-12)
+    assert k[0, 3] == k[0, 4] == 0.0 and np.all(k[:, :3] >= 0)
+    assert np.hypot(k[:, 3], k[:, 4]).max() <= ref.kernel_range(samples) + 1e-9  # a disc
+    taps = {(round(x, 9), round(y, 9)): tuple(w) for *w, x, y in k.tolist()}
+    for (x, y), w in taps.items():  # invariant under the 8 symmetries of the grid
+        for mirror in ((y, x), (-x, y), (x, -y)):
+            np.testing.assert_allclose(taps[mirror], w, rtol=1e-12)
+    # weight / cell area depends on r only: the profile itself
+    offsets, cells = ref._offsets_and_cells(samples)
+    cell = {round(o, 9): c for o, c in zip(offsets, cells, strict=True)}
+    unblended = k.copy()
+    s = np.asarray(ref.SKIN_STRENGTH)
+    unblended[1:, :3] /= s
+    density = unblended[1:, :3] / np.array([cell[round(x, 9)] * cell[round(y, 9)] for x, y in k[1:, 3:5]])[:, None]
+    want = np.array([ref.profile(np.hypot(x, y)) for x, y in k[1:, 3:5]])
+    ratio = density / want
+    np.testing.assert_allclose(ratio, np.broadcast_to(ratio[0], ratio.shape), rtol=1e-9)
+
+
+def test_2d_reference_is_isotropic_where_the_separable_pair_is_not():
+    """On a radially symmetric input the 2D blur stays (nearly) radially symmetric; the
+    separable pair puts far more light along the axes than along the diagonals (its strength
+    blend runs once per direction, leaving one-axis blurs, and k(x) k(y) is not the profile)."""
+    depth, color, nsss, r, angle = disc_inputs()
+    cam = camera(64, 64)
+    settings = ref.SSSSettings(samples=25, width=0.1, follow_depth=1.0)
+    kw = dict(p00=cam.p00, p11=cam.p11, near=NEAR, settings=settings)
+    separable = ref.reference(color, depth, nsss[..., 3], **kw)["diffuse"]
+    two_d = ref.reference(color, depth, nsss[..., 3], **{**kw, "settings": ref.SSSSettings(
+        samples=25, width=0.1, follow_depth=1.0, kernel="2d")})["diffuse"]
+    assert np.all(np.abs(diagonal_over_axis(two_d, r, angle) - 1.0) < 0.1)
+    assert np.all(diagonal_over_axis(separable, r, angle) < 0.3)
+
+
+@pytest.mark.vulkan
+@pytest.mark.parametrize("samples", [11, 25])
+def test_2d_kernel_on_gpu_matches_reference_and_differs_from_separable(samples):
+    n = 64
+    depth, color, nsss, r, angle = disc_inputs(n)
+    cam = camera(n, n)
+    params = {"sss.samples": samples, "sss.width": 0.1, "sss.follow_depth": 1.0}
+    two_d = run((n, n), depth, color, nsss, {**params, "sss.kernel": "2d"})
+    separable = run((n, n), depth, color, nsss, params)
+    settings = ref.SSSSettings(samples=samples, width=0.1, follow_depth=1.0, kernel="2d")
+    want = ref.blur_2d(color, depth, nsss[..., 3], p00=cam.p00, p11=cam.p11, near=NEAR, settings=settings)
+    assert close(two_d["sss_tmp"], want)
+    assert np.array_equal(two_d["diffuse"], two_d["sss_tmp"])  # the v pass is a copy
+    assert not close(separable["diffuse"], want)
+    # the 2D grid is coarse in the profile's tail at 11 samples (ratio 0.75 there, 1.0-1.04 at 25)
+    assert np.all(np.abs(diagonal_over_axis(two_d["diffuse"], r, angle) - 1.0) < (0.1 if samples == 25 else 0.3))
+    assert np.all(diagonal_over_axis(separable["diffuse"], r, angle) < 0.3)
+
+
+@pytest.mark.vulkan
+def test_2d_kernel_matches_reference_on_a_sphere_with_follow_surface():
+    w, h = 48, 32
+    cam = camera(w, h)
+    depth, color, nsss = inputs(w, h)
+    out = run((w, h), depth, color, nsss, {"sss.kernel": "2d", "sss.samples": 17, "sss.width": 0.03})
+    settings = ref.SSSSettings(samples=17, width=0.03, kernel="2d")
+    want = ref.blur_2d(color, depth, nsss[..., 3], p00=cam.p00, p11=cam.p11, near=NEAR, settings=settings)
+    assert close(out["diffuse"], want) and np.abs(want - color).max() > 0.1
+    skin = nsss[..., 3] > 0
+    assert np.array_equal(out["diffuse"][~skin], color[~skin])
+
+
+def test_unknown_kernel_is_refused():
+    with pytest.raises(ValueError, match="sss.kernel"):
+        ref.SSSSettings.from_params({"sss.kernel": "3d"})

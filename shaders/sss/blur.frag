@@ -1,11 +1,23 @@
 #version 460
-// Separable screen-space subsurface scattering (Jimenez et al. 2015), one direction per pass.
-// passes/sss_ref.py:blur is the reference; keep the two in step.
+// Screen-space subsurface scattering (Jimenez et al. 2015). passes/sss_ref.py is the
+// reference (blur, blur_2d); keep the two in step.
+//   default:      one direction of the separable kernel per pass (HORIZONTAL 1 or 0);
+//   KERNEL_2D 1:  the non-separable 2D kernel of the same profile in one pass (TAPS taps);
+//   COPY 1:       copy the colour source unchanged (the vertical pass in 2D mode).
 #ifndef SAMPLES
 #define SAMPLES 17
 #endif
 #ifndef HORIZONTAL
 #define HORIZONTAL 1
+#endif
+#ifndef KERNEL_2D
+#define KERNEL_2D 0
+#endif
+#ifndef TAPS
+#define TAPS 1
+#endif
+#ifndef COPY
+#define COPY 0
 #endif
 
 layout(location = 0) in vec2 uv;
@@ -13,36 +25,56 @@ layout(location = 0) out vec4 result;
 layout(set = 0, binding = 0) uniform sampler2D color_tex;   // linear, clamp to edge
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;   // nearest
 layout(set = 0, binding = 2) uniform sampler2D normal_sss;  // nearest; .a = SSS strength
+#if KERNEL_2D
+layout(set = 0, binding = 3) uniform Kernel {
+    vec4 taps[2 * TAPS];  // [2i] rgb weight, [2i + 1] xy offset in [-R, R]^2; tap 0 is the centre
+    vec4 params;          // width (world), follow depth (world), P00 * width_px / 2 / 3, near
+    vec4 params2;         // P11 * height_px / 2 / 3, -, -, -
+} kern;
+#else
 layout(set = 0, binding = 3) uniform Kernel {
     vec4 taps[SAMPLES];  // rgb weight, a offset in [-R, R]; taps[0] is the centre
     vec4 params;         // width (world), follow depth (world), projection scale * size / 2 / 3, near
 } kern;
+#endif
+
+// The tap's colour lerped toward the centre's by the depth difference (follow-surface).
+vec3 follow(vec2 pos, ivec2 size, float z, vec3 centre) {
+    vec3 tap = texture(color_tex, pos / vec2(size)).rgb;
+    ivec2 t = clamp(ivec2(floor(pos)), ivec2(0), size - 1);
+    float dt = texelFetch(depth_tex, t, 0).r;
+    float s = dt > 0.0 ? clamp(abs(z - kern.params.w / dt) / kern.params.y, 0.0, 1.0) : 1.0;
+    return mix(tap, centre, s);
+}
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
+#if COPY
+    result = texelFetch(color_tex, p, 0);
+#else
     ivec2 size = textureSize(color_tex, 0);
     vec4 centre = texelFetch(color_tex, p, 0);
     float d = texelFetch(depth_tex, p, 0).r;
     float a = texelFetch(normal_sss, p, 0).a;
     float width = kern.params.x;
     if (a <= 0.0 || d <= 0.0 || width <= 0.0) { result = centre; return; }  // exact identity
-    float near = kern.params.w;
-    float z = near / d;
+    float z = kern.params.w / d;
+    vec2 c = vec2(p) + 0.5;
+    vec3 acc = centre.rgb * kern.taps[0].rgb;
+#if KERNEL_2D
+    vec2 stp = width * a * vec2(kern.params.z, kern.params2.x) / z;
+    for (int i = 1; i < TAPS; ++i)
+        acc += kern.taps[2 * i].rgb * follow(c + kern.taps[2 * i + 1].xy * stp, size, z, centre.rgb);
+#else
     float stp = width * a * kern.params.z / z;
 #if HORIZONTAL
     vec2 dir = vec2(1.0, 0.0);
 #else
     vec2 dir = vec2(0.0, 1.0);
 #endif
-    vec2 c = vec2(p) + 0.5;
-    vec3 acc = centre.rgb * kern.taps[0].rgb;
-    for (int i = 1; i < SAMPLES; ++i) {
-        vec2 pos = c + dir * (kern.taps[i].a * stp);
-        vec3 tap = texture(color_tex, pos / vec2(size)).rgb;
-        ivec2 t = clamp(ivec2(floor(pos)), ivec2(0), size - 1);
-        float dt = texelFetch(depth_tex, t, 0).r;
-        float s = dt > 0.0 ? clamp(abs(z - near / dt) / kern.params.y, 0.0, 1.0) : 1.0;
-        acc += kern.taps[i].rgb * mix(tap, centre.rgb, s);
-    }
+    for (int i = 1; i < SAMPLES; ++i)
+        acc += kern.taps[i].rgb * follow(c + dir * (kern.taps[i].a * stp), size, z, centre.rgb);
+#endif
     result = vec4(acc, centre.a);
+#endif
 }

@@ -44,7 +44,7 @@ def test_depth_to_compute_release_and_acquire_carry_no_layout_change(surgery):
         "DEPTH_ATTACHMENT_OPTIMAL", "DEPTH_ATTACHMENT_OPTIMAL", 0, 1, "DEPTH_READ_ONLY_OPTIMAL")
     # then the layout change, an ordinary barrier on the compute queue chained to the acquire
     assert transition == [BarrierSpec(
-        "depth", WHOLE, ("COMPUTE_SHADER",), (), ("COMPUTE_SHADER",), ("SHADER_SAMPLED_READ",),
+        "depth", WHOLE, ("COMPUTE_SHADER",), ("MEMORY_READ",), ("COMPUTE_SHADER",), ("SHADER_SAMPLED_READ",),
         "DEPTH_ATTACHMENT_OPTIMAL", "DEPTH_READ_ONLY_OPTIMAL", None, None, "DEPTH_READ_ONLY_OPTIMAL")]
 
 
@@ -64,8 +64,8 @@ def test_ao_back_to_graphics(surgery):
     assert ao.src_stages == ao.dst_stages == ("FRAGMENT_SHADER",)
     assert set(ao.src_stages) <= wait_stages
     # depth keeps its layout across the transfer: no second barrier for it
-    assert [(s.resource, s.old_layout, s.new_layout, s.src_family, s.src_stages) for s in groups[1]] == [
-        ("ao", "GENERAL", "SHADER_READ_ONLY_OPTIMAL", None, ("FRAGMENT_SHADER",))]
+    assert [(s.resource, s.old_layout, s.new_layout, s.src_family, s.src_stages, s.src_access) for s in groups[1]] == [
+        ("ao", "GENERAL", "SHADER_READ_ONLY_OPTIMAL", None, ("FRAGMENT_SHADER",), ("MEMORY_READ",))]
 
 
 def test_one_family_merges_each_pair_into_one_barrier_at_the_acquire(surgery):
@@ -108,6 +108,28 @@ def test_every_acquire_chains_to_its_semaphore_wait(tmp_path, seed):
         for spec in transitions:
             acquire = next(a for a in acquires if a.resource == spec.resource and a.subresource == spec.subresource)
             assert spec.src_stages == acquire.dst_stages and spec.old_layout == acquire.new_layout
+            assert spec.src_access == ("MEMORY_READ",)
             assert (spec.src_family, spec.dst_family) == (None, None)
     if seed == 0:
         assert transfers, "seed 0 should exercise at least one ownership transfer"
+
+
+def test_transition_after_reads_names_memory_read():
+    """A transition whose plan src is reads only (stages, no access) records srcAccessMask
+    MEMORY_READ (a no-op by the spec; the form the 1.3.239 layer credits across command
+    buffers); transitions after writes and from UNDEFINED keep the plan's src access."""
+    def barrier(src_stages, src_access, old, new):
+        return {"resource": "a", "subresource": WHOLE, "aliases": None,
+                "src": {"stages": src_stages, "access": src_access, "layout": old, "queue": "graphics"},
+                "dst": {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_SAMPLED_READ"], "layout": new,
+                        "queue": "graphics"}}
+    after_reads, alias_after_reads, after_write, first_use, same_layout = (
+        lower_barriers([b], "barrier", TWO_FAMILIES)[0][0] for b in (
+            barrier(["COMPUTE_SHADER"], [], "GENERAL", "SHADER_READ_ONLY_OPTIMAL"),
+            barrier(["COMPUTE_SHADER"], [], "UNDEFINED", "GENERAL"),  # aliased memory after its reads
+            barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "GENERAL", "SHADER_READ_ONLY_OPTIMAL"),
+            barrier([], [], "UNDEFINED", "GENERAL"),
+            barrier(["COMPUTE_SHADER"], [], "GENERAL", "GENERAL")))
+    assert after_reads.src_access == alias_after_reads.src_access == ("MEMORY_READ",)
+    assert after_write.src_access == ("SHADER_STORAGE_WRITE",)
+    assert first_use.src_access == () and same_layout.src_access == ()

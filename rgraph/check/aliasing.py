@@ -4,7 +4,9 @@ Resources on the same heap whose byte ranges overlap share memory. If both are a
 at once (by the passes that actually touch them) that is an overlap error. Otherwise
 the later one's first barrier must hand the memory over from each earlier occupant it
 directly follows on some byte (an older occupant fully covered by a later one was
-already handed over to that one).
+already handed over to that one -- if that later one touches all of its subresources:
+one that touches only some hands over only their bytes, so the older occupant still
+needs a hand-off from the next resource on its bytes).
 """
 
 from __future__ import annotations
@@ -85,6 +87,7 @@ def analyse(plan: Plan) -> AliasInfo:
                 else:
                     earlier.setdefault(a, []).append(b)
 
+    whole = _wholly_touched(plan)
     for later, candidates in earlier.items():
         rl = plan.resources[later]
         lo, hi = rl.offset or 0, (rl.offset or 0) + (rl.bytes or 0)
@@ -95,9 +98,26 @@ def analyse(plan: Plan) -> AliasInfo:
             span = (max(lo, re_.offset or 0), min(hi, (re_.offset or 0) + (re_.bytes or 0)))
             if not _covered(span, covered):
                 chosen.append(e)
-            covered = _union(covered, span)
+            if whole[e]:
+                covered = _union(covered, span)
         info.handoffs[later] = chosen
     return info
+
+
+def _wholly_touched(plan: Plan) -> list[bool]:
+    """Per resource: do the frame's accesses touch every subresource (buffers: any access)?"""
+    cells: list[set[tuple[int, int]] | None] = [None] * len(plan.resources)
+    for p in plan.passes:
+        for a in p.accesses:
+            if a.resource < 0:
+                continue
+            res = plan.resources[a.resource]
+            seen = cells[a.resource] if cells[a.resource] is not None else set()
+            rect = a.rect or res.whole
+            seen.update((m, layer) for m in range(rect[0], rect[1]) for layer in range(rect[2], rect[3]))
+            cells[a.resource] = seen
+    return [c is not None and (not res.is_image or len(c) == res.mips * res.layers)
+            for c, res in zip(cells, plan.resources, strict=True)]
 
 
 def _covered(span: tuple[int, int], intervals: list[tuple[int, int]]) -> bool:

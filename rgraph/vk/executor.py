@@ -363,7 +363,12 @@ class Executor:
                 for j, bi in enumerate(run):
                     batch = self.batches[bi]
                     first, last = batch.passes[0], batch.passes[-1]
-                    waits = [(w["queue"], w["value"], names.stages(w["stages"])) for w in first["waits"]]
+                    # A wait on a plan queue that shares this batch's VkQueue is left out: submission
+                    # order and the plan's barriers (ownership pairs merged at the acquire) order them,
+                    # and the 1.3.239 layer treats timeline semaphores as binary, so such a wait re-imports
+                    # an older snapshot of the queue's accesses (false WRITE_AFTER_WRITE after it).
+                    waits = [(w["queue"], w["value"], names.stages(w["stages"])) for w in first["waits"]
+                             if handle_of[w["queue"]] != handle_of[batch.queue]]
                     if distinct and first_of[batch.queue] == bi:  # frame start: the previous frame is done
                         waits += [(q, 0, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) for q in queues if q != batch.queue]
                     signals = [(sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in last["signals"]]

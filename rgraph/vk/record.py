@@ -72,35 +72,63 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int])
       out of the pair also keeps a layer that does not model ownership transfers (1.3.239,
       DESIGN.md) from counting one transition twice; release/acquire access masks follow the
       spec (release: no dst access, acquire: no src access).
+    - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``).
     """
     first: list[BarrierSpec] = []
     after: list[BarrierSpec] = []
     for b in barriers:
-        src, dst = b["src"], b["dst"]
-        sub = b.get("subresource")
-        crossing = src["queue"] != dst["queue"]
-        transfer = crossing and families[src["queue"]] != families[dst["queue"]]
-        aspect = dst["layout"] if dst["layout"] not in (None, "UNDEFINED") else src["layout"]
-        src_stages, src_access = tuple(src["stages"]), tuple(src["access"])
-        dst_stages, dst_access = tuple(dst["stages"]), tuple(dst["access"])
-        if not transfer:
-            if crossing and role == "release":
-                continue  # same family: executed once, at the acquire point
-            first.append(BarrierSpec(b["resource"], sub, src_stages, src_access, dst_stages, dst_access,
-                                     src["layout"], dst["layout"], None, None, aspect))
-            continue
-        families_pair = (families[src["queue"]], families[dst["queue"]])
-        held = src["layout"]  # the layout the resource keeps while it changes hands
-        if role == "release":
-            first.append(BarrierSpec(b["resource"], sub, src_stages, src_access, (), (), held, held,
-                                     *families_pair, aspect))
-            continue
-        first.append(BarrierSpec(b["resource"], sub, dst_stages, (), dst_stages, dst_access, held, held,
-                                 *families_pair, aspect))
-        if src["layout"] != dst["layout"]:
-            after.append(BarrierSpec(b["resource"], sub, dst_stages, (), dst_stages, dst_access, src["layout"],
-                                     dst["layout"], None, None, aspect))
+        for group, spec in _lower_one(b, role, families):
+            (first if group == 0 else after).append(_after_reads(spec))
     return [group for group in (first, after) if group]
+
+
+#: srcAccessMask of a layout transition that follows reads (see ``_after_reads``).
+AFTER_READS_ACCESS = ("MEMORY_READ",)
+
+
+def _after_reads(spec: BarrierSpec) -> BarrierSpec:
+    """A layout transition whose src scope is reads only (src stages, no src access) gets
+    srcAccessMask MEMORY_READ. By the spec this is a no-op: availability operations concern
+    writes, the write before those reads was made available by the barrier in front of them,
+    and the transition is ordered after it through the reads' stages (an execution chain).
+    The 1.3.239 layer credits that chain inside one command buffer but not at submit time
+    across command buffers: there it wants the transition's src access scope to meet the
+    accesses the write was made visible to (the reads), and otherwise reports
+    WRITE_AFTER_WRITE for "storage write -> (barrier, no layout change) -> storage read ->
+    transition" (random graphs seed 0 and 9, tests/test_run_fuzz.py), and likewise for an
+    aliased resource's first transition (from UNDEFINED) after the previous occupant's reads
+    (seeds 0 and 32 with 10 passes, aliased). Naming the reads in srcAccessMask records the
+    same dependency in the form the layer understands."""
+    if spec.old_layout is not None and spec.old_layout != spec.new_layout and spec.src_stages and not spec.src_access:
+        return BarrierSpec(spec.resource, spec.subresource, spec.src_stages, AFTER_READS_ACCESS, spec.dst_stages,
+                           spec.dst_access, spec.old_layout, spec.new_layout, spec.src_family, spec.dst_family,
+                           spec.aspect_layout)
+    return spec
+
+
+def _lower_one(b: dict, role: str, families: Mapping[str, int]) -> list[tuple[int, BarrierSpec]]:
+    """(call index, struct) pairs for one plan barrier (see ``lower_barriers``)."""
+    src, dst = b["src"], b["dst"]
+    resource, sub = b["resource"], b.get("subresource")
+    crossing = src["queue"] != dst["queue"]
+    transfer = crossing and families[src["queue"]] != families[dst["queue"]]
+    aspect = dst["layout"] if dst["layout"] not in (None, "UNDEFINED") else src["layout"]
+    src_stages, src_access = tuple(src["stages"]), tuple(src["access"])
+    dst_stages, dst_access = tuple(dst["stages"]), tuple(dst["access"])
+    if not transfer:
+        if crossing and role == "release":
+            return []  # same family: executed once, at the acquire point
+        return [(0, BarrierSpec(resource, sub, src_stages, src_access, dst_stages, dst_access, src["layout"],
+                                dst["layout"], None, None, aspect))]
+    pair = (families[src["queue"]], families[dst["queue"]])
+    held = src["layout"]  # the layout the resource keeps while it changes hands
+    if role == "release":
+        return [(0, BarrierSpec(resource, sub, src_stages, src_access, (), (), held, held, *pair, aspect))]
+    out = [(0, BarrierSpec(resource, sub, dst_stages, (), dst_stages, dst_access, held, held, *pair, aspect))]
+    if src["layout"] != dst["layout"]:
+        out.append((1, BarrierSpec(resource, sub, dst_stages, (), dst_stages, dst_access, src["layout"], dst["layout"],
+                                   None, None, aspect)))
+    return out
 
 
 @dataclass

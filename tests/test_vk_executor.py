@@ -120,10 +120,10 @@ CAUGHT_BY = {
     "compute_storage": {"syncval"},  # GENERAL -> GENERAL: a pure memory dependency
     "transfer_copy": {"syncval", "validation"},
     "array_layers": {"syncval", "validation"},
-    # The acquire barrier of the ownership pair: the semaphore wait (ALL_COMMANDS) already orders
-    # and makes the writes visible when both queues share one family: nothing can catch this drop
-    # on lavapipe (on a multi-family GPU it is a missing ownership acquire).
-    "cross_queue": set(),
+    # The acquire barrier of the ownership pair: both plan queues share lavapipe's one VkQueue, where
+    # the runtime records no semaphore wait between them (submission order and the plan's barriers
+    # order them), so syncval sees the missing barrier (on a multi-family GPU it is a missing acquire).
+    "cross_queue": {"syncval"},
     "aliasing": {"syncval", "validation"},
     "persistent_history": {"syncval"},  # frame N+1 vs frame N, caught at submit time
     "geometry_inputs": {"syncval"},
@@ -206,3 +206,43 @@ def _execute_unvalidated(plan, frames):
         return execute_plan(plan, validate=False, frames=frames, check_data=True)
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
+
+
+EMPTY_GRAPH = """rgraph: 1
+name: all_culled
+resources:
+  img: {kind: image, format: r8g8b8a8_unorm, size: [16, 16]}
+passes:
+  p: {kind: compute, writes: {img: storage_write}}
+outputs: []
+"""
+
+
+def test_plan_with_every_pass_culled_runs_clean(tmp_path):
+    """Zero passes: no submits, no fences to wait for (a fence wait of count 0 is invalid)."""
+    from rgraph.compile.pipeline import compile_graph
+
+    path = tmp_path / "g.yaml"
+    path.write_text(EMPTY_GRAPH)
+    plan = compile_graph(path, size=(16, 16))
+    assert plan["passes"] == [] and [c["pass"] for c in plan["culled"]] == ["p"]
+    result = _execute(plan, frames=3)
+    assert [str(m) for m in result.messages] == []
+    assert result.timings["passes"] == {} and result.timings["total_ms"] is None
+
+
+def test_run_command_reports_what_was_culled(tmp_path, capsys):
+    from rgraph.cli import main
+
+    path = tmp_path / "g.yaml"
+    path.write_text(EMPTY_GRAPH)
+    try:
+        status = main(["run", str(path), "--size", "16x16", "--validate", "--frames", "2"])
+    except VulkanUnavailable as exc:  # pragma: no cover
+        pytest.skip(str(exc))
+    err = capsys.readouterr().err
+    if "no Vulkan device" in err:  # pragma: no cover
+        pytest.skip(err)
+    assert status == 0, err
+    assert "every pass was culled" in err and "culled p: reaches no output" in err
+    assert "0 validation message(s)" in err

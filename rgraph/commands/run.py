@@ -82,7 +82,12 @@ def run(args: argparse.Namespace) -> int:
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
-    _print_table(plan, result.timings)
+    if plan["passes"]:
+        _print_table(plan, result.timings)
+    else:
+        print("rgraph: nothing to execute: every pass was culled", file=sys.stderr)
+    for entry in plan.get("culled", []):
+        print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
     if args.timings:
         args.timings.write_text(json.dumps({"device": result.device_name, **result.timings}, indent=1,
                                            sort_keys=True) + "\n")

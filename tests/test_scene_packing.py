@@ -70,3 +70,23 @@ def test_frame_and_tables_hold_the_scene():
 def test_hi_lo_split_restores_float64(value):
     hi, lo = packing.split_hi_lo(np.array([value]))
     assert abs(float(hi[0]) + float(lo[0]) - value) <= abs(value) * 2.0 ** -46 + 1e-30
+
+
+def test_vectorized_draws_equal_the_per_draw_float64_construction():
+    """draws_bytes caches world matrices and subtracts the camera in float64 for all draws at
+    once; it must give the same bytes as building each camera-relative matrix on its own."""
+    import numpy as np
+
+    from rgraph.scene import packing
+    from rgraph.scene.build import build_scene
+    from rgraph.spec.scene import load_scene
+
+    scene = build_scene(load_scene("graphs/scenes/cct.yaml").model, (64, 36))
+    draws = scene.draw_models(scene.camera(0).position)
+    want = np.zeros((len(draws), packing.DRAW_BYTES // 4), dtype=np.float32)
+    for k, (model, normal, material, mesh, flags) in enumerate(draws):
+        want[k, 0:16] = packing.mat(model)
+        want[k, 16:32] = packing.mat(normal)
+        want.view(np.uint32)[k, 32:36] = (material, mesh, flags, 0)
+    assert packing.draws_bytes(scene, 0) == want.tobytes()
+    assert packing.draws_bytes(scene, 7) == want.tobytes()  # static camera: the same every frame

@@ -115,10 +115,13 @@ class SceneData:
         return frame * FRAME_SECONDS
 
     def camera(self, frame: int = 0) -> CameraState:
-        """The camera of ``frame`` (static: the scene file's)."""
-        c = self.model.camera
-        w, h = self.extent
-        return camera_state(c.position, c.look_at, c.up, c.fov_y, c.near, w / h)
+        """The camera of ``frame`` (static: the scene file's; computed once)."""
+        cached = self.__dict__.get("_camera")
+        if cached is None:
+            c = self.model.camera
+            w, h = self.extent
+            cached = self.__dict__["_camera"] = camera_state(c.position, c.look_at, c.up, c.fov_y, c.near, w / h)
+        return cached
 
     def draw_models(self, camera_position: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, int, int, int]]:
         """Per draw, in draw order: (camera-relative model, normal matrix, material, mesh index,

@@ -40,7 +40,21 @@ def split_hi_lo(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def frame_bytes(scene: SceneData, frame: int) -> bytes:
+    """The Frame uniform for ``frame``. Everything but the time fields depends on the camera
+    alone and is cached per camera state (the per-frame cost is the camera and a copy)."""
     cam = scene.camera(frame)
+    key = (np.asarray(cam.position, dtype=np.float64).tobytes(), np.asarray(cam.view_proj).tobytes())
+    cached = getattr(scene, "_frame_cache", None)
+    if cached is None or cached[0] != key:
+        cached = (key, _frame_for_camera(scene, cam))
+        scene._frame_cache = cached  # type: ignore[attr-defined]
+    f = cached[1].copy()
+    o = FRAME_OFFSETS["time"] // 4
+    f[o:o + 4] = (scene.seconds(frame), float(frame), cam.near, np.radians(cam.fov_y_deg))
+    return f.tobytes()
+
+
+def _frame_for_camera(scene: SceneData, cam) -> np.ndarray:
     f = np.zeros(FRAME_BYTES // 4, dtype=np.float32)
     i = f.view(np.int32)
 
@@ -65,7 +79,6 @@ def frame_bytes(scene: SceneData, frame: int) -> bytes:
     directional = sum(1 for li in scene.lights if li.type == LIGHT_TYPES["directional"])
     i[o:o + 8] = (len(scene.lights), len(scene.shadow_lights), len(scene.decals), scene.point_light_count,
                   len(scene.materials), scene.draw_count, directional, len(scene.deformable))
-    put("time", (scene.seconds(frame), float(frame), cam.near, np.radians(cam.fov_y_deg)))
     sun = next((li for li in scene.lights if li.type == LIGHT_TYPES["directional"]), None)
     if sun is not None:
         put("sun_direction", (*(-sun.direction), float(sun.shadow_layer)))
@@ -79,18 +92,36 @@ def frame_bytes(scene: SceneData, frame: int) -> bytes:
     pts = scene.bounds_rel(cam.position)
     centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
     put("scene_bounds", (*centre, float(np.linalg.norm(pts - centre, axis=1).max())))
-    return f.tobytes()
+    return f
+
+
+def _draw_table(scene: SceneData) -> tuple[np.ndarray, np.ndarray]:
+    """Per scene, once: (N, 4, 4) float64 world model matrices and the packed (N, DRAW_BYTES/4)
+    float32 rows with everything but the camera-relative model (normal matrix, ids)."""
+    table = getattr(scene, "_packed_draw_table", None)
+    if table is None:
+        draws = scene.draw_models(np.zeros(3))  # relative to the origin: world space
+        world = np.stack([m for m, *_ in draws]) if draws else np.zeros((0, 4, 4))
+        rows = np.zeros((max(len(draws), 1), DRAW_BYTES // 4), dtype=np.float32)
+        ints = rows.view(np.uint32)
+        for k, (_model, normal, material, mesh, flags) in enumerate(draws):
+            rows[k, 16:32] = mat(normal)
+            ints[k, 32:36] = (material, mesh, flags, 0)
+        table = (world, rows)
+        scene._packed_draw_table = table  # type: ignore[attr-defined]
+    return table
 
 
 def draws_bytes(scene: SceneData, frame: int) -> bytes:
-    draws = scene.draw_models(scene.camera(frame).position)
-    out = np.zeros((max(len(draws), 1), DRAW_BYTES // 4), dtype=np.float32)
-    ints = out.view(np.uint32)
-    for k, (model, normal, material, mesh, flags) in enumerate(draws):
-        out[k, 0:16] = mat(model)
-        out[k, 16:32] = mat(normal)
-        ints[k, 32:36] = (material, mesh, flags, 0)
-    return out.tobytes()
+    """The Draws buffer for ``frame``: camera-relative model matrices (translation minus the
+    camera formed in float64, then cast) - vectorized over draws; the rest is cached."""
+    world, rows = _draw_table(scene)
+    n = len(world)
+    if n:
+        rel = world.copy()
+        rel[:, :3, 3] -= np.asarray(scene.camera(frame).position, dtype=np.float64)
+        rows[:n, 0:16] = rel.transpose(0, 2, 1).astype(np.float32).reshape(n, 16)
+    return rows.tobytes()
 
 
 def materials_bytes(scene: SceneData) -> bytes:
@@ -110,6 +141,16 @@ def scene_lights_bytes(scene: SceneData) -> bytes:
 
 
 def decals_bytes(scene: SceneData, frame: int) -> bytes:
+    """The Decals buffer for ``frame`` (camera-relative boxes; cached per camera position)."""
+    position = np.asarray(scene.camera(frame).position, dtype=np.float64)
+    cached = getattr(scene, "_decals_cache", None)
+    if cached is None or cached[0] != position.tobytes():
+        cached = (position.tobytes(), _decals_for_camera(scene, frame))
+        scene._decals_cache = cached  # type: ignore[attr-defined]
+    return cached[1]
+
+
+def _decals_for_camera(scene: SceneData, frame: int) -> bytes:
     out = np.zeros((max(len(scene.decals), 1), DECAL_BYTES // 4), dtype=np.float32)
     for k, (d, m) in enumerate(zip(scene.decals, scene.decal_matrices(scene.camera(frame).position), strict=True)):
         out[k, 0:16] = mat(m)

@@ -19,6 +19,7 @@ REQUIRED_13 = ("synchronization2", "maintenance4")
 OPTIONAL_CORE = (
     "fragmentStoresAndAtomics", "vertexPipelineStoresAndAtomics", "shaderStorageImageWriteWithoutFormat",
     "shaderStorageImageReadWithoutFormat", "drawIndirectFirstInstance", "multiDrawIndirect", "independentBlend",
+    "shaderFloat64",  # float64 transform variants (the large-world study)
 )
 
 

@@ -16,8 +16,13 @@ wall time (perf_counter over many pipelined frames). Two figures: the span from 
 pass's start to the last pass's end (gaps between passes count as busy), and the sum of the
 per-pass times capped at the span (gaps excluded when passes do not overlap); target >= 95%.
 
+``--compare-sync WxH`` instead compares the normal plan with ``--sync naive`` (a full
+barrier before every pass, one queue, no semaphores) at that size, in one process:
+rounds alternate the two plans; each reports wall ms per frame over ``--busy-frames``
+pipelined frames and the GPU span (first pass start to last pass end, median).
+
     python benchmarks/frame_cpu.py [--frames 2000] [--busy-frames 300] [--size 64x64]
-        [--policy P] [--passes probe|real]
+        [--policy P] [--passes probe|real] [--compare-sync 1920x1080 [--rounds 3]]
 """
 
 from __future__ import annotations
@@ -86,6 +91,28 @@ def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
             "sum_fraction": summed / wall_ms, "cpu_submit_ms": timings["cpu_submit_ms"]}
 
 
+def compare_sync(size: tuple[int, int], frames: int, policy: str | None, passes: str, rounds: int) -> None:
+    plans = {}
+    for mode in ("normal", "naive"):
+        plan, device, _ = compile_for_device(size, policy, sync=mode)
+        plans[mode] = probe_only(plan) if passes == "probe" else plan
+    print(f"device: {device}")
+    print(f"surgery {size[0]}x{size[1]} ({passes} passes), {frames} frames per round; normal: "
+          f"{plans['normal']['stats']['barriers']} barriers, {plans['normal']['stats']['semaphores']} semaphores, "
+          f"queues {plans['normal']['queues']}; naive: {plans['naive']['stats']['barriers']} barriers, one queue")
+    results: dict[str, list[dict[str, float]]] = {"normal": [], "naive": []}
+    for r in range(rounds):
+        for mode in ("normal", "naive") if r % 2 == 0 else ("naive", "normal"):
+            busy = gpu_busy(plans[mode], frames)
+            results[mode].append(busy)
+            print(f"  round {r} {mode:6s}: wall {busy['wall_ms']:.3f} ms/frame, GPU span {busy['span_ms']:.3f} ms")
+    wall = {m: statistics.median(b["wall_ms"] for b in v) for m, v in results.items()}
+    span = {m: statistics.median(b["span_ms"] for b in v) for m, v in results.items()}
+    print(f"median of rounds: normal wall {wall['normal']:.3f} ms, span {span['normal']:.3f} ms; naive wall "
+          f"{wall['naive']:.3f} ms, span {span['naive']:.3f} ms; naive/normal wall {wall['naive'] / wall['normal']:.3f}, "
+          f"span {span['naive'] / span['normal']:.3f}")
+
+
 def _summary(values: list[float]) -> str:
     deciles = statistics.quantiles(values, n=10)
     return f"median {statistics.median(values):.1f} us, p10 {deciles[0]:.1f} us, p90 {deciles[-1]:.1f} us"
@@ -99,7 +126,13 @@ def main() -> None:
     parser.add_argument("--policy", default=None, help="memory placement policy (default: the compiler's)")
     parser.add_argument("--passes", choices=("probe", "real"), default="probe",
                         help="probe: every pass by the probe (the runtime's own cost); real: the graph's passes")
+    parser.add_argument("--compare-sync", metavar="WxH", help="compare normal and --sync naive plans at this size")
+    parser.add_argument("--rounds", type=int, default=3, help="rounds of --compare-sync (default 3)")
     args = parser.parse_args()
+    if args.compare_sync:
+        cw, ch = (int(x) for x in args.compare_sync.lower().split("x"))
+        compare_sync((cw, ch), args.busy_frames, args.policy, args.passes, args.rounds)
+        return
     w, h = (int(x) for x in args.size.lower().split("x"))
     plan, device, is_gpu = compile_for_device((w, h), args.policy)
     if args.passes == "probe":

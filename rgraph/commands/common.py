@@ -37,6 +37,13 @@ def add_graph_arguments(parser: argparse.ArgumentParser, *, size_default: str = 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, blocks:SIZE, tlsf")
     parser.add_argument("--profile", help="device profile (bundled name or JSON path) for sizes and alignments")
+    add_sync_argument(parser)
+
+
+def add_sync_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--sync", default="normal", choices=("normal", "naive"),
+                        help="normal (default): the barrier generator's plan; naive: a full barrier before "
+                             "every pass, all passes on the graphics queue, no semaphores (for comparison)")
 
 
 def compile_from_args(args: argparse.Namespace) -> dict:
@@ -49,4 +56,5 @@ def compile_from_args(args: argparse.Namespace) -> dict:
         size=parse_size(args.size),
         policy=getattr(args, "policy", None),
         profile=getattr(args, "profile", None),
+        sync=getattr(args, "sync", "normal"),
     )

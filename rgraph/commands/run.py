@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
+from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
 from rgraph.errors import RGraphError
 
 
@@ -15,6 +15,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
     add_graph_arguments(parser, size_default="640x360")
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
+    add_sync_argument(parser)
     parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
     parser.add_argument("--validate", action="store_true",
                         help="Khronos validation + synchronization validation; exit 1 on any message")
@@ -34,6 +35,10 @@ def _load_plan(args: argparse.Namespace) -> dict:
         plan, _ = load_plan_file(path)
         if plan.get("format") != "rgraph-plan/1":
             raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
+        if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
+            from rgraph.compile.pipeline import apply_sync_mode
+
+            plan = apply_sync_mode(plan, "naive")
         return plan
     from rgraph.compile.pipeline import compile_graph
     from rgraph.vk.device import create_device
@@ -46,7 +51,7 @@ def _load_plan(args: argparse.Namespace) -> dict:
         try:
             return compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
                                  size=parse_size(args.size), policy=args.policy,
-                                 memory=DeviceMemoryRequirements(device))
+                                 memory=DeviceMemoryRequirements(device), sync=args.sync)
         finally:
             device.destroy()
     finally:

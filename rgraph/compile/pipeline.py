@@ -135,11 +135,14 @@ def compile_graph(
     memory: MemoryRequirementsProvider | None = None,
     profile: str | None = None,
     extra_outputs: Sequence[str] = (),
+    sync: str = "normal",
 ) -> dict[str, Any]:
     """Compile a graph file (or bundled graph name) into a plan dict.
 
     ``extra_outputs`` names resources kept as outputs besides the graph's own (their
     writers are not culled and the runtime reads them back), e.g. an HDR intermediate.
+    ``sync="naive"`` transforms the plan with ``rgraph.compile.naive_sync`` (a full barrier
+    before every pass, one queue, no semaphores), for comparison.
     """
     front = frontend(graph, scene_path, params, size)
     add_outputs(front.spec, extra_outputs)
@@ -151,4 +154,19 @@ def compile_graph(
         provider = ProfileMemoryRequirements.named(profile)
         profile_name = provider.name
     chosen = policy or front.source.memory_policy or DEFAULT_POLICY
-    return compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name)
+    plan = compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name)
+    return apply_sync_mode(plan, sync)
+
+
+SYNC_MODES = ("normal", "naive")
+
+
+def apply_sync_mode(plan: dict[str, Any], sync: str) -> dict[str, Any]:
+    """``plan`` as is ("normal") or transformed by ``rgraph.compile.naive_sync`` ("naive")."""
+    if sync == "normal":
+        return plan
+    if sync == "naive":
+        from rgraph.compile.naive_sync import naive_sync
+
+        return naive_sync(plan)
+    raise RGraphError.in_file("<command line>", f"--sync expects one of {', '.join(SYNC_MODES)}, got '{sync}'")

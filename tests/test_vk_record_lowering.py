@@ -133,3 +133,20 @@ def test_transition_after_reads_names_memory_read():
     assert after_reads.src_access == alias_after_reads.src_access == ("MEMORY_READ",)
     assert after_write.src_access == ("SHADER_STORAGE_WRITE",)
     assert first_use.src_access == () and same_layout.src_access == ()
+
+
+def test_barriers_of_a_pass_with_a_cross_queue_wait_chain_to_it():
+    """An ordinary barrier whose src stages belong to another queue's work (an aliased
+    resource's previous occupant, read on the compute queue) adds the wait's stages to its src
+    stages, so it is ordered after the semaphore wait; acquires and first uses are unchanged."""
+    alias = {"resource": "a", "subresource": WHOLE, "aliases": "old",
+             "src": {"stages": ["COMPUTE_SHADER"], "access": [], "layout": "UNDEFINED", "queue": "graphics"},
+             "dst": {"stages": ["COLOR_ATTACHMENT_OUTPUT"], "access": ["COLOR_ATTACHMENT_WRITE"],
+                     "layout": "COLOR_ATTACHMENT_OPTIMAL", "queue": "graphics"}}
+    first_use = {**alias, "resource": "b", "aliases": None, "src": {**alias["src"], "stages": []}}
+    wait = ["COLOR_ATTACHMENT_OUTPUT", "FRAGMENT_SHADER"]
+    (group,) = lower_barriers([alias, first_use], "barrier", TWO_FAMILIES, wait)
+    assert _only(group, "a").src_stages == ("COLOR_ATTACHMENT_OUTPUT", "COMPUTE_SHADER", "FRAGMENT_SHADER")
+    assert _only(group, "b").src_stages == ()
+    (unchained,) = lower_barriers([alias], "barrier", TWO_FAMILIES)
+    assert unchained[0].src_stages == ("COMPUTE_SHADER",)

@@ -301,7 +301,8 @@ class Executor:
                     if timestamps:
                         v.vkCmdResetQueryPool(cb, self.query_pools[s], 2 * i, 2)
                         v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
-                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier"):
+                    waited = [st for w in p["waits"] if not dev.same_queue(w["queue"], p["queue"]) for st in w["stages"]]
+                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", waited):
                         self.barrier_batches.append(barriers)
                         v.vkCmdPipelineBarrier2(cb, barriers.dependency)
                     self.passes[i].record(ctx, s)
@@ -374,6 +375,7 @@ class Executor:
                     signals = [(sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in last["signals"]]
                     if last_by_plan_queue[batch.queue] == bi:
                         signals.append((batch.queue, self.frame_span[batch.queue], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT))
+                    waits, signals = _one_per_semaphore(waits), _one_per_semaphore(signals)
                     info = infos[j]
                     info.sType = v.VK_STRUCTURE_TYPE_SUBMIT_INFO_2
                     for count_field, array_field, specs in (("waitSemaphoreInfoCount", "pWaitSemaphoreInfos", waits),
@@ -607,6 +609,20 @@ class Executor:
         if self.instance is not None and self.instance.handle is not None:
             self.instance.destroy()
         return self.instance.log.messages
+
+
+def _one_per_semaphore(specs: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
+    """One (queue, value offset, stage mask) per timeline semaphore: the highest value and the
+    union of the stages. Timeline semantics make this equivalent (a wait for the higher value
+    covers the lower; one signal of the higher value satisfies every wait up to it), and it
+    pairs each signal with its waits for the 1.3.239 layer, which treats timeline semaphores
+    as binary (two waits or two signals of one semaphore in one submit made it import stale
+    state: WRITE_RACING_WRITE / READ_RACING_WRITE across queues on an H100)."""
+    merged: dict[str, tuple[int, int]] = {}
+    for q, offset, stages in specs:
+        prev = merged.get(q)
+        merged[q] = (max(offset, prev[0]), stages | prev[1]) if prev else (offset, stages)
+    return [(q, offset, stages) for q, (offset, stages) in merged.items()]
 
 
 def _check(result: int, call: str) -> None:

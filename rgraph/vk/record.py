@@ -7,7 +7,7 @@ push constants. It has no barrier calls: the graph owns synchronization.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from rgraph.vk import names
@@ -47,7 +47,8 @@ class BarrierSpec:
     aspect_layout: str | None = None
 
 
-def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int]) -> list[list[BarrierSpec]]:
+def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
+                   wait_stages: Sequence[str] = ()) -> list[list[BarrierSpec]]:
     """Plan barriers -> the vkCmdPipelineBarrier2 calls that execute them, in recording order.
 
     ``role`` is "barrier" (before the pass) or "release" (after it); ``families`` maps plan
@@ -73,11 +74,19 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int])
       DESIGN.md) from counting one transition twice; release/acquire access masks follow the
       spec (release: no dst access, acquire: no src access).
     - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``).
+    - ``wait_stages``: the stages of the pass's semaphore waits on another VkQueue. Every
+      barrier before the pass with a src scope adds them to its src stages, so it chains to
+      the wait: a plan barrier's src stages may name another queue's stages (an aliased
+      resource's previous occupant read on the compute queue, say), which on this queue are
+      ordered after nothing the semaphore covers (an H100 run: WRITE_AFTER_READ in forward).
     """
     first: list[BarrierSpec] = []
     after: list[BarrierSpec] = []
+    chain = tuple(sorted(set(wait_stages)))
     for b in barriers:
         for group, spec in _lower_one(b, role, families):
+            if chain and group == 0 and spec.src_stages and spec.src_family is None:
+                spec = replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(chain))))
             (first if group == 0 else after).append(_after_reads(spec))
     return [group for group in (first, after) if group]
 
@@ -141,11 +150,11 @@ class BarrierBatch:
 
 
 def build_barriers(device: Device, resources: ResourceSet, set_index: int, barriers: list[dict],
-                   role: str) -> list[BarrierBatch]:
+                   role: str, wait_stages: Sequence[str] = ()) -> list[BarrierBatch]:
     """Sync2 structs for plan barriers (see ``lower_barriers``): one batch per
     vkCmdPipelineBarrier2, to be recorded in order; [] when there is nothing to record."""
     return [_dependency(resources, set_index, group)
-            for group in lower_barriers(barriers, role, device.families)]
+            for group in lower_barriers(barriers, role, device.families, wait_stages)]
 
 
 def _family(index: int | None) -> int:

@@ -136,10 +136,10 @@ def has_float64(device_index: int | None = None) -> tuple[bool, str]:
 def gpu_run(mode: int, distance: float, *, size: tuple[int, int], frames: int, instances: int, triangles: int,
             validate: bool = False, device_index: int | None = None) -> dict[str, Any]:
     """Median GPU ms of the transform pass, the image, and validation messages."""
-    from rgraph.compile.pipeline import compile_graph
     from rgraph.vk.executor import execute_plan
+    from rgraph.vk.memreq import compile_for_device
 
-    plan = compile_graph(GPU_GRAPH, size=size, params={"lw.mode": str(mode), "lw.distance": repr(float(distance)),
+    plan = compile_for_device(GPU_GRAPH, device_index, size=size, params={"lw.mode": str(mode), "lw.distance": repr(float(distance)),
                                                        "lw.instances": str(instances), "lw.triangles": str(triangles)})
     result = execute_plan(plan, validate=validate, frames=frames, device_index=device_index, read_outputs=True,
                           check_data=False)

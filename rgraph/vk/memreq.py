@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 from rgraph.vk import names
 from rgraph.vk.device import Device
@@ -60,3 +61,22 @@ class DeviceMemoryRequirements:
         v.vkGetDeviceBufferMemoryRequirements(self.device.handle, query, out)
         req = out.memoryRequirements
         return int(req.size), int(req.alignment), int(req.memoryTypeBits)
+
+
+def compile_for_device(graph: Any, device_index: int | None = None, **options: Any) -> dict:
+    """``compile_graph(graph, **options)`` with sizes and alignments from the live device that
+    ``execute_plan(..., device_index=device_index)`` will use (a plan compiled for another
+    device's profile is refused by the runtime's requirements cross-check)."""
+    from rgraph.compile.pipeline import compile_graph
+    from rgraph.vk.device import create_device
+    from rgraph.vk.instance import create_instance
+
+    instance = create_instance(validate=False)
+    try:
+        device = create_device(instance, device_index, verbose=False)
+        try:
+            return compile_graph(graph, memory=DeviceMemoryRequirements(device), **options)
+        finally:
+            device.destroy()
+    finally:
+        instance.destroy()

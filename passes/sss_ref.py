@@ -172,23 +172,8 @@ def blur(color: np.ndarray, depth: np.ndarray, sss: np.ndarray, *, direction: st
     scale, size = (abs(p00), w) if direction == "h" else (abs(p11), h)
     with np.errstate(divide="ignore", invalid="ignore"):
         step = np.where(active, settings.width * a * scale / z * size / 2.0 / 3.0, 0.0)
-    ys, xs = np.mgrid[0:h, 0:w].astype(np.float64)
-    cx, cy = xs + 0.5, ys + 0.5
-    out = color.copy()
-    acc = color[..., :3] * k[0, :3]
-    for i in range(1, len(k)):
-        off = k[i, 3] * step
-        px, py = (cx + off, cy) if direction == "h" else (cx, cy + off)
-        tap = _bilinear(color[..., :3], px, py)
-        tx = np.clip(np.floor(px).astype(int), 0, w - 1)
-        ty = np.clip(np.floor(py).astype(int), 0, h - 1)
-        with np.errstate(invalid="ignore"):
-            s = np.clip(np.abs(z - z[ty, tx]) / settings.follow_depth, 0.0, 1.0)
-        s = np.where(np.isfinite(s), s, 1.0)[..., None]
-        tap = tap + (color[..., :3] - tap) * s
-        acc = acc + k[i, :3] * tap
-    out[..., :3] = np.where(active[..., None], acc, color[..., :3])
-    return out
+    offsets = [(k[i, 3] * step, 0.0) if direction == "h" else (0.0, k[i, 3] * step) for i in range(1, len(k))]
+    return _follow_surface_sum(color, z, active, k[:, :3], offsets, settings.follow_depth)
 
 
 def blur_2d(color: np.ndarray, depth: np.ndarray, sss: np.ndarray, *, p00: float, p11: float, near: float,
@@ -204,20 +189,30 @@ def blur_2d(color: np.ndarray, depth: np.ndarray, sss: np.ndarray, *, p00: float
     with np.errstate(divide="ignore", invalid="ignore"):
         base = np.where(active, settings.width * a / z / 2.0 / 3.0, 0.0)
     step_x, step_y = base * abs(p00) * w, base * abs(p11) * h
+    offsets = [(k[i, 3] * step_x, k[i, 4] * step_y) for i in range(1, len(k))]
+    return _follow_surface_sum(color, z, active, k[:, :3], offsets, settings.follow_depth)
+
+
+def _follow_surface_sum(color: np.ndarray, z: np.ndarray, active: np.ndarray, weights: np.ndarray,
+                        offsets: list[tuple], follow_depth: float) -> np.ndarray:
+    """Sum of ``weights[0]`` x centre and ``weights[i]`` x the bilinear tap at pixel centre +
+    ``offsets[i-1]`` (per-pixel arrays or scalars), each tap pulled toward the centre colour by
+    its linear-depth difference / ``follow_depth``; inactive pixels keep ``color``."""
+    h, w = z.shape
     ys, xs = np.mgrid[0:h, 0:w].astype(np.float64)
     cx, cy = xs + 0.5, ys + 0.5
     out = color.copy()
-    acc = color[..., :3] * k[0, :3]
-    for i in range(1, len(k)):
-        px, py = cx + k[i, 3] * step_x, cy + k[i, 4] * step_y
+    acc = color[..., :3] * weights[0]
+    for weight, (dx, dy) in zip(weights[1:], offsets, strict=True):
+        px, py = cx + dx, cy + dy
         tap = _bilinear(color[..., :3], px, py)
         tx = np.clip(np.floor(px).astype(int), 0, w - 1)
         ty = np.clip(np.floor(py).astype(int), 0, h - 1)
         with np.errstate(invalid="ignore"):
-            s = np.clip(np.abs(z - z[ty, tx]) / settings.follow_depth, 0.0, 1.0)
+            s = np.clip(np.abs(z - z[ty, tx]) / follow_depth, 0.0, 1.0)
         s = np.where(np.isfinite(s), s, 1.0)[..., None]
         tap = tap + (color[..., :3] - tap) * s
-        acc = acc + k[i, :3] * tap
+        acc = acc + weight * tap
     out[..., :3] = np.where(active[..., None], acc, color[..., :3])
     return out
 

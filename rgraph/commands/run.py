@@ -40,22 +40,10 @@ def _load_plan(args: argparse.Namespace) -> dict:
 
             plan = apply_sync_mode(plan, "naive")
         return plan
-    from rgraph.compile.pipeline import compile_graph
-    from rgraph.vk.device import create_device
-    from rgraph.vk.instance import create_instance
-    from rgraph.vk.memreq import DeviceMemoryRequirements
+    from rgraph.vk.memreq import compile_for_device
 
-    instance = create_instance(validate=False)
-    try:
-        device = create_device(instance, args.device, verbose=False)
-        try:
-            return compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
-                                 size=parse_size(args.size), policy=args.policy,
-                                 memory=DeviceMemoryRequirements(device), sync=args.sync)
-        finally:
-            device.destroy()
-    finally:
-        instance.destroy()
+    return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
+                              size=parse_size(args.size), policy=args.policy, sync=args.sync)
 
 
 def _print_table(plan: dict, timings: dict) -> None:

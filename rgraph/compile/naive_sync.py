@@ -24,6 +24,8 @@ import copy
 from collections import defaultdict
 from typing import Any
 
+from rgraph.compile.sync import mip_layer_rectangles
+
 QUEUE = "graphics"
 SRC = {"stages": ["ALL_COMMANDS"], "access": ["MEMORY_WRITE"]}
 DST = {"stages": ["ALL_COMMANDS"], "access": ["MEMORY_READ", "MEMORY_WRITE"]}
@@ -54,7 +56,7 @@ def naive_sync(plan: dict[str, Any]) -> dict[str, Any]:
                 groups[(layouts[name].get(cell), layout)].append(cell)
                 layouts[name][cell] = layout
             for (old, new), cells in sorted(groups.items(), key=lambda kv: (str(kv[0][0]), str(kv[0][1]))):
-                for rect in _rectangles(cells):
+                for rect in mip_layer_rectangles(cells):
                     barriers.append(_barrier(res, rect, old, new, aliases.get(name) if name not in handed_over else None))
             handed_over.add(name)
         p["barriers"] = barriers
@@ -101,35 +103,6 @@ def _cells(res: dict, sub: dict | None) -> list[Cell]:
         return [(0, 0)]
     sub = sub or {"mips": [0, res["mips"]], "layers": [0, res["layers"]]}
     return [(m, layer) for m in range(*sub["mips"]) for layer in range(*sub["layers"])]
-
-
-def _rectangles(cells: list[Cell]) -> list[tuple[tuple[int, int], tuple[int, int]]]:
-    """Cells -> disjoint (mips, layers) rectangles: runs of layers per mip, equal runs of
-    consecutive mips merged."""
-    by_mip: dict[int, list[int]] = defaultdict(list)
-    for mip, layer in cells:
-        by_mip[mip].append(layer)
-    runs = {m: _runs(sorted(ls)) for m, ls in by_mip.items()}
-    out = []
-    mips = sorted(runs)
-    i = 0
-    while i < len(mips):
-        j = i
-        while j + 1 < len(mips) and mips[j + 1] == mips[j] + 1 and runs[mips[j + 1]] == runs[mips[i]]:
-            j += 1
-        out += [((mips[i], mips[j] + 1), run) for run in runs[mips[i]]]
-        i = j + 1
-    return out
-
-
-def _runs(values: list[int]) -> list[tuple[int, int]]:
-    runs: list[tuple[int, int]] = []
-    for v in values:
-        if runs and runs[-1][1] == v:
-            runs[-1] = (runs[-1][0], v + 1)
-        else:
-            runs.append((v, v + 1))
-    return runs
 
 
 def _barrier(res: dict, rect, old: str | None, new: str | None, aliases: Any) -> dict:

@@ -18,7 +18,7 @@ resource's last accesses and UNDEFINED.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 from rgraph.compile.usages import Sync, merge, sync_of
@@ -399,26 +399,33 @@ class _Simulation:
 
 def _rectangles(groups: Mapping[tuple[str, BarrierKey], list[Cell]]) -> list[Barrier]:
     """Merge cells with one barrier into mip x layer rectangles (deterministic order)."""
-    out: list[Barrier] = []
-    for (res, key), cs in groups.items():
-        by_mip: dict[int, list[int]] = defaultdict(list)
-        for _, mip, layer in cs:
-            by_mip[mip].append(layer)
-        runs_by_mip = {m: _runs(sorted(ls)) for m, ls in by_mip.items()}
-        mips = sorted(runs_by_mip)
-        start = 0
-        while start < len(mips):
-            end = start
-            while (
-                end + 1 < len(mips)
-                and mips[end + 1] == mips[end] + 1
-                and runs_by_mip[mips[end + 1]] == runs_by_mip[mips[start]]
-            ):
-                end += 1
-            for run in runs_by_mip[mips[start]]:
-                out.append(Barrier(res, (mips[start], mips[end] + 1), run, key))
-            start = end + 1
+    out = [Barrier(res, mips, layers, key)
+           for (res, key), cs in groups.items()
+           for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
     return sorted(out, key=_barrier_sort_key)
+
+
+def mip_layer_rectangles(cells: Iterable[tuple[int, int]]) -> list[tuple[tuple[int, int], tuple[int, int]]]:
+    """(mip, layer) cells -> disjoint half-open (mips, layers) rectangles: runs of layers per
+    mip, with consecutive mips of equal runs merged."""
+    by_mip: dict[int, list[int]] = defaultdict(list)
+    for mip, layer in cells:
+        by_mip[mip].append(layer)
+    runs_by_mip = {m: _runs(sorted(ls)) for m, ls in by_mip.items()}
+    mips = sorted(runs_by_mip)
+    out = []
+    start = 0
+    while start < len(mips):
+        end = start
+        while (
+            end + 1 < len(mips)
+            and mips[end + 1] == mips[end] + 1
+            and runs_by_mip[mips[end + 1]] == runs_by_mip[mips[start]]
+        ):
+            end += 1
+        out += [((mips[start], mips[end] + 1), run) for run in runs_by_mip[mips[start]]]
+        start = end + 1
+    return out
 
 
 def _barrier_sort_key(b: Barrier):

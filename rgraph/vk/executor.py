@@ -746,13 +746,10 @@ def _png_rgba(res: dict, raw: bytes, w: int, h: int, implemented: bool) -> Any:
     else the probe's value visualisation."""
     import numpy as np
 
-    fmt = res["format"].lower()
-    if implemented and fmt in ("r8g8b8a8_srgb", "r8g8b8a8_unorm"):
-        rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4).copy()
-        rgba[..., 3] = 255
-        return rgba
-    if implemented and fmt in ("b8g8r8a8_srgb", "b8g8r8a8_unorm"):
-        rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4)[..., [2, 1, 0, 3]].copy()
+    channel_order = {"r8g8b8a8": [0, 1, 2, 3], "b8g8r8a8": [2, 1, 0, 3]}
+    head, _, kind = res["format"].lower().rpartition("_")
+    if implemented and head in channel_order and kind in ("srgb", "unorm"):
+        rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4)[..., channel_order[head]].copy()
         rgba[..., 3] = 255
         return rgba
     return image_to_rgba8(res, raw, w, h)

@@ -78,14 +78,15 @@ def choose_physical_device(devices: list[PhysicalDeviceInfo], index: int | None)
 
 @dataclass
 class Device:
-    """A logical device with one VkQueue per plan queue and one timeline semaphore per plan queue."""
+    """A logical device with one VkQueue per plan queue; owns the timeline semaphores made by
+    ``new_timeline`` (destroyed with it)."""
 
     instance: Instance
     physical: PhysicalDeviceInfo
     handle: Any
     families: dict[str, int]  # plan queue -> queue family index
     queues: dict[str, Any]  # plan queue -> VkQueue (shared when families coincide)
-    timelines: dict[str, Any] = field(default_factory=dict)  # plan queue -> VkSemaphore
+    timelines: list[Any] = field(default_factory=list)
     properties: Any = None
     memory_properties: Any = None
     enabled_features: set[str] = field(default_factory=set)
@@ -112,6 +113,11 @@ class Device:
     def same_queue(self, a: str, b: str) -> bool:
         return self.queues[a] == self.queues[b]
 
+    def new_timeline(self) -> Any:
+        """A timeline semaphore at value 0, destroyed with the device."""
+        self.timelines.append(create_timeline(self, 0))
+        return self.timelines[-1]
+
     def wait_idle(self) -> None:
         vk().vkDeviceWaitIdle(self.handle)
 
@@ -120,7 +126,7 @@ class Device:
         if self.handle is None:
             return
         v.vkDeviceWaitIdle(self.handle)
-        for sem in self.timelines.values():
+        for sem in self.timelines:
             v.vkDestroySemaphore(self.handle, sem, None)
         self.timelines.clear()
         v.vkDestroyDevice(self.handle, None)
@@ -154,7 +160,7 @@ def _query_features(handle: Any) -> tuple[Any, Any, Any, Any]:
 
 
 def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True) -> Device:
-    """Choose a physical device, check required features, create queues and timelines."""
+    """Choose a physical device, check required features, create the queues."""
     v = vk()
     physical = choose_physical_device(list_physical_devices(instance), device_index)
     if physical.api_version < (1, 3, 0):
@@ -199,8 +205,6 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},
     )
-    for q in PLAN_QUEUES:
-        device.timelines[q] = create_timeline(device, 0)
     return device
 
 

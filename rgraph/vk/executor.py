@@ -27,6 +27,7 @@ from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
 from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
 from rgraph.vk.resources import HostBuffer, ResourceSet
+from rgraph.vk.semaphore_edges import BatchSync, batch_semaphores, semaphore_count, semaphore_edges
 from rgraph.vk.texels import decode, encode
 
 FRAMES_IN_FLIGHT = 2
@@ -100,7 +101,7 @@ class Executor:
         self.fences: list[list[Any]] = []
         self.fence_arrays: list[Any] = []
         self.submit_calls: list[list[SubmitCall]] = []
-        self.value_slots: list[list[tuple[Any, int, int]]] = []
+        self.value_slots: list[list[tuple[Any, int]]] = []
         self.sampler = None
         self.host_buffers: list[HostBuffer] = []
         self.batches: list[Batch] = []
@@ -323,24 +324,25 @@ class Executor:
         Without validation, consecutive batches on one VkQueue (plan order) go in one
         vkQueueSubmit2 call with an array of VkSubmitInfo2; under validation each batch is its
         own call so that messages name the batch. Plan order keeps every wait submitted after
-        its signal (no wait-before-signal). Timeline value = frame * span[queue] + offset,
-        written straight into the cffi structs.
+        its signal (no wait-before-signal). Semaphores: one per edge (rgraph.vk.semaphore_edges),
+        value = frame + offset, written straight into the cffi structs.
         """
         v = vk()
         ffi = v.ffi
         dev = self.device
-        queues = list(dict.fromkeys(p["queue"] for p in self.plan["passes"]))
-        self.frame_span = {q: 1 + max([s["value"] for p in self.plan["passes"] for s in p["signals"]
-                                       if s["queue"] == q] + [0]) for q in queues}
-        handle_of = {q: int(ffi.cast("uintptr_t", dev.queues[q])) for q in queues}
-        distinct = len(set(handle_of.values())) > 1
-        first_of: dict[str, int] = {}
+        handle_of = {q: int(ffi.cast("uintptr_t", vk_queue)) for q, vk_queue in dev.queues.items()}
+        syncs = [BatchSync(b.queue, handle_of[b.queue],
+                           tuple((w["queue"], w["value"], names.stages(w["stages"])) for w in b.passes[0]["waits"]),
+                           tuple((sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in b.passes[-1]["signals"]))
+                 for b in self.batches]
+        try:
+            edges = semaphore_edges(syncs, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT)
+        except ValueError as exc:
+            raise ExecutionError(f"plan semaphores: {exc}") from None
+        semaphores = [dev.new_timeline() for _ in range(semaphore_count(edges, FRAMES_IN_FLIGHT))]
         last_of: dict[int, int] = {}
-        last_by_plan_queue: dict[str, int] = {}
         for bi, batch in enumerate(self.batches):
-            first_of.setdefault(batch.queue, bi)
             last_of[handle_of[batch.queue]] = bi
-            last_by_plan_queue[batch.queue] = bi
         fence_batches = sorted(set(last_of.values()))
         # calls: runs of consecutive batches on one VkQueue (one batch each under validation)
         runs: list[list[int]] = []
@@ -357,25 +359,13 @@ class Executor:
         self.value_slots = []
         for s in range(FRAMES_IN_FLIGHT):
             calls: list[SubmitCall] = []
-            slots: list[tuple[Any, int, int]] = []
+            slots: list[tuple[Any, int]] = []
             for run in runs:
                 infos = ffi.new("VkSubmitInfo2[]", len(run))
                 keep: list[Any] = [infos]
                 for j, bi in enumerate(run):
                     batch = self.batches[bi]
-                    first, last = batch.passes[0], batch.passes[-1]
-                    # A wait on a plan queue that shares this batch's VkQueue is left out: submission
-                    # order and the plan's barriers (ownership pairs merged at the acquire) order them,
-                    # and the 1.3.239 layer treats timeline semaphores as binary, so such a wait re-imports
-                    # an older snapshot of the queue's accesses (false WRITE_AFTER_WRITE after it).
-                    waits = [(w["queue"], w["value"], names.stages(w["stages"])) for w in first["waits"]
-                             if handle_of[w["queue"]] != handle_of[batch.queue]]
-                    if distinct and first_of[batch.queue] == bi:  # frame start: the previous frame is done
-                        waits += [(q, 0, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) for q in queues if q != batch.queue]
-                    signals = [(sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in last["signals"]]
-                    if last_by_plan_queue[batch.queue] == bi:
-                        signals.append((batch.queue, self.frame_span[batch.queue], v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT))
-                    waits, signals = _one_per_semaphore(waits), _one_per_semaphore(signals)
+                    waits, signals = batch_semaphores(edges, FRAMES_IN_FLIGHT, s, bi)
                     info = infos[j]
                     info.sType = v.VK_STRUCTURE_TYPE_SUBMIT_INFO_2
                     for count_field, array_field, specs in (("waitSemaphoreInfoCount", "pWaitSemaphoreInfos", waits),
@@ -385,11 +375,11 @@ class Executor:
                             continue
                         array = ffi.new("VkSemaphoreSubmitInfo[]", len(specs))
                         keep.append(array)
-                        for k, (q, offset, stage_mask) in enumerate(specs):
+                        for k, use in enumerate(specs):
                             array[k].sType = v.VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO
-                            array[k].semaphore = dev.timelines[q]
-                            array[k].stageMask = stage_mask
-                            slots.append((array[k], self.frame_span[q], offset))
+                            array[k].semaphore = semaphores[use.semaphore]
+                            array[k].stageMask = use.stages
+                            slots.append((array[k], use.offset))
                         setattr(info, count_field, len(specs))
                         setattr(info, array_field, array)
                     cbi = ffi.new("VkCommandBufferSubmitInfo[]", 1)
@@ -409,9 +399,9 @@ class Executor:
     # ----------------------------------------------------------------- frames
     def run_frames(self, frames: int, marks: list[float] | None = None) -> dict[str, Any]:
         """Submit ``frames`` frames; per-pass GPU medians from timestamps. ``marks`` (if given)
-        gets the main thread's CPU time (time.thread_time) three times per frame: at its start,
-        after its fence wait, timestamp read and fence reset, and after the per-frame updates
-        (scene and pass ``update`` hooks).
+        gets the main thread's CPU time (time.thread_time) four times per frame: at its start,
+        after its fence wait (time blocked on the GPU), after the timestamp read and fence reset,
+        and after the per-frame updates (scene and pass ``update`` hooks).
 
         The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
         wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
@@ -450,11 +440,15 @@ class Executor:
             t0 = perf()
             if fence_counts[s]:
                 _check(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
+                if marks is not None:
+                    marks.append(thread_time())
                 if submitted[s] and timestamps:
                     if get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
                         rows[collected] = query_view
                         collected += 1
                 _check(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
+            elif marks is not None:
+                marks.append(thread_time())
             if marks is not None:
                 marks.append(thread_time())
             if scene is not None:
@@ -463,8 +457,8 @@ class Executor:
                 p.update(frame, s)
             if marks is not None:
                 marks.append(thread_time())
-            for slot, span, offset in self.value_slots[s]:
-                slot.value = frame * span + offset
+            for slot, offset in self.value_slots[s]:
+                slot.value = frame + offset
             for call in self.submit_calls[s]:
                 if validate:
                     log.context = f"frame {frame} {call.context}"
@@ -609,20 +603,6 @@ class Executor:
         if self.instance is not None and self.instance.handle is not None:
             self.instance.destroy()
         return self.instance.log.messages
-
-
-def _one_per_semaphore(specs: list[tuple[str, int, int]]) -> list[tuple[str, int, int]]:
-    """One (queue, value offset, stage mask) per timeline semaphore: the highest value and the
-    union of the stages. Timeline semantics make this equivalent (a wait for the higher value
-    covers the lower; one signal of the higher value satisfies every wait up to it), and it
-    pairs each signal with its waits for the 1.3.239 layer, which treats timeline semaphores
-    as binary (two waits or two signals of one semaphore in one submit made it import stale
-    state: WRITE_RACING_WRITE / READ_RACING_WRITE across queues on an H100)."""
-    merged: dict[str, tuple[int, int]] = {}
-    for q, offset, stages in specs:
-        prev = merged.get(q)
-        merged[q] = (max(offset, prev[0]), stages | prev[1]) if prev else (offset, stages)
-    return [(q, offset, stages) for q, (offset, stages) in merged.items()]
 
 
 def _check(result: int, call: str) -> None:

@@ -1,0 +1,124 @@
+"""Cross-queue semaphores of a frame: one timeline semaphore per edge, signalled and waited
+once per frame.
+
+The plan orders queues with per-queue timeline values (pass ``waits``/``signals``). The
+runtime turns each cross-VkQueue wait into an edge from the batch that signals the value to
+the batch that waits for it, keeps only the latest signalling batch per (waiting batch,
+signalling VkQueue) (queue order covers the earlier ones), and adds frame edges: every
+VkQueue's first batch of a frame waits for every other VkQueue's last batch of the previous
+frame (persistent resources, and memory reused across frames in flight).
+
+Each edge has its own semaphore (a frame edge one per frame-in-flight set), so in host
+submission order every semaphore alternates signal, wait, signal, wait. Timeline semantics
+need none of this, but Khronos validation 1.3.239 models timeline semaphores as binary: a
+signal of a semaphore whose previous signal no wait has consumed is dropped, and the next
+wait imports the stale one (false cross-queue races on an H100 when one semaphore per queue
+carried every signal of a frame). Alternating semaphores make the layer's pairing exact.
+
+Values: an in-frame edge is signalled and waited with ``frame + 1``; a frame edge of set
+``s`` is signalled with ``frame + 1`` at the end of a frame of set ``s`` and waited with
+``frame`` (the previous frame's signal, on the previous set's semaphore) at the start of the
+next frame; frame 0 waits for value 0, which every timeline starts at.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Hashable
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class BatchSync:
+    """What the executor knows of one batch: its plan queue, the VkQueue it runs on, the plan
+    waits of its first pass and the plan signals of its last pass as (plan queue, value, stage
+    mask)."""
+
+    plan_queue: str
+    vk_queue: Hashable
+    waits: tuple[tuple[str, int, int], ...]
+    signals: tuple[tuple[str, int, int], ...]
+
+
+@dataclass(frozen=True)
+class SemaphoreEdge:
+    signal_batch: int
+    wait_batch: int
+    signal_stages: int
+    wait_stages: int
+    frame_edge: bool  # signalled at the end of one frame, waited at the start of the next
+
+
+@dataclass(frozen=True)
+class SemaphoreUse:
+    """One VkSemaphoreSubmitInfo of a batch: semaphore index, value = frame + offset, stages."""
+
+    semaphore: int
+    offset: int
+    stages: int
+
+
+def semaphore_edges(batches: list[BatchSync], all_commands: int) -> list[SemaphoreEdge]:
+    """The edges of one frame (see the module docstring); ``all_commands`` is the stage mask
+    of frame edges."""
+    signalled_by: dict[tuple[str, int], int] = {}
+    for bi, batch in enumerate(batches):
+        for queue, value, _stages in batch.signals:
+            signalled_by[(queue, value)] = bi
+    latest: dict[tuple[int, Hashable], tuple[int, int, int]] = {}  # (wait batch, signal VkQueue) -> edge parts
+    for bi, batch in enumerate(batches):
+        for queue, value, stages in batch.waits:
+            if (queue, value) not in signalled_by:
+                raise ValueError(f"batch {bi} waits for {queue} value {value}, which no pass signals")
+            source = signalled_by[(queue, value)]
+            if batches[source].vk_queue == batch.vk_queue:
+                continue  # submission order and the plan's barriers order one VkQueue
+            if source >= bi:
+                raise ValueError(f"batch {bi} waits for batch {source}, which comes later in the plan")
+            key = (bi, batches[source].vk_queue)
+            signal_stages = _signal_stages(batches[source], queue, value)
+            if key in latest:
+                prev_source, prev_signal, prev_wait = latest[key]
+                source, signal_stages, stages = max(source, prev_source), signal_stages | prev_signal, stages | prev_wait
+            latest[key] = (source, signal_stages, stages)
+    edges = [SemaphoreEdge(source, wait, signal_stages, wait_stages, False)
+             for (wait, _q), (source, signal_stages, wait_stages) in sorted(latest.items(), key=lambda kv: kv[0][0])]
+    first: dict[Hashable, int] = {}
+    last: dict[Hashable, int] = {}
+    for bi, batch in enumerate(batches):
+        first.setdefault(batch.vk_queue, bi)
+        last[batch.vk_queue] = bi
+    for x, last_x in last.items():
+        for y, first_y in first.items():
+            if x != y:
+                edges.append(SemaphoreEdge(last_x, first_y, all_commands, all_commands, True))
+    return edges
+
+
+def _signal_stages(batch: BatchSync, queue: str, value: int) -> int:
+    return next(stages for q, v, stages in batch.signals if (q, v) == (queue, value))
+
+
+def semaphore_count(edges: list[SemaphoreEdge], sets: int) -> int:
+    return sum(sets if e.frame_edge else 1 for e in edges)
+
+
+def batch_semaphores(edges: list[SemaphoreEdge], sets: int, s: int,
+                     batch: int) -> tuple[list[SemaphoreUse], list[SemaphoreUse]]:
+    """(waits, signals) of ``batch`` in the submits of frame-in-flight set ``s``."""
+    waits: list[SemaphoreUse] = []
+    signals: list[SemaphoreUse] = []
+    index = 0
+    for e in edges:
+        if e.frame_edge:
+            if e.signal_batch == batch:
+                signals.append(SemaphoreUse(index + s, 1, e.signal_stages))
+            if e.wait_batch == batch:
+                waits.append(SemaphoreUse(index + (s - 1) % sets, 0, e.wait_stages))
+            index += sets
+        else:
+            if e.signal_batch == batch:
+                signals.append(SemaphoreUse(index, 1, e.signal_stages))
+            if e.wait_batch == batch:
+                waits.append(SemaphoreUse(index, 1, e.wait_stages))
+            index += 1
+    return waits, signals

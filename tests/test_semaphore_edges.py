@@ -19,7 +19,13 @@ import pytest
 from rgraph.compile.pipeline import compile_graph
 from rgraph.random_graph import random_graph, to_yaml
 from rgraph.vk.executor import make_batches
-from rgraph.vk.semaphore_edges import BatchSync, batch_semaphores, semaphore_count, semaphore_edges
+from rgraph.vk.semaphore_edges import (
+    BatchSync,
+    batch_semaphores,
+    semaphore_count,
+    semaphore_edges,
+    submission_order,
+)
 
 ALL = 1 << 16
 SETS = 2
@@ -44,13 +50,16 @@ def syncs_of(plan: dict, device: FakeDevice, one_per_pass: bool) -> list[BatchSy
 
 
 def emulate_layer(syncs: list[BatchSync], frames: int) -> list[str]:
-    """Submit ``frames`` frames in plan order under the layer's binary model; problems found."""
+    """Submit ``frames`` frames in submission order under the layer's binary model; problems
+    found (a wait submitted before its signal imports nothing and is reported too)."""
     edges = semaphore_edges(syncs, ALL)
+    order = submission_order(syncs, edges)
+    assert sorted(order) == list(range(len(syncs)))
     stored: dict[int, int] = {}  # semaphore -> value of its unconsumed signal
     problems = []
     for frame in range(frames):
         s = frame % SETS
-        for bi in range(len(syncs)):
+        for bi in order:
             waits, signals = batch_semaphores(edges, SETS, s, bi)
             for w in waits:
                 want = frame + w.offset
@@ -141,3 +150,58 @@ def test_latest_signal_per_queue_is_kept_and_stages_merge():
              BatchSync("compute", 1, (("graphics", 1, 8), ("graphics", 2, 16)), ())]
     in_frame = [e for e in semaphore_edges(syncs, ALL) if not e.frame_edge]
     assert [(e.signal_batch, e.wait_batch, e.signal_stages, e.wait_stages) for e in in_frame] == [(1, 2, 6, 24)]
+
+
+def racing_reports(plan: dict, device: FakeDevice, order_of, frames: int = 3) -> set[str]:
+    """The 1.3.239 layer's async (racing) check as observed on an H100: a batch on queue X is
+    checked against the last batch of every queue Y it has not waited for, counting every
+    access in that batch's context tagged after X's last sync with Y - including X's own
+    accesses that Y imported. Accesses are taken as writes (layout transitions are). Returns
+    the passes such a check reports."""
+    batches = make_batches(plan, device, one_per_pass=True)
+    syncs = syncs_of(plan, device, True)
+    edges = semaphore_edges(syncs, ALL)
+    order = order_of(syncs, edges)
+    touched = [{a["resource"] for p in b.passes for a in p["accesses"]} for b in batches]
+    ctx: dict = {q: {} for q in {s.vk_queue for s in syncs}}  # queue -> resource -> last access tag
+    synced: dict = {q: {} for q in ctx}  # queue -> other queue -> tag synced
+    snapshot: dict = {}  # (batch, frame) -> (ctx, synced, tag)
+    last: dict = {}  # queue -> (ctx, tag) of its last batch
+    tag = 0
+    reports = set()
+    for frame in range(frames):
+        s = frame % SETS
+        for bi in order:
+            x = syncs[bi].vk_queue
+            waits, _ = batch_semaphores(edges, SETS, s, bi)
+            for e in edges:
+                if e.wait_batch != bi:
+                    continue
+                key = (e.signal_batch, frame - 1 if e.frame_edge else frame)
+                if key not in snapshot:
+                    continue
+                sctx, ssync, stag = snapshot[key]
+                for r, t in sctx.items():
+                    ctx[x][r] = max(ctx[x].get(r, -1), t)
+                for q, t in ssync.items():
+                    synced[x][q] = max(synced[x].get(q, -1), t)
+                synced[x][syncs[e.signal_batch].vk_queue] = max(synced[x].get(syncs[e.signal_batch].vk_queue, -1), stag)
+            tag += 1
+            for y, (yctx, ytag) in last.items():
+                if y == x or ytag <= synced[x].get(y, -1):
+                    continue
+                if any(yctx.get(r, -1) > synced[x].get(y, -1) for r in touched[bi]):
+                    reports.add(batches[bi].passes[0]["name"])
+            for r in touched[bi]:
+                ctx[x][r] = tag
+            synced[x][x] = tag
+            snapshot[(bi, frame)] = (dict(ctx[x]), dict(synced[x]), tag)
+            last[x] = (dict(ctx[x]), tag)
+    return reports
+
+
+def test_layer_racing_model_reproduces_the_h100_reports_and_the_order_avoids_them():
+    plan = compile_graph("surgery", size=(1920, 1080))
+    in_plan_order = racing_reports(plan, SEPARATE, lambda syncs, edges: list(range(len(syncs))))
+    assert in_plan_order == {"ibl_brdf_lut", "ibl_prefilter"}  # what the H100 run reported
+    assert racing_reports(plan, SEPARATE, submission_order) == set()

@@ -13,7 +13,7 @@ from rgraph.vk.loader import vk
 PLAN_QUEUES = ("graphics", "compute", "transfer")
 
 #: Vulkan 1.2/1.3 features the runtime cannot do without.
-REQUIRED_12 = ("timelineSemaphore", "separateDepthStencilLayouts")
+REQUIRED_12 = ("timelineSemaphore", "separateDepthStencilLayouts", "hostQueryReset")
 REQUIRED_13 = ("synchronization2", "maintenance4")
 #: Core features the probe uses when a plan needs them (enabled when present).
 OPTIONAL_CORE = (
@@ -184,7 +184,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
     e13 = v.VkPhysicalDeviceVulkan13Features(synchronization2=v.VK_TRUE, maintenance4=v.VK_TRUE)
     e12 = v.VkPhysicalDeviceVulkan12Features(
         pNext=e13, timelineSemaphore=v.VK_TRUE, separateDepthStencilLayouts=v.VK_TRUE,
-        hostQueryReset=v.VK_TRUE if f12.hostQueryReset else v.VK_FALSE,
+        hostQueryReset=v.VK_TRUE,  # timestamp queries are reset from the host (transfer queues cannot)
         shaderOutputLayer=v.VK_TRUE if f12.shaderOutputLayer else v.VK_FALSE,  # gl_Layer in vertex shaders
     )
     enabled = v.VkPhysicalDeviceFeatures2(pNext=e12, features=core_features)
@@ -200,7 +200,6 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         queues={q: queues_by_family[f] for q, f in plan_families.items()},
         properties=props, memory_properties=v.vkGetPhysicalDeviceMemoryProperties(physical.handle),
         enabled_features=enabled_core | set(REQUIRED_12) | set(REQUIRED_13)
-        | ({"hostQueryReset"} if f12.hostQueryReset else set())
         | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},

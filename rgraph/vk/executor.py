@@ -27,7 +27,13 @@ from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
 from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
 from rgraph.vk.resources import HostBuffer, ResourceSet
-from rgraph.vk.semaphore_edges import BatchSync, batch_semaphores, semaphore_count, semaphore_edges
+from rgraph.vk.semaphore_edges import (
+    BatchSync,
+    batch_semaphores,
+    semaphore_count,
+    semaphore_edges,
+    submission_order,
+)
 from rgraph.vk.texels import decode, encode
 
 FRAMES_IN_FLIGHT = 2
@@ -146,6 +152,9 @@ class Executor:
         for _ in range(FRAMES_IN_FLIGHT):
             self.query_pools.append(v.vkCreateQueryPool(dev.handle, v.VkQueryPoolCreateInfo(
                 queryType=v.VK_QUERY_TYPE_TIMESTAMP, queryCount=max(2 * n, 2)), None))
+            # reset from the host (hostQueryReset): vkCmdResetQueryPool is not allowed on a
+            # transfer-only queue family, and one host call per frame replaces one per pass
+            v.vkResetQueryPool(dev.handle, self.query_pools[-1], 0, max(2 * n, 2))
         self.batches = make_batches(self.plan, dev, one_per_pass=self.instance.validate)
         self.log.context = "recording"
         self._record()
@@ -192,8 +201,13 @@ class Executor:
         v = vk()
         plan_size = tuple(self.plan.get("size") or (64, 64))
         by_queue: dict[str, list] = {}
+        handoffs: dict[str, list] = {}  # final queue -> images initialised on graphics
         for r in self.resources.shared():
-            by_queue.setdefault(r.plan["final"]["queue"], []).append(r)
+            queue = r.plan["final"]["queue"]
+            if _needs_graphics_copy(r, self.device, queue):
+                handoffs.setdefault(queue, []).append(r)
+                queue = "graphics"
+            by_queue.setdefault(queue, []).append(r)
         for queue, items in by_queue.items():
             work = []
             for r in items:
@@ -232,6 +246,9 @@ class Executor:
                         v.vkCmdPipelineBarrier2(cb, dep)
                         v.vkCmdCopyBufferToImage(cb, buf.handle, r.handle, v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                                  len(regions), regions)
+                        if r.plan["final"]["queue"] != queue:  # release to the final queue's family
+                            keep.append(_ownership_barrier(cb, r, rng, self.device, "graphics", final["queue"], True))
+                            continue
                         to_final = v.VkImageMemoryBarrier2(
                             srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
                             dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
@@ -257,6 +274,8 @@ class Executor:
                         v.vkCmdPipelineBarrier2(cb, dep)
 
             self._one_time(queue, record)
+        for queue, items in handoffs.items():
+            self._one_time(queue, lambda cb, items=items, queue=queue: _acquire_initialised(cb, items, self.device, queue))
 
     def _label(self, cb: Any, text: str | None) -> None:
         v = vk()
@@ -300,7 +319,6 @@ class Executor:
                     self.log.context = f"recording pass {p['name']}"
                     self._label(cb, f"pass {p['name']}")
                     if timestamps:
-                        v.vkCmdResetQueryPool(cb, self.query_pools[s], 2 * i, 2)
                         v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
                     waited = [st for w in p["waits"] if not dev.same_queue(w["queue"], p["queue"]) for st in w["stages"]]
                     for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", waited):
@@ -321,11 +339,12 @@ class Executor:
         """Prebuilt submit arrays per set; per frame only the semaphore values change.
 
         Each batch is one VkSubmitInfo2 (its semaphores order it against the other queues).
-        Without validation, consecutive batches on one VkQueue (plan order) go in one
-        vkQueueSubmit2 call with an array of VkSubmitInfo2; under validation each batch is its
-        own call so that messages name the batch. Plan order keeps every wait submitted after
-        its signal (no wait-before-signal). Semaphores: one per edge (rgraph.vk.semaphore_edges),
-        value = frame + offset, written straight into the cffi structs.
+        Batches go in ``submission_order`` (each VkQueue runs ahead as far as its waits allow;
+        every wait is submitted after its signal). Without validation, consecutive batches on
+        one VkQueue in that order go in one vkQueueSubmit2 call with an array of VkSubmitInfo2;
+        under validation each batch is its own call so that messages name the batch.
+        Semaphores: one per edge (rgraph.vk.semaphore_edges), value = frame + offset, written
+        straight into the cffi structs.
         """
         v = vk()
         ffi = v.ffi
@@ -337,6 +356,7 @@ class Executor:
                  for b in self.batches]
         try:
             edges = semaphore_edges(syncs, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT)
+            order = submission_order(syncs, edges)
         except ValueError as exc:
             raise ExecutionError(f"plan semaphores: {exc}") from None
         semaphores = [dev.new_timeline() for _ in range(semaphore_count(edges, FRAMES_IN_FLIGHT))]
@@ -346,7 +366,8 @@ class Executor:
         fence_batches = sorted(set(last_of.values()))
         # calls: runs of consecutive batches on one VkQueue (one batch each under validation)
         runs: list[list[int]] = []
-        for bi, batch in enumerate(self.batches):
+        for bi in order:
+            batch = self.batches[bi]
             if (runs and not self.instance.validate
                     and handle_of[self.batches[runs[-1][-1]].queue] == handle_of[batch.queue]):
                 runs[-1].append(bi)
@@ -429,7 +450,7 @@ class Executor:
         submitted = [False] * FRAMES_IN_FLIGHT
         scene, updaters = self.scene_gpu, self.updaters
         wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
-        get_queries = lib.vkGetQueryPoolResults
+        get_queries, reset_queries = lib.vkGetQueryPoolResults, lib.vkResetQueryPool
         timeout = 10**11
         perf, thread_time = time.perf_counter, time.thread_time
         for frame in range(frames):
@@ -447,6 +468,8 @@ class Executor:
                         rows[collected] = query_view
                         collected += 1
                 _check(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
+                if timestamps:
+                    reset_queries(handle, pools[s], 0, 2 * n)
             elif marks is not None:
                 marks.append(thread_time())
             if marks is not None:
@@ -603,6 +626,52 @@ class Executor:
         if self.instance is not None and self.instance.handle is not None:
             self.instance.destroy()
         return self.instance.log.messages
+
+
+def _needs_graphics_copy(r: Any, device: Device, queue: str) -> bool:
+    """Depth/stencil images can only be copied to on a graphics-capable queue family
+    (VUID-vkCmdCopyBufferToImage-commandBuffer-07739): initialise them there and hand them over."""
+    v = vk()
+    return (r.is_image and names.aspect_mask(r.plan["format"]) != v.VK_IMAGE_ASPECT_COLOR_BIT
+            and not device.same_family(queue, "graphics"))
+
+
+def _ownership_barrier(cb: Any, r: Any, rng: Any, device: Device, src: str, dst: str, release: bool) -> tuple:
+    """The release (on ``src``) or acquire (on ``dst``) half of an ownership transfer of an
+    initialised image, layout kept at TRANSFER_DST_OPTIMAL; returns the structs to keep alive."""
+    v = vk()
+    b = v.VkImageMemoryBarrier2(
+        srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT if release else 0,
+        srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT if release else 0,
+        dstStageMask=0 if release else v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+        dstAccessMask=0 if release else v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
+        oldLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+        srcQueueFamilyIndex=device.families[src], dstQueueFamilyIndex=device.families[dst],
+        image=r.handle, subresourceRange=rng)
+    dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[b])
+    v.vkCmdPipelineBarrier2(cb, dep)
+    return b, dep
+
+
+def _acquire_initialised(cb: Any, items: list, device: Device, queue: str) -> list:
+    """On ``queue``: acquire images initialised on graphics, then move them to their final layout."""
+    v = vk()
+    keep: list = []
+    for r in items:
+        rng = v.VkImageSubresourceRange(aspectMask=names.aspect_mask(r.plan["format"]), baseMipLevel=0,
+                                        levelCount=r.plan["mips"], baseArrayLayer=0, layerCount=r.plan["layers"])
+        keep.append(_ownership_barrier(cb, r, rng, device, "graphics", queue, False))
+        b = v.VkImageMemoryBarrier2(
+            srcStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, srcAccessMask=0,
+            dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+            dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
+            oldLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=names.layout(r.plan["final"]["layout"]),
+            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+            image=r.handle, subresourceRange=rng)
+        dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[b])
+        v.vkCmdPipelineBarrier2(cb, dep)
+        keep.append((b, dep))
+    return keep
 
 
 def _check(result: int, call: str) -> None:

@@ -122,3 +122,37 @@ def batch_semaphores(edges: list[SemaphoreEdge], sets: int, s: int,
                 waits.append(SemaphoreUse(index, 1, e.wait_stages))
             index += 1
     return waits, signals
+
+
+def submission_order(batches: list[BatchSync], edges: list[SemaphoreEdge]) -> list[int]:
+    """Host submission order of a frame's batches: each VkQueue runs ahead as far as its waits
+    allow before another queue's batch is submitted (queue order and signal-before-wait kept).
+
+    Khronos validation 1.3.239 checks a batch for races against every other queue's last
+    batch it has not waited for, and counts in that batch's context the accesses it imported
+    from this very queue: a graphics pass submitted after a compute batch that waited for
+    graphics, and before graphics waits for it, was reported as racing its own queue's earlier
+    accesses (H100: the IBL passes against the previous frame's forward). Running ahead
+    submits such passes before the other queue's batch exists.
+    """
+    needs: dict[int, set[int]] = {}
+    for e in edges:
+        if not e.frame_edge:
+            needs.setdefault(e.wait_batch, set()).add(e.signal_batch)
+    pending: dict[Hashable, list[int]] = {}
+    for bi, batch in enumerate(batches):
+        pending.setdefault(batch.vk_queue, []).append(bi)
+    order: list[int] = []
+    done: set[int] = set()
+    current: Hashable | None = None
+    while len(order) < len(batches):
+        ready = [q[0] for q in pending.values() if q and needs.get(q[0], set()) <= done]
+        if not ready:
+            raise ValueError("the batches' semaphore waits form a cycle")
+        same = [bi for bi in ready if batches[bi].vk_queue == current]
+        bi = same[0] if same else min(ready)
+        current = batches[bi].vk_queue
+        pending[current].pop(0)
+        order.append(bi)
+        done.add(bi)
+    return order

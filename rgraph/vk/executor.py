@@ -228,7 +228,7 @@ class Executor:
                 self.host_buffers.append(buf)
                 work.append((r, buf, regions))
 
-            def record(cb, work=work):
+            def record(cb, work=work, queue=queue):
                 keep = []
                 for r, buf, regions in work:
                     final = r.plan["final"]

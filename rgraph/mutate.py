@@ -28,6 +28,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
+from rgraph.stages import supported_accesses
+
 ORACLES = ("check", "syncval", "data")
 KINDS = ("drop", "src-access", "dst-stages")
 REDUNDANT = "redundant barrier (generator finding)"
@@ -40,37 +42,6 @@ STAGE_ORDER = (
     "COMPUTE_SHADER", "RAY_TRACING_SHADER_KHR", "ACCELERATION_STRUCTURE_BUILD_KHR", "COPY", "BLIT", "RESOLVE",
     "CLEAR", "ALL_TRANSFER", "HOST",
 )
-_SHADER_STAGES = frozenset({
-    "VERTEX_SHADER", "TESSELLATION_CONTROL_SHADER", "TESSELLATION_EVALUATION_SHADER", "GEOMETRY_SHADER",
-    "TASK_SHADER_EXT", "MESH_SHADER_EXT", "FRAGMENT_SHADER", "COMPUTE_SHADER", "RAY_TRACING_SHADER_KHR",
-    "PRE_RASTERIZATION_SHADERS",
-})
-_TRANSFER_STAGES = frozenset({"COPY", "BLIT", "RESOLVE", "CLEAR", "ALL_TRANSFER", "TRANSFER"})
-_ALL = frozenset({"ALL_COMMANDS"})
-# access -> stages able to perform it (ALL_COMMANDS supports every access)
-ACCESS_STAGES: dict[str, frozenset[str]] = {
-    "INDIRECT_COMMAND_READ": frozenset({"DRAW_INDIRECT", "ACCELERATION_STRUCTURE_BUILD_KHR"}),
-    "INDEX_READ": frozenset({"INDEX_INPUT", "VERTEX_INPUT"}),
-    "VERTEX_ATTRIBUTE_READ": frozenset({"VERTEX_ATTRIBUTE_INPUT", "VERTEX_INPUT"}),
-    "UNIFORM_READ": _SHADER_STAGES,
-    "SHADER_READ": _SHADER_STAGES | {"ACCELERATION_STRUCTURE_BUILD_KHR"},
-    "SHADER_WRITE": _SHADER_STAGES,
-    "SHADER_SAMPLED_READ": _SHADER_STAGES,
-    "SHADER_STORAGE_READ": _SHADER_STAGES,
-    "SHADER_STORAGE_WRITE": _SHADER_STAGES,
-    "INPUT_ATTACHMENT_READ": frozenset({"FRAGMENT_SHADER"}),
-    "COLOR_ATTACHMENT_READ": frozenset({"COLOR_ATTACHMENT_OUTPUT"}),
-    "COLOR_ATTACHMENT_WRITE": frozenset({"COLOR_ATTACHMENT_OUTPUT"}),
-    "DEPTH_STENCIL_ATTACHMENT_READ": frozenset({"EARLY_FRAGMENT_TESTS", "LATE_FRAGMENT_TESTS"}),
-    "DEPTH_STENCIL_ATTACHMENT_WRITE": frozenset({"EARLY_FRAGMENT_TESTS", "LATE_FRAGMENT_TESTS"}),
-    "TRANSFER_READ": _TRANSFER_STAGES | {"ACCELERATION_STRUCTURE_BUILD_KHR"},
-    "TRANSFER_WRITE": _TRANSFER_STAGES | {"ACCELERATION_STRUCTURE_BUILD_KHR"},
-    "HOST_READ": frozenset({"HOST"}),
-    "HOST_WRITE": frozenset({"HOST"}),
-    "ACCELERATION_STRUCTURE_READ_KHR": _SHADER_STAGES | {"ACCELERATION_STRUCTURE_BUILD_KHR"},
-    "ACCELERATION_STRUCTURE_WRITE_KHR": frozenset({"ACCELERATION_STRUCTURE_BUILD_KHR"}),
-}
-
 BLIND_SPOTS = {
     "ownership": "queue family ownership transfer: syncval 1.3.239 does not track ownership transfers",
     "same_family_acquire": "dropped acquire of a same-family ownership pair: the ALL_COMMANDS semaphore wait "
@@ -189,17 +160,6 @@ def _stage_rank(stage: str) -> int:
     return STAGE_ORDER.index(stage) if stage in STAGE_ORDER else len(STAGE_ORDER)
 
 
-def supported_accesses(accesses: Iterable[str], stages: Iterable[str]) -> list[str]:
-    """The accesses among ``accesses`` that some stage of ``stages`` can perform."""
-    stages = set(stages)
-    if stages & _ALL:
-        return sorted(accesses)
-    out = []
-    for a in accesses:
-        able = ACCESS_STAGES.get(a)
-        if a.startswith("MEMORY_") or able is None or able & stages:
-            out.append(a)
-    return sorted(out)
 
 
 def narrowed_dst(dst: dict) -> tuple[dict, str] | None:

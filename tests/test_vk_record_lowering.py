@@ -8,6 +8,7 @@ import pytest
 
 from rgraph.compile.pipeline import compile_graph
 from rgraph.random_graph import random_graph, to_yaml
+from rgraph.stages import fit_to_queue, queue_supports
 from rgraph.vk.record import BarrierSpec, lower_barriers
 
 TWO_FAMILIES = {"graphics": 0, "compute": 1, "transfer": 2}
@@ -150,3 +151,61 @@ def test_barriers_of_a_pass_with_a_cross_queue_wait_chain_to_it():
     assert _only(group, "b").src_stages == ()
     (unchained,) = lower_barriers([alias], "barrier", TWO_FAMILIES)
     assert unchained[0].src_stages == ("COMPUTE_SHADER",)
+
+
+def _random_plan(seed: int, passes: int, policy: str) -> dict:
+    import tempfile
+    from pathlib import Path
+
+    path = Path(tempfile.mkdtemp()) / f"g{seed}.yaml"
+    path.write_text(to_yaml(random_graph(seed, passes)))
+    return compile_graph(str(path), size=(16, 16), policy=policy)
+
+
+NVIDIA_FAMILIES = {"graphics": 0, "compute": 2, "transfer": 1}
+CAPS = {"graphics": frozenset({"graphics", "compute", "transfer"}), "compute": frozenset({"compute", "transfer"}),
+        "transfer": frozenset({"transfer"})}
+
+
+@pytest.mark.parametrize("seed,passes,policy", [(0, 14, "dedicated"), (48, 16, "aliased"), (3, 20, "dedicated"),
+                                                (11, 18, "aliased")])
+def test_every_acquire_has_a_release_of_the_same_range(seed, passes, policy):
+    """The layer pairs ownership transfers by exact subresource range: a resource released in
+    two pieces (two passes) must be acquired in the same two pieces (H100 fuzz seed 0/14:
+    'no matching release barrier queued for execution')."""
+    plan = _random_plan(seed, passes, policy)
+    releases, acquires = [], []
+    for p in plan["passes"]:
+        for role, key, out in (("release", "releases", releases), ("barrier", "barriers", acquires)):
+            for group in lower_barriers(p[key], role, NVIDIA_FAMILIES):
+                out += [(s.resource, str(s.subresource), s.src_family, s.dst_family) for s in group
+                        if s.src_family is not None and s.src_family != s.dst_family]
+    assert sorted(acquires) == sorted(releases)
+
+
+def test_barriers_fit_the_recording_queue_family():
+    """Seed 48's release of buf4 on the compute queue names the graphics reads before it
+    (INDEX_INPUT): recorded on a compute-only family those stages are dropped."""
+    plan = _random_plan(48, 16, "aliased")
+    p = _pass(plan, "p00006")
+    assert p["queue"] == "compute"
+    plain = [s for g in lower_barriers(p["releases"], "release", NVIDIA_FAMILIES) for s in g if s.resource == "buf4"]
+    assert "INDEX_INPUT" in plain[0].src_stages
+    fitted = [s for g in lower_barriers(p["releases"], "release", NVIDIA_FAMILIES, (), CAPS["compute"])
+              for s in g if s.resource == "buf4"]
+    assert fitted[0].src_stages == ("COMPUTE_SHADER", "DRAW_INDIRECT")
+    for q in plan["passes"]:
+        for role, key in (("release", "releases"), ("barrier", "barriers")):
+            for g in lower_barriers(q[key], role, NVIDIA_FAMILIES, (), CAPS[q["queue"]]):
+                for s in g:
+                    for stage in s.src_stages + s.dst_stages:
+                        assert queue_supports(stage, CAPS[q["queue"]]), (q["name"], s)
+
+
+def test_fit_to_queue_drops_accesses_of_dropped_stages():
+    assert fit_to_queue(("FRAGMENT_SHADER", "COMPUTE_SHADER"), ("SHADER_SAMPLED_READ", "COLOR_ATTACHMENT_READ"),
+                        CAPS["compute"]) == (("COMPUTE_SHADER",), ("SHADER_SAMPLED_READ",))
+    assert fit_to_queue(("FRAGMENT_SHADER",), ("SHADER_SAMPLED_READ",), CAPS["compute"]) == ((), ())
+    assert fit_to_queue(("COPY", "COMPUTE_SHADER"), ("TRANSFER_WRITE", "SHADER_STORAGE_WRITE"), CAPS["transfer"]) == \
+        (("COPY",), ("TRANSFER_WRITE",))
+    assert fit_to_queue(("ALL_COMMANDS",), ("MEMORY_WRITE",), CAPS["transfer"]) == (("ALL_COMMANDS",), ("MEMORY_WRITE",))

@@ -281,14 +281,16 @@ class _Simulation:
     def run(self, start: dict[Cell, _Cell]) -> None:
         self.cells = start
         for i, p in enumerate(self.passes):
-            groups: dict[tuple[str, BarrierKey], list[Cell]] = defaultdict(list)
+            # acquires grouped by their release pass too, so that each acquire's rectangles equal
+            # its release's (the layer pairs ownership transfers by exact subresource range)
+            groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = defaultdict(list)
             release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] = defaultdict(list)
             waits: dict[str, tuple[int, set[str]]] = {}
             for c, (s, w) in self.per_pass_cells[i].items():
                 cell = self.cells[c]
                 key, release_at, wait_on = self._step(c, cell, i, p.queue, s, w)
                 if key is not None:
-                    groups[(c[0], key)].append(c)
+                    groups[(c[0], key, release_at)].append(c)
                     if release_at is not None:
                         release_groups[(release_at, c[0], key)].append(c)
                 for q, j in wait_on:
@@ -397,10 +399,11 @@ class _Simulation:
         return {c: cell.state() for c, cell in self.cells.items()}
 
 
-def _rectangles(groups: Mapping[tuple[str, BarrierKey], list[Cell]]) -> list[Barrier]:
-    """Merge cells with one barrier into mip x layer rectangles (deterministic order)."""
+def _rectangles(groups: Mapping[tuple, list[Cell]]) -> list[Barrier]:
+    """Merge cells with one barrier into mip x layer rectangles (deterministic order); a group
+    key is (resource, BarrierKey, ...)."""
     out = [Barrier(res, mips, layers, key)
-           for (res, key), cs in groups.items()
+           for (res, key, *_), cs in groups.items()
            for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
     return sorted(out, key=_barrier_sort_key)
 

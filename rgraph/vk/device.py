@@ -92,6 +92,7 @@ class Device:
     enabled_features: set[str] = field(default_factory=set)
     timestamp_period_ns: float = 1.0
     timestamp_valid_bits: dict[str, int] = field(default_factory=dict)
+    capabilities: dict[str, frozenset[str]] = field(default_factory=dict)  # plan queue -> graphics/compute/transfer
     _fns: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -203,8 +204,15 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},
+        capabilities={q: _capabilities(families[f].queueFlags) for q, f in plan_families.items()},
     )
     return device
+
+
+def _capabilities(flags: int) -> frozenset[str]:
+    v = vk()
+    return frozenset(name for name, bit in (("graphics", v.VK_QUEUE_GRAPHICS_BIT), ("compute", v.VK_QUEUE_COMPUTE_BIT),
+                                            ("transfer", v.VK_QUEUE_TRANSFER_BIT)) if flags & bit)
 
 
 def create_timeline(device: Device, initial: int) -> Any:

@@ -321,11 +321,11 @@ class Executor:
                     if timestamps:
                         v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
                     waited = [st for w in p["waits"] if not dev.same_queue(w["queue"], p["queue"]) for st in w["stages"]]
-                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", waited):
+                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", p["queue"], waited):
                         self.barrier_batches.append(barriers)
                         v.vkCmdPipelineBarrier2(cb, barriers.dependency)
                     self.passes[i].record(ctx, s)
-                    for releases in build_barriers(dev, self.resources, s, p["releases"], "release"):
+                    for releases in build_barriers(dev, self.resources, s, p["releases"], "release", p["queue"]):
                         self.barrier_batches.append(releases)
                         v.vkCmdPipelineBarrier2(cb, releases.dependency)
                     if timestamps:

@@ -10,6 +10,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from rgraph.stages import CAPABILITIES, fit_to_queue
 from rgraph.vk import names
 from rgraph.vk.device import Device
 from rgraph.vk.loader import vk
@@ -48,7 +49,8 @@ class BarrierSpec:
 
 
 def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
-                   wait_stages: Sequence[str] = ()) -> list[list[BarrierSpec]]:
+                   wait_stages: Sequence[str] = (),
+                   capabilities: frozenset[str] = CAPABILITIES) -> list[list[BarrierSpec]]:
     """Plan barriers -> the vkCmdPipelineBarrier2 calls that execute them, in recording order.
 
     ``role`` is "barrier" (before the pass) or "release" (after it); ``families`` maps plan
@@ -79,6 +81,11 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
       the wait: a plan barrier's src stages may name another queue's stages (an aliased
       resource's previous occupant read on the compute queue, say), which on this queue are
       ordered after nothing the semaphore covers (an H100 run: WRITE_AFTER_READ in forward).
+    - ``capabilities``: what the recording queue's family does (graphics/compute/transfer).
+      Stages it does not run, and the accesses only they perform, are dropped from both
+      scopes (``rgraph.stages.fit_to_queue``): a release on a compute-only family after
+      reads on the graphics queue names INDEX_INPUT in the plan, which that family rejects
+      (VUID-vkCmdPipelineBarrier2-srcStageMask-03849, H100 fuzz seed 48).
     """
     first: list[BarrierSpec] = []
     after: list[BarrierSpec] = []
@@ -87,8 +94,16 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
         for group, spec in _lower_one(b, role, families):
             if chain and group == 0 and spec.src_stages and spec.src_family is None:
                 spec = replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(chain))))
+            if capabilities != CAPABILITIES:
+                spec = _fit(spec, capabilities)
             (first if group == 0 else after).append(_after_reads(spec))
     return [group for group in (first, after) if group]
+
+
+def _fit(spec: BarrierSpec, capabilities: frozenset[str]) -> BarrierSpec:
+    src_stages, src_access = fit_to_queue(spec.src_stages, spec.src_access, capabilities)
+    dst_stages, dst_access = fit_to_queue(spec.dst_stages, spec.dst_access, capabilities)
+    return replace(spec, src_stages=src_stages, src_access=src_access, dst_stages=dst_stages, dst_access=dst_access)
 
 
 #: srcAccessMask of a layout transition that follows reads (see ``_after_reads``).
@@ -150,11 +165,12 @@ class BarrierBatch:
 
 
 def build_barriers(device: Device, resources: ResourceSet, set_index: int, barriers: list[dict],
-                   role: str, wait_stages: Sequence[str] = ()) -> list[BarrierBatch]:
-    """Sync2 structs for plan barriers (see ``lower_barriers``): one batch per
-    vkCmdPipelineBarrier2, to be recorded in order; [] when there is nothing to record."""
+                   role: str, queue: str, wait_stages: Sequence[str] = ()) -> list[BarrierBatch]:
+    """Sync2 structs for plan barriers recorded on plan queue ``queue`` (see ``lower_barriers``):
+    one batch per vkCmdPipelineBarrier2, to be recorded in order; [] when there is nothing."""
     return [_dependency(resources, set_index, group)
-            for group in lower_barriers(barriers, role, device.families, wait_stages)]
+            for group in lower_barriers(barriers, role, device.families, wait_stages,
+                                        device.capabilities.get(queue, CAPABILITIES))]
 
 
 def _family(index: int | None) -> int:

@@ -6,7 +6,7 @@ not counted. Each frame is split into: blocked (the vkWaitForFences call: the CP
 of the GPU and waits for the frame two back; a driver that spins while it waits bills this
 as CPU time), and the runtime's work, everything else - target <= 50 us: timestamp read and
 fence reset, updates (scene animation and pass ``update`` hooks: with ``--passes real`` the
-pass implementations' cost) and submit (timeline values and vkQueueSubmit2 calls).
+pass implementations' cost), semaphore values, and the vkQueueSubmit2 calls (driver time).
 
 ``--passes probe`` (default) runs every pass with the probe implementation, so the figure is
 the runtime's resubmission cost alone; ``--passes real`` keeps the graph's implementations.
@@ -66,7 +66,7 @@ def frame_cpu_us(plan: dict, frames: int) -> dict[str, list[float]]:
         executor.run_frames(frames, marks=marks)
     finally:
         executor.close()
-    starts, blocked, read, updated = marks[0::4], marks[1::4], marks[2::4], marks[3::4]
+    starts, blocked, read, updated, valued = (marks[k::5] for k in range(5))
     skip = 10  # warm-up
     frame = [(b - a) * 1e6 for a, b in zip(starts, starts[1:], strict=False)]
     gpu_wait = [(b - a) * 1e6 for a, b in zip(starts, blocked, strict=False)][:len(frame)]
@@ -76,8 +76,18 @@ def frame_cpu_us(plan: dict, frames: int) -> dict[str, list[float]]:
         "runtime": [f - w for f, w in zip(frame, gpu_wait, strict=True)][skip:],
         "readback": [(b - a) * 1e6 for a, b in zip(blocked, read, strict=False)][skip:-1],
         "updates": [(b - a) * 1e6 for a, b in zip(read, updated, strict=False)][skip:-1],
-        "submit": [(b - a) * 1e6 for a, b in zip(updated, starts[1:], strict=False)][skip:],
+        "values": [(b - a) * 1e6 for a, b in zip(updated, valued, strict=False)][skip:-1],
+        "submit": [(b - a) * 1e6 for a, b in zip(valued, starts[1:], strict=False)][skip:],
     }
+
+
+def plan_calls(plan: dict) -> list[str]:
+    """Queues of the vkQueueSubmit2 calls of one frame, as the executor groups them."""
+    executor = Executor(plan, validate=False, device_index=None, verbose=False)
+    try:
+        return [str(call.context) for call in executor.submit_calls[0]]
+    finally:
+        executor.close()
 
 
 def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
@@ -151,7 +161,9 @@ def main() -> None:
     print(f"  runtime (frame minus the fence wait):              {_summary(parts['runtime'])} (target <= 50 us)")
     print(f"    timestamp read, fence reset:                     {_summary(parts['readback'])}")
     print(f"    updates (scene, pass update hooks):              {_summary(parts['updates'])}")
-    print(f"    submit (timeline values, vkQueueSubmit2):        {_summary(parts['submit'])}")
+    print(f"    semaphore values:                                {_summary(parts['values'])}")
+    calls = f"    vkQueueSubmit2 calls ({len(plan_calls(plan))} per frame):"
+    print(f"{calls:<53}{_summary(parts['submit'])}")
     if not is_gpu:
         print("GPU busy fraction: skipped (CPU device: lavapipe runs the frame on CPU threads)")
         return

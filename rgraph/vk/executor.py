@@ -420,9 +420,10 @@ class Executor:
     # ----------------------------------------------------------------- frames
     def run_frames(self, frames: int, marks: list[float] | None = None) -> dict[str, Any]:
         """Submit ``frames`` frames; per-pass GPU medians from timestamps. ``marks`` (if given)
-        gets the main thread's CPU time (time.thread_time) four times per frame: at its start,
+        gets the main thread's CPU time (time.thread_time) five times per frame: at its start,
         after its fence wait (time blocked on the GPU), after the timestamp read and fence reset,
-        and after the per-frame updates (scene and pass ``update`` hooks).
+        after the per-frame updates (scene and pass ``update`` hooks) and after writing the
+        semaphore values (the rest of the frame is the vkQueueSubmit2 calls).
 
         The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
         wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
@@ -482,6 +483,8 @@ class Executor:
                 marks.append(thread_time())
             for slot, offset in self.value_slots[s]:
                 slot.value = frame + offset
+            if marks is not None:
+                marks.append(thread_time())
             for call in self.submit_calls[s]:
                 if validate:
                     log.context = f"frame {frame} {call.context}"

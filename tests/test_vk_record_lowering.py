@@ -209,3 +209,20 @@ def test_fit_to_queue_drops_accesses_of_dropped_stages():
     assert fit_to_queue(("COPY", "COMPUTE_SHADER"), ("TRANSFER_WRITE", "SHADER_STORAGE_WRITE"), CAPS["transfer"]) == \
         (("COPY",), ("TRANSFER_WRITE",))
     assert fit_to_queue(("ALL_COMMANDS",), ("MEMORY_WRITE",), CAPS["transfer"]) == (("ALL_COMMANDS",), ("MEMORY_WRITE",))
+
+
+@pytest.mark.parametrize("seed,passes,policy,expected", [
+    (13, 12, "dedicated", {"graphics": [("img2", "compute")]}),
+    (48, 16, "aliased", {"compute": [("depth7", "graphics")]}),
+])
+def test_first_frame_releases_are_the_wrap_around_handoffs(seed, passes, policy, expected):
+    """Frame 0's first-use acquires of persistent resources pair with releases from a previous
+    frame that does not exist (H100 fuzz seeds 13/12 and 48/16): the runtime records exactly
+    the releases whose acquire comes at or before them in the frame, once, after init."""
+    from rgraph.vk.executor import first_frame_releases
+    from rgraph.vk.resources import SHARED
+
+    plan = _random_plan(seed, passes, policy)
+    shared = {r["name"] for r in plan["resources"] if r["lifetime"] in SHARED}
+    got = first_frame_releases(plan, shared)
+    assert {q: [(b["resource"], b["dst"]["queue"]) for b in bs] for q, bs in got.items()} == expected

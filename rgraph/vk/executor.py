@@ -139,6 +139,7 @@ class Executor:
             maxLod=1000.0), None)
         self.log.context = "initialising persistent resources"
         self._init_shared()
+        self._release_for_first_frame()
         self.log.context = "creating pipelines"
         for p in self.plan["passes"]:
             self.log.context = f"creating pipelines of pass {p['name']}"
@@ -276,6 +277,21 @@ class Executor:
             self._one_time(queue, record)
         for queue, items in handoffs.items():
             self._one_time(queue, lambda cb, items=items, queue=queue: _acquire_initialised(cb, items, self.device, queue))
+
+    def _release_for_first_frame(self) -> None:
+        """Ownership releases that frame 0's acquires pair with.
+
+        A persistent resource whose last use in a frame is on another queue family than its
+        first use is released at that last use and acquired at the next frame's first use.
+        Frame 0 has no previous frame, so after initialisation (which leaves the resource in
+        its ``final`` state on its final queue) the runtime records those same releases once."""
+        shared = {r.plan["name"] for r in self.resources.shared()}
+        for queue, releases in first_frame_releases(self.plan, shared).items():
+            batches = build_barriers(self.device, self.resources, 0, releases, "release", queue)
+            if batches:
+                self.log.context = f"releasing persistent resources for frame 0 on {queue}"
+                self._one_time(queue, lambda cb, batches=batches: [vk().vkCmdPipelineBarrier2(cb, b.dependency)
+                                                                   for b in batches])
 
     def _label(self, cb: Any, text: str | None) -> None:
         v = vk()
@@ -629,6 +645,22 @@ class Executor:
         if self.instance is not None and self.instance.handle is not None:
             self.instance.destroy()
         return self.instance.log.messages
+
+
+def first_frame_releases(plan: dict, shared: set[str]) -> dict[str, list[dict]]:
+    """Plan releases (by releasing queue) of ``shared`` resources whose acquire comes at or
+    before the releasing pass: they hand the resource to the next frame."""
+    def key(b: dict) -> tuple:
+        return b["resource"], str(b.get("subresource")), b["src"]["queue"], b["dst"]["queue"]
+
+    acquires = {key(b): i for i, p in enumerate(plan["passes"]) for b in p["barriers"]
+                if b["src"]["queue"] != b["dst"]["queue"]}
+    by_queue: dict[str, list[dict]] = {}
+    for i, p in enumerate(plan["passes"]):
+        for b in p["releases"]:
+            if b["resource"] in shared and acquires.get(key(b), len(plan["passes"])) <= i:
+                by_queue.setdefault(b["src"]["queue"], []).append(b)
+    return by_queue
 
 
 def _needs_graphics_copy(r: Any, device: Device, queue: str) -> bool:

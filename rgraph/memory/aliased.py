@@ -2,10 +2,11 @@
 
 1. Greedy best fit under several orderings (size, area, lifetime, start, contention), keep
    the lowest peak: fast and already within a few percent on typical render graphs.
-2. If the peak is above the lower bound, the MiniMalloc-style exact search
-   (``rgraph.memory.search``) looks for a placement under a series of capacities, from the
-   lower bound up, with a node budget derived from the time budget. Any placement it finds
-   replaces the greedy one.
+2. If the peak is above the lower bound, the MiniMalloc-style search
+   (``rgraph.memory.search``) looks for placements under tighter and tighter capacities
+   (bisection between the lower bound and the best peak found), each capacity tried with a
+   few short dives under different block preorderings (``restarts.py``). Any placement it
+   finds replaces the greedy one.
 
 The time budget is turned into a node count (``NODES_PER_SECOND``) so that results are
 the same on every machine; the real time taken varies with the machine.
@@ -17,11 +18,18 @@ from dataclasses import dataclass
 
 from rgraph.memory.greedy import best_fit, orderings
 from rgraph.memory.instance import Instance
-from rgraph.memory.search import PREORDERINGS, CapacitySearch, preorder
+from rgraph.memory.restarts import Preorders
+from rgraph.memory.search import CapacitySearch
 
-#: Search nodes granted per second of budget (about what a 2-core laptop visits on a
-#: 200-block instance); node cost grows with sections x blocks, which scales it down.
-NODES_PER_SECOND = 20000
+#: Search nodes granted per second of budget for a 100-block instance (about what a 2-core
+#: laptop visits); a node costs about linearly in the block count, which scales it down.
+NODES_PER_SECOND = 100000
+
+#: Nodes per dive, in blocks: a little backtracking beyond one full dive.
+DIVE_NODES = 2
+
+#: Dives (each under another preordering) before a capacity is given up as too tight.
+DIVES_PER_CAPACITY = 3
 
 
 @dataclass
@@ -44,20 +52,24 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
     if best.peak <= lb or inst.n == 0:
         return best
     budget = node_budget_for(inst, time_budget_s)
-    if budget < 2 * inst.n:
+    if budget < inst.n:
         return best  # too little to finish even one dive of the search
-    orders = [preorder(inst, h) for h in PREORDERINGS]
-    # First the lower bound itself (often reachable), then bisection between the highest
-    # capacity that failed and the best peak found, each try with a share of what is left.
-    low, tries = lb, 0
-    while budget > 0 and best.peak - low > max(best.peak // 1000, 1):
-        capacity = lb if tries == 0 else (low + best.peak) // 2
-        share = budget // 3 if tries == 0 else max(budget // 2, 1)
-        found, spent = search_capacity(inst, orders, capacity, share)
+    preorders = Preorders(inst)
+    # Bisection between the highest capacity given up on and the best peak found; once it
+    # closes, start again from the lower bound with twice the dives per capacity.
+    low, dives, infeasible = lb, DIVES_PER_CAPACITY, lb - 1  # infeasible: proven too small
+    while budget >= inst.n:
+        if best.peak - low <= max(best.peak // 1000, 1):
+            if best.peak - infeasible <= max(best.peak // 1000, 1):
+                break
+            low, dives = max(lb, infeasible), 2 * dives
+        capacity = (low + best.peak) // 2
+        found, spent, proven = search_capacity(inst, preorders, capacity, budget, dives)
         budget -= spent
-        tries += 1
         if found is None:
             low = capacity
+            if proven:
+                infeasible = max(infeasible, capacity)
             continue
         peak = inst.peak(found)
         if peak < best.peak:
@@ -66,25 +78,26 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
 
 
 def node_budget_for(inst: Instance, time_budget_s: float) -> int:
-    work_per_node = max(1.0, inst.section_count * inst.n / 40_000)
+    work_per_node = max(1.0, inst.n / 100)
     return int(time_budget_s * NODES_PER_SECOND / work_per_node)
 
 
 def search_capacity(
-    inst: Instance, orders: list[list[int]], capacity: int, node_budget: int
-) -> tuple[list[int] | None, int]:
-    """Round robin over the preorderings with doubling node limits (as MiniMalloc does),
-    until a placement within ``capacity`` is found, one is proven impossible, or the node
-    budget is spent. Returns the offsets (or None) and the nodes spent."""
-    limit = 2 * max(inst.n, 1)
-    remaining = node_budget
-    while remaining > 0:
-        for order in orders:
-            run = CapacitySearch(inst, order, capacity, min(limit, remaining))
-            found = run.run()
-            remaining -= max(run.work, 1)
-            if found is not None or not run.exhausted or remaining <= 0:
-                # found, or proven that nothing fits under this capacity, or out of nodes
-                return found, node_budget - remaining
-        limit *= 2
-    return None, node_budget - remaining
+    inst: Instance, preorders: Preorders, capacity: int, node_budget: int, dives: int
+) -> tuple[list[int] | None, int, bool]:
+    """Up to ``dives`` dives of ``DIVE_NODES * n`` nodes, each under the next
+    preordering, until a placement within ``capacity`` is found or one dive proves that
+    none exists. Returns the offsets (or None), the nodes spent and whether it is proven."""
+    limit = DIVE_NODES * max(inst.n, 1)
+    spent = 0
+    for _ in range(dives):
+        if node_budget - spent <= 0:
+            break
+        run = CapacitySearch(inst, preorders.next(), capacity, min(limit, node_budget - spent))
+        found = run.run()
+        spent += max(run.work, 1)
+        if found is not None:
+            return found, spent, False
+        if not run.exhausted:
+            return None, spent, True
+    return None, spent, False

@@ -69,6 +69,15 @@ class Instance:
             matrix[self.sec_lo[i] : self.sec_hi[i], i] = True
         return matrix
 
+    @cached_property
+    def section_blocks(self) -> list[list[int]]:
+        """``section_blocks[s]``: the blocks live in section ``s``, ascending."""
+        rows: list[list[int]] = [[] for _ in range(self.section_count)]
+        for i in range(self.n):
+            for s in range(self.sec_lo[i], self.sec_hi[i]):
+                rows[s].append(i)
+        return rows
+
     def section_totals(self) -> list[int]:
         """Aligned bytes alive in each section."""
         diff = [0] * (self.section_count + 1)

@@ -5,11 +5,17 @@ Decides whether the blocks fit under a capacity ``C`` by depth-first search over
 each at its lowest feasible offset (the highest top of the placed blocks it overlaps in
 time). At each node the candidates are the unplaced blocks whose minimum offset is below
 the lowest top any unplaced block could reach (placing anything higher would leave a gap
-that block could fill: dominated). A partial solution is pruned when some section's floor
-plus the bytes still to place in it exceeds ``C``.
+that block could fill: dominated). Inference prunes a partial solution when
 
-The search is cut off after a fixed number of nodes, so results never depend on machine
-speed.
+- some section touched by the block just placed has its new floor plus the bytes still to
+  place in it above ``C``;
+- the current offset plus the most bytes still to place in any one section is above ``C``
+  (everything left goes at or above the current offset);
+- a block pushed up by the block just placed no longer fits under ``C``.
+
+A node is plain Python over lists (no per-node array allocation), so its cost grows with
+the number of unplaced blocks and the neighbours of the block placed. The search is cut
+off after a fixed number of nodes, so results never depend on machine speed.
 """
 
 from __future__ import annotations
@@ -17,16 +23,11 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
-import numpy as np
-
 from rgraph.memory.instance import Instance
 
 #: Static preorderings (MiniMalloc's defaults): W = lifetime width, A = area,
 #: T = the largest live total among the block's sections. All descending.
 PREORDERINGS = ("WAT", "TAW", "TWA")
-
-
-_HUGE = np.iinfo(np.int64).max // 4
 
 
 class _OutOfNodes(Exception):
@@ -53,7 +54,8 @@ class CapacitySearch:
         self.inst = inst
         self.capacity = capacity
         self.nodes_left = node_limit
-        self.nodes = 0
+        self.work = 0
+        self.exhausted = False
         self.rank = [0] * inst.n
         for r, i in enumerate(order):
             self.rank[i] = r
@@ -61,22 +63,15 @@ class CapacitySearch:
         self.unplaced = [i for i in order if inst.size[i] > 0]
         self.offsets = [0 if inst.size[i] == 0 else -1 for i in range(inst.n)]
         self.min_off = [0] * inst.n
-        self.floor = np.zeros(inst.section_count, dtype=np.int64)
-        self.total = np.asarray(inst.section_totals(), dtype=np.int64)
-        self.members = inst.members
-        self.pending_min = np.zeros(inst.n, dtype=np.int64)  # min_off, or a huge value once placed
-        for i in range(inst.n):
-            if inst.size[i] == 0:
-                self.pending_min[i] = _HUGE
-        # Lowest minimum offset of the unplaced blocks in each section (0 when none).
-        self.pending_floor = np.zeros(inst.section_count, dtype=np.int64)
+        self.floor = [0] * inst.section_count
+        self.total = inst.section_totals()
 
     def run(self) -> list[int] | None:
         """Offsets if a placement within capacity was found; None if none exists or the
         node limit ran out (see ``exhausted``)."""
         self.exhausted = False
         start_budget = self.nodes_left
-        if self.total.size and int(self.total.max()) > self.capacity:
+        if max(self.total, default=0) > self.capacity:
             return None
         limit = sys.getrecursionlimit()
         sys.setrecursionlimit(max(limit, 4 * self.inst.n + 1000))
@@ -91,60 +86,79 @@ class CapacitySearch:
         return list(self.offsets) if found else None
 
     def _dfs(self, last_off: int, last_rank: int) -> bool:
-        if self.nodes_left <= 0:
-            raise _OutOfNodes
-        self.nodes += 1
         unplaced = self.unplaced
         if not unplaced:
             return True
-        inst, min_off, rank = self.inst, self.min_off, self.rank
-        size, align, neighbors, offsets = inst.size, inst.align, inst.neighbors, self.offsets
-        min_height = min(min_off[i] + size[i] for i in unplaced)
-        candidates = sorted(
-            (min_off[i], rank[i], i)
-            for i in unplaced
-            if min_off[i] < min_height and (min_off[i] > last_off or (min_off[i] == last_off and rank[i] > last_rank))
-        )
+        if self.nodes_left <= 0:
+            raise _OutOfNodes
+        inst, mins, rank, offsets = self.inst, self.min_off, self.rank, self.offsets
+        size, align, neighbors = inst.size, inst.align, inst.neighbors
         floor, total, capacity = self.floor, self.total, self.capacity
-        for off, r, i in candidates:
+        min_height = min([mins[i] + size[i] for i in unplaced])
+        candidates = [
+            i
+            for i in unplaced
+            if last_off <= mins[i] < min_height and (mins[i] > last_off or rank[i] > last_rank)
+        ]
+        candidates.sort(key=mins.__getitem__)  # stable: ties keep preorder rank
+        headroom = capacity - max(total)
+        for i in candidates:
+            off = mins[i]
+            if off > headroom:
+                break  # everything left goes at or above off; later candidates are higher
             top = off + size[i]
+            self.nodes_left -= 1
             offsets[i] = off
             position = unplaced.index(i)
             del unplaced[position]
+            ok = True
             changed = []
             for j in neighbors[i]:
-                if offsets[j] < 0 and min_off[j] < top:
-                    changed.append((j, min_off[j]))
+                old = mins[j]
+                if old < top and offsets[j] < 0:
                     a = align[j]
-                    min_off[j] = top if top % a == 0 else top + a - top % a
+                    new = top if top % a == 0 else top + a - top % a
+                    mins[j] = new
+                    changed.append((j, old))
+                    if new + size[j] > capacity:
+                        ok = False
             lo, hi = inst.sec_lo[i], inst.sec_hi[i]
-            saved_floor = floor[lo:hi].copy()
-            floor[lo:hi] = top
-            total[lo:hi] -= size[i]
-            pending = self.pending_min
-            pending[i] = _HUGE
-            rows_lo, rows_hi = lo, hi
-            for j, _ in changed:
-                pending[j] = min_off[j]
-                rows_lo = min(rows_lo, inst.sec_lo[j])
-                rows_hi = max(rows_hi, inst.sec_hi[j])
-            pending_floor = self.pending_floor
-            saved_pending_floor = pending_floor[rows_lo:rows_hi].copy()
-            lowest = np.where(self.members[rows_lo:rows_hi], pending, _HUGE).min(axis=1)
-            lowest[lowest == _HUGE] = 0
-            pending_floor[rows_lo:rows_hi] = lowest
-            bottom = np.maximum(np.maximum(floor, pending_floor), off)
-            ok = not (bottom + total > capacity).any()
-            self.nodes_left -= 1
-            if ok and self._dfs(off, r):
+            if ok and changed:
+                ok = self._pending_ok(changed, lo, hi)
+            saved = floor[lo:hi]
+            z = size[i]
+            for s in range(lo, hi):
+                floor[s] = top
+                left = total[s] - z
+                total[s] = left
+                if top + left > capacity:
+                    ok = False
+            if ok and self._dfs(off, rank[i]):
                 return True
-            floor[lo:hi] = saved_floor
-            pending_floor[rows_lo:rows_hi] = saved_pending_floor
-            total[lo:hi] += size[i]
-            for j, old in reversed(changed):
-                min_off[j] = old
-                pending[j] = old
-            pending[i] = min_off[i]
+            floor[lo:hi] = saved
+            for s in range(lo, hi):
+                total[s] += z
+            for j, old in changed:
+                mins[j] = old
             unplaced.insert(position, i)
             offsets[i] = -1
         return False
+
+    def _pending_ok(self, changed: list[tuple[int, int]], lo: int, hi: int) -> bool:
+        """Sections outside ``lo..hi`` that a pushed-up block lives in: the lowest minimum
+        offset of their unplaced blocks plus their bytes still to place must fit."""
+        inst, mins, offsets = self.inst, self.min_off, self.offsets
+        first = min(inst.sec_lo[j] for j, _ in changed)
+        last = max(inst.sec_hi[j] for j, _ in changed)
+        rows, total, capacity = inst.section_blocks, self.total, self.capacity
+        for s in (*range(first, lo), *range(hi, last)):
+            left = total[s]
+            if not left:
+                continue
+            threshold = capacity - left
+            for j in rows[s]:
+                if mins[j] <= threshold and offsets[j] < 0:
+                    break
+            else:
+                return False
+        return True

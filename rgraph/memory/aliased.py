@@ -88,7 +88,7 @@ def search_capacity(
     """Up to ``dives`` dives of ``DIVE_NODES * n`` nodes, each under the next
     preordering, until a placement within ``capacity`` is found or one dive proves that
     none exists. Returns the offsets (or None), the nodes spent and whether it is proven."""
-    limit = DIVE_NODES * max(inst.n, 1)
+    limit = int(DIVE_NODES * max(inst.n, 1))
     spent = 0
     for _ in range(dives):
         if node_budget - spent <= 0:

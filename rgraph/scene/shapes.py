@@ -53,9 +53,11 @@ def vertex_normals(positions: np.ndarray, indices: np.ndarray, fallback: np.ndar
     cancelling vertices take ``fallback``)."""
     p = positions[indices]
     face = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])  # length = 2 * area
-    acc = np.zeros_like(positions)
-    for k in range(3):
-        np.add.at(acc, indices[:, k], face)
+    corners = np.asarray(indices, dtype=np.int64).T.reshape(-1)  # all first corners, then second, third
+    weights = np.concatenate([face, face, face])
+    n = len(positions)
+    # bincount sums in the same order as np.add.at over the three corners, several times faster
+    acc = np.stack([np.bincount(corners, weights=weights[:, c], minlength=n) for c in range(3)], axis=1)
     return safe_normalize(acc, fallback)
 
 

@@ -55,12 +55,31 @@ def rss_at_frames(frames: int, marks: tuple[int, ...], size=(16, 16)) -> dict[in
     return samples
 
 
+def rss_in_fresh_process(frames: int, marks: tuple[int, ...]) -> dict[int, int]:
+    """``rss_at_frames`` in a new interpreter: a pytest worker's resident set also moves with
+    what earlier tests left in its allocator (+3.5 MiB between frames 20 and 199 inside the
+    parallel suite, flat within 30 KiB alone), which is not the frame loop's doing."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parent
+    code = (f"import json, sys; sys.path.insert(0, {str(here)!r}); from test_soak import rss_at_frames; "
+            f"print(json.dumps(rss_at_frames({frames}, {marks!r})))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    if "Skipped" in done.stderr:  # pragma: no cover - environment without Vulkan
+        pytest.skip(done.stderr.strip().splitlines()[-1])
+    assert done.returncode == 0, done.stderr[-3000:]
+    return {int(k): v for k, v in json.loads(done.stdout.strip().splitlines()[-1]).items()}
+
+
 def test_soak_200_frames_rss_flat():
-    rss = rss_at_frames(200, (20, 199))
+    rss = rss_in_fresh_process(200, (20, 199))
     assert rss[199] - rss[20] <= RSS_TOLERANCE_KIB, rss
 
 
 @pytest.mark.slow
 def test_soak_1000_frames_rss_flat():
-    rss = rss_at_frames(1000, (100, 999))
+    rss = rss_in_fresh_process(1000, (100, 999))
     assert rss[999] - rss[100] <= RSS_TOLERANCE_KIB, rss

@@ -18,16 +18,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("trace", help="CSV trace: id,lower,upper,size[,alignment]")
     parser.add_argument("--policy", default="aliased", help="dedicated | aliased | optimal | tlsf | blocks:SIZE")
-    parser.add_argument("--budget", type=float, default=None, help="time budget in seconds (aliased/optimal)")
+    parser.add_argument("--budget", type=float, default=None,
+                        help="time budget in seconds (default: 1 for aliased, 2 for optimal; the compiler uses 0.05)")
     parser.add_argument("--verify", action="store_true", help="check the placement independently")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.memory import place
+    from rgraph.memory import TRACE_BUDGET_S, place
     from rgraph.memory.verify import overlaps
 
     policy, budget = parse_place_args(args.policy, args.budget, source="--policy")
+    if budget is None and policy.kind == "aliased":
+        budget = TRACE_BUDGET_S
     blocks = read_trace(args.trace)
     placement = place(blocks, policy, **({"time_budget_s": budget} if budget is not None else {}))
     s = placement.stats

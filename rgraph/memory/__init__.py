@@ -20,7 +20,13 @@ __all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_poli
 
 #: Budget of the ``optimal`` policy when the caller leaves the default.
 OPTIMAL_BUDGET_S = 2.0
+#: The compiler's budget per memory class: it runs on every compile, so 1,000 resources
+#: must place in well under 100 ms (a graph's greedy placement is usually at the bound and
+#: the search never starts).
 DEFAULT_BUDGET_S = 0.05
+#: ``rgraph place``'s default for ``aliased``: an offline tool for lifetime traces, where a
+#: second buys the search enough dives on the hard MiniMalloc instances (benchmarks/placement.py).
+TRACE_BUDGET_S = 1.0
 
 
 def parse_place_args(policy: str, budget: float | None, source: str = "<command line>") -> tuple[Policy, float | None]:

@@ -58,9 +58,9 @@ def probe_only(plan: dict) -> dict:
     return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
 
 
-def frame_cpu_us(plan: dict, frames: int) -> dict[str, list[float]]:
+def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, list[float]]:
     """Main-thread CPU microseconds per frame (frame start to next frame start) and its parts."""
-    executor = Executor(plan, validate=False, device_index=None, verbose=False)
+    executor = Executor(plan, validate=False, device_index=None, verbose=False, one_call_per_queue=one_call_per_queue)
     marks: list[float] = []
     try:
         executor.run_frames(frames, marks=marks)
@@ -81,9 +81,9 @@ def frame_cpu_us(plan: dict, frames: int) -> dict[str, list[float]]:
     }
 
 
-def plan_calls(plan: dict) -> list[str]:
+def plan_calls(plan: dict, one_call_per_queue: bool = True) -> list[str]:
     """Queues of the vkQueueSubmit2 calls of one frame, as the executor groups them."""
-    executor = Executor(plan, validate=False, device_index=None, verbose=False)
+    executor = Executor(plan, validate=False, device_index=None, verbose=False, one_call_per_queue=one_call_per_queue)
     try:
         return [str(call.context) for call in executor.submit_calls[0]]
     finally:
@@ -164,6 +164,10 @@ def main() -> None:
     print(f"    semaphore values:                                {_summary(parts['values'])}")
     calls = f"    vkQueueSubmit2 calls ({len(plan_calls(plan))} per frame):"
     print(f"{calls:<53}{_summary(parts['submit'])}")
+    runs = frame_cpu_us(plan, args.frames, one_call_per_queue=False)  # same process, for the ratio
+    print(f"  one call per run of consecutive batches ({len(plan_calls(plan, False))} calls): runtime "
+          f"{_summary(runs['runtime'])}, submit calls median {statistics.median(runs['submit']):.1f} us; "
+          f"runtime per-queue/per-run {statistics.median(parts['runtime']) / statistics.median(runs['runtime']):.2f}")
     if not is_gpu:
         print("GPU busy fraction: skipped (CPU device: lavapipe runs the frame on CPU threads)")
         return

@@ -89,11 +89,12 @@ class Executor:
     """Owns every Vulkan object of one run; ``close`` destroys them in reverse order."""
 
     def __init__(self, plan: dict, *, validate: bool, device_index: int | None, verbose: bool = True,
-                 inputs: dict[str, Any] | None = None) -> None:
+                 inputs: dict[str, Any] | None = None, one_call_per_queue: bool = True) -> None:
         if plan.get("format") != "rgraph-plan/1":
             raise ExecutionError("not an rgraph plan (format != rgraph-plan/1)")
         self.plan = plan
         self.verbose = verbose
+        self.one_call_per_queue = one_call_per_queue
         self.inputs = dict(inputs or {})
         self.scene_gpu: Any = None
         self.samplers: dict[str, Any] = {}
@@ -356,9 +357,12 @@ class Executor:
 
         Each batch is one VkSubmitInfo2 (its semaphores order it against the other queues).
         Batches go in ``submission_order`` (each VkQueue runs ahead as far as its waits allow;
-        every wait is submitted after its signal). Without validation, consecutive batches on
-        one VkQueue in that order go in one vkQueueSubmit2 call with an array of VkSubmitInfo2;
-        under validation each batch is its own call so that messages name the batch.
+        every wait is submitted after its signal). Under validation each batch is its own
+        vkQueueSubmit2 call so that messages name the batch. Without validation each VkQueue
+        gets one call per frame with all its batches (``one_call_per_queue``, the default: a
+        wait may then be submitted before its signal, which timeline semaphores allow, and the
+        driver's per-call cost is paid once per queue), or, with it off, one call per run of
+        consecutive batches on one VkQueue in submission order.
         Semaphores: one per edge (rgraph.vk.semaphore_edges), value = frame + offset, written
         straight into the cffi structs.
         """
@@ -382,13 +386,20 @@ class Executor:
         fence_batches = sorted(set(last_of.values()))
         # calls: runs of consecutive batches on one VkQueue (one batch each under validation)
         runs: list[list[int]] = []
-        for bi in order:
-            batch = self.batches[bi]
-            if (runs and not self.instance.validate
-                    and handle_of[self.batches[runs[-1][-1]].queue] == handle_of[batch.queue]):
-                runs[-1].append(bi)
-            else:
-                runs.append([bi])
+        if self.instance.validate:
+            runs = [[bi] for bi in order]
+        elif self.one_call_per_queue:  # waits may come before their signals: timeline semantics allow it
+            per_queue: dict[int, list[int]] = {}
+            for bi in order:
+                per_queue.setdefault(handle_of[self.batches[bi].queue], []).append(bi)
+            runs = list(per_queue.values())
+        else:
+            for bi in order:
+                batch = self.batches[bi]
+                if runs and handle_of[self.batches[runs[-1][-1]].queue] == handle_of[batch.queue]:
+                    runs[-1].append(bi)
+                else:
+                    runs.append([bi])
         self.fences = [[v.vkCreateFence(dev.handle, v.VkFenceCreateInfo(flags=v.VK_FENCE_CREATE_SIGNALED_BIT), None)
                         for _ in fence_batches] for _ in range(FRAMES_IN_FLIGHT)]
         self.fence_arrays = [ffi.new("VkFence[]", fences) if fences else ffi.NULL for fences in self.fences]

@@ -179,22 +179,12 @@ def plot(rows: list[dict[str, Any]], sizes: list[int], path: Path, title: str) -
 def compile_all(args: argparse.Namespace) -> tuple[dict[tuple[str, int], dict], dict, str, int]:
     """Every plan (and a tiny warm-up one), compiled with the image memory requirements of the
     device that will run them; the device's name and maxMemoryAllocationCount."""
-    from rgraph.vk.device import create_device
-    from rgraph.vk.instance import create_instance
-    from rgraph.vk.memreq import DeviceMemoryRequirements
+    from rgraph.vk.memreq import live_requirements
 
-    instance = create_instance(validate=False)
-    try:
-        device = create_device(instance, args.device, verbose=False)
-        try:
-            memory = DeviceMemoryRequirements(device)
-            plans = {(mix, block): compile_plan(args, block, mix, memory) for mix in args.mix for block in args.sizes}
-            warm = compile_plan(argparse.Namespace(**{**vars(args), "meshes": 16, "segments": 4}), 4, "mixed", memory)
-            return plans, warm, device.name, int(device.properties.limits.maxMemoryAllocationCount)
-        finally:
-            device.destroy()
-    finally:
-        instance.destroy()
+    with live_requirements(args.device) as (memory, device):
+        plans = {(mix, block): compile_plan(args, block, mix, memory) for mix in args.mix for block in args.sizes}
+        warm = compile_plan(argparse.Namespace(**{**vars(args), "meshes": 16, "segments": 4}), 4, "mixed", memory)
+        return plans, warm, device.name, int(device.properties.limits.maxMemoryAllocationCount)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -30,27 +30,18 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from typing import Any
 
 from rgraph.compile.pipeline import compile_graph
-from rgraph.vk.device import create_device
 from rgraph.vk.executor import Executor
-from rgraph.vk.instance import create_instance
-from rgraph.vk.memreq import DeviceMemoryRequirements
+from rgraph.vk.memreq import live_requirements
 
 
 def compile_for_device(size: tuple[int, int], policy: str | None = None, graph: str = "surgery",
                        sync: str | None = None) -> tuple[dict, str, bool]:
-    instance = create_instance(validate=False)
-    try:
-        device = create_device(instance, None, verbose=False)
-        try:
-            plan = compile_graph(graph, size=size, policy=policy, memory=DeviceMemoryRequirements(device),
-                                 **({"sync": sync} if sync else {}))
-            return plan, device.name, device.physical.device_type != "cpu"
-        finally:
-            device.destroy()
-    finally:
-        instance.destroy()
+    with live_requirements() as (memory, device):
+        plan = compile_graph(graph, size=size, policy=policy, memory=memory, **({"sync": sync} if sync else {}))
+        return plan, device.name, device.physical.device_type != "cpu"
 
 
 def probe_only(plan: dict) -> dict:
@@ -58,12 +49,14 @@ def probe_only(plan: dict) -> dict:
     return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
 
 
-def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, list[float]]:
-    """Main-thread CPU microseconds per frame (frame start to next frame start) and its parts."""
+def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, Any]:
+    """Main-thread CPU microseconds per frame (frame start to next frame start) and its parts;
+    ``calls``: vkQueueSubmit2 calls per frame."""
     executor = Executor(plan, validate=False, device_index=None, verbose=False, one_call_per_queue=one_call_per_queue)
     marks: list[float] = []
     try:
         executor.run_frames(frames, marks=marks)
+        calls = len(executor.submit_calls[0])
     finally:
         executor.close()
     starts, blocked, read, updated, valued = (marks[k::5] for k in range(5))
@@ -71,6 +64,7 @@ def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> di
     frame = [(b - a) * 1e6 for a, b in zip(starts, starts[1:], strict=False)]
     gpu_wait = [(b - a) * 1e6 for a, b in zip(starts, blocked, strict=False)][:len(frame)]
     return {
+        "calls": calls,
         "frame": frame[skip:],
         "gpu_wait": gpu_wait[skip:],
         "runtime": [f - w for f, w in zip(frame, gpu_wait, strict=True)][skip:],
@@ -79,15 +73,6 @@ def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> di
         "values": [(b - a) * 1e6 for a, b in zip(updated, valued, strict=False)][skip:-1],
         "submit": [(b - a) * 1e6 for a, b in zip(valued, starts[1:], strict=False)][skip:],
     }
-
-
-def plan_calls(plan: dict, one_call_per_queue: bool = True) -> list[str]:
-    """Queues of the vkQueueSubmit2 calls of one frame, as the executor groups them."""
-    executor = Executor(plan, validate=False, device_index=None, verbose=False, one_call_per_queue=one_call_per_queue)
-    try:
-        return [str(call.context) for call in executor.submit_calls[0]]
-    finally:
-        executor.close()
 
 
 def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
@@ -162,10 +147,10 @@ def main() -> None:
     print(f"    timestamp read, fence reset:                     {_summary(parts['readback'])}")
     print(f"    updates (scene, pass update hooks):              {_summary(parts['updates'])}")
     print(f"    semaphore values:                                {_summary(parts['values'])}")
-    calls = f"    vkQueueSubmit2 calls ({len(plan_calls(plan))} per frame):"
+    calls = f"    vkQueueSubmit2 calls ({parts['calls']} per frame):"
     print(f"{calls:<53}{_summary(parts['submit'])}")
     runs = frame_cpu_us(plan, args.frames, one_call_per_queue=False)  # same process, for the ratio
-    print(f"  one call per run of consecutive batches ({len(plan_calls(plan, False))} calls): runtime "
+    print(f"  one call per run of consecutive batches ({runs['calls']} calls): runtime "
           f"{_summary(runs['runtime'])}, submit calls median {statistics.median(runs['submit']):.1f} us; "
           f"runtime per-queue/per-run {statistics.median(parts['runtime']) / statistics.median(runs['runtime']):.2f}")
     if not is_gpu:

@@ -69,7 +69,8 @@ def fit_to_queue(stages: Iterable[str], access: Iterable[str],
     before an ownership transfer); a barrier cannot wait for another queue's work anyway
     (the semaphore orders it), and the spec forbids unsupported stages in the mask."""
     kept = tuple(s for s in stages if queue_supports(s, capabilities))
-    kept_access = tuple(a for a in access if a in supported_accesses(access, kept)) if kept else ()
+    able = set(supported_accesses(access, kept)) if kept else set()
+    kept_access = tuple(a for a in access if a in able)
     return kept, kept_access
 
 

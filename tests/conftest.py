@@ -2,3 +2,18 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def memory():
+    """Memory requirements from the live device, so plans match it (lavapipe or a GPU)."""
+    from rgraph.vk.errors import VulkanUnavailable
+    from rgraph.vk.memreq import live_requirements
+
+    try:
+        with live_requirements() as (requirements, _device):
+            yield requirements
+    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
+        pytest.skip(str(exc))

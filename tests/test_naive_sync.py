@@ -13,7 +13,6 @@ from rgraph.cli import main
 from rgraph.compile.naive_sync import naive_sync
 from rgraph.compile.pipeline import compile_graph, compile_spec, frontend
 from rgraph.random_graph import random_graph, to_yaml
-from rgraph.vk.errors import VulkanUnavailable
 
 
 def _cells(sub, res):
@@ -78,22 +77,6 @@ def test_unknown_sync_mode_is_a_usage_error(capsys):
         main(["compile", "surgery", "--sync", "fast"])
     assert exc.value.code == 2
     assert "--sync" in capsys.readouterr().err
-
-
-@pytest.fixture(scope="module")
-def memory():
-    try:
-        from rgraph.vk.device import create_device
-        from rgraph.vk.instance import create_instance
-        from rgraph.vk.memreq import DeviceMemoryRequirements
-
-        instance = create_instance(validate=False)
-        device = create_device(instance, None, verbose=False)
-    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
-        pytest.skip(str(exc))
-    yield DeviceMemoryRequirements(device)
-    device.destroy()
-    instance.destroy()
 
 
 @pytest.mark.vulkan

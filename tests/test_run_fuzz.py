@@ -13,30 +13,12 @@ from hypothesis import strategies as st
 
 from rgraph.compile.pipeline import compile_spec, frontend
 from rgraph.random_graph import random_graph, to_yaml
-from rgraph.vk.errors import VulkanUnavailable
 
 pytestmark = pytest.mark.vulkan
 
 EXAMPLES = int(os.environ.get("RGRAPH_FUZZ_EXAMPLES", "8"))
 SLOW_EXAMPLES = int(os.environ.get("RGRAPH_FUZZ_EXAMPLES", "200"))
 POLICIES = ("dedicated", "aliased")
-
-
-@pytest.fixture(scope="module")
-def memory():
-    """Memory requirements from the live device, so plans match it (lavapipe or a GPU)."""
-    try:
-        from rgraph.vk.device import create_device
-        from rgraph.vk.instance import create_instance
-        from rgraph.vk.memreq import DeviceMemoryRequirements
-
-        instance = create_instance(validate=False)
-        device = create_device(instance, None, verbose=False)
-    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
-        pytest.skip(str(exc))
-    yield DeviceMemoryRequirements(device)
-    device.destroy()
-    instance.destroy()
 
 
 def run_random(tmp: Path, memory, seed: int, passes: int, policy: str) -> None:

@@ -170,10 +170,8 @@ def racing_reports(plan: dict, device: FakeDevice, order_of, frames: int = 3) ->
     tag = 0
     reports = set()
     for frame in range(frames):
-        s = frame % SETS
         for bi in order:
             x = syncs[bi].vk_queue
-            waits, _ = batch_semaphores(edges, SETS, s, bi)
             for e in edges:
                 if e.wait_batch != bi:
                     continue

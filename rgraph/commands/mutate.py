@@ -49,19 +49,9 @@ def _compile(args: argparse.Namespace, need_device: bool) -> dict:
                   policy=args.policy)
     if not need_device:
         return compile_graph(args.graph, **kwargs)
-    from rgraph.vk.device import create_device
-    from rgraph.vk.instance import create_instance
-    from rgraph.vk.memreq import DeviceMemoryRequirements
+    from rgraph.vk.memreq import compile_for_device
 
-    instance = create_instance(validate=False)
-    try:
-        device = create_device(instance, args.device, verbose=False)
-        try:
-            return compile_graph(args.graph, memory=DeviceMemoryRequirements(device), **kwargs)
-        finally:
-            device.destroy()
-    finally:
-        instance.destroy()
+    return compile_for_device(args.graph, args.device, **kwargs)
 
 
 def print_report(report, out=sys.stdout) -> None:

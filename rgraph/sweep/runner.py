@@ -181,26 +181,16 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
 def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, dict]:
     """Plans by params key, compiled with the live device's memory requirements."""
     from rgraph.compile.pipeline import compile_graph
-    from rgraph.vk.device import create_device
-    from rgraph.vk.instance import create_instance
-    from rgraph.vk.memreq import DeviceMemoryRequirements
+    from rgraph.vk.memreq import live_requirements
 
     source = load_graph(resolve_graph(request.graph))
     plans: dict[tuple, dict] = {}
-    instance = create_instance(validate=False)
-    try:
-        device = create_device(instance, request.device, verbose=False)
-        try:
-            memory = DeviceMemoryRequirements(device)
-            for s in settings:
-                plans[params_key(resolved(source, s.overrides))] = compile_graph(
-                    request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
-                    policy=request.policy, memory=memory,
-                    extra_outputs=[request.hdr] if request.hdr else [])
-        finally:
-            device.destroy()
-    finally:
-        instance.destroy()
+    with live_requirements(request.device) as (memory, _device):
+        for s in settings:
+            plans[params_key(resolved(source, s.overrides))] = compile_graph(
+                request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
+                policy=request.policy, memory=memory,
+                extra_outputs=[request.hdr] if request.hdr else [])
     return plans
 
 

@@ -235,45 +235,22 @@ class Executor:
                 for r, buf, regions in work:
                     final = r.plan["final"]
                     if r.is_image:
-                        rng = v.VkImageSubresourceRange(aspectMask=names.aspect_mask(r.plan["format"]), baseMipLevel=0,
-                                                        levelCount=r.plan["mips"], baseArrayLayer=0,
-                                                        layerCount=r.plan["layers"])
-                        to_dst = v.VkImageMemoryBarrier2(
-                            srcStageMask=0, srcAccessMask=0, dstStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT,
-                            dstAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT, oldLayout=v.VK_IMAGE_LAYOUT_UNDEFINED,
-                            newLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-                            dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, image=r.handle, subresourceRange=rng)
-                        dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[to_dst])
-                        keep.append((to_dst, dep))
-                        v.vkCmdPipelineBarrier2(cb, dep)
+                        rng = _whole_range(r)
+                        keep.append(_image_barrier(cb, r, rng, (0, 0), _copy_write(), v.VK_IMAGE_LAYOUT_UNDEFINED,
+                                                   v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL))
                         v.vkCmdCopyBufferToImage(cb, buf.handle, r.handle, v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                                  len(regions), regions)
-                        if r.plan["final"]["queue"] != queue:  # release to the final queue's family
+                        if final["queue"] != queue:  # release to the final queue's family
                             keep.append(_ownership_barrier(cb, r, rng, self.device, "graphics", final["queue"], True))
-                            continue
-                        to_final = v.VkImageMemoryBarrier2(
-                            srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                            dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
-                            oldLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=names.layout(final["layout"]),
-                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-                            image=r.handle, subresourceRange=rng)
-                        dep2 = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[to_final])
-                        keep.append((to_final, dep2))
-                        v.vkCmdPipelineBarrier2(cb, dep2)
+                        else:
+                            keep.append(_image_barrier(cb, r, rng, _copy_write(), _any_access(),
+                                                       v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                                       names.layout(final["layout"])))
                     else:
                         size = int(r.plan["size_bytes"] or r.plan["bytes"])
                         v.vkCmdCopyBuffer(cb, buf.handle, r.handle, 1, [v.VkBufferCopy(srcOffset=0, dstOffset=0,
                                                                                       size=size)])
-                        after = v.VkBufferMemoryBarrier2(
-                            srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                            dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
-                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-                            buffer=r.handle, offset=0, size=names.WHOLE_SIZE)
-                        dep = v.VkDependencyInfo(bufferMemoryBarrierCount=1, pBufferMemoryBarriers=[after])
-                        keep.append((after, dep))
-                        v.vkCmdPipelineBarrier2(cb, dep)
+                        keep.append(_buffer_barrier(cb, r, _copy_write(), _any_access()))
 
             self._one_time(queue, record)
         for queue, items in handoffs.items():
@@ -291,8 +268,7 @@ class Executor:
             batches = build_barriers(self.device, self.resources, 0, releases, "release", queue)
             if batches:
                 self.log.context = f"releasing persistent resources for frame 0 on {queue}"
-                self._one_time(queue, lambda cb, batches=batches: [vk().vkCmdPipelineBarrier2(cb, b.dependency)
-                                                                   for b in batches])
+                self._one_time(queue, lambda cb, batches=batches: _record_barriers(cb, batches))
 
     def _label(self, cb: Any, text: str | None) -> None:
         v = vk()
@@ -571,31 +547,15 @@ class Executor:
                 keep = []
                 for res, r, buf, regions, size in jobs:
                     final = res["final"]
-                    src_stages, src_access = names.stages(final["stages"]), names.accesses(final["access"])
+                    src = names.stages(final["stages"]), names.accesses(final["access"])
+                    copy_read = v.VK_PIPELINE_STAGE_2_COPY_BIT, v.VK_ACCESS_2_TRANSFER_READ_BIT
                     if r.is_image:
-                        rng = v.VkImageSubresourceRange(aspectMask=names.aspect_mask(res["format"]), baseMipLevel=0,
-                                                        levelCount=res["mips"], baseArrayLayer=0,
-                                                        layerCount=res["layers"])
-                        b = v.VkImageMemoryBarrier2(
-                            srcStageMask=src_stages, srcAccessMask=src_access,
-                            dstStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, dstAccessMask=v.VK_ACCESS_2_TRANSFER_READ_BIT,
-                            oldLayout=names.layout(final["layout"]), newLayout=v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-                            image=r.handle, subresourceRange=rng)
-                        dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[b])
-                        keep.append((b, dep))
-                        v.vkCmdPipelineBarrier2(cb, dep)
+                        keep.append(_image_barrier(cb, r, _whole_range(r), src, copy_read, names.layout(final["layout"]),
+                                                   v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL))
                         v.vkCmdCopyImageToBuffer(cb, r.handle, v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf.handle,
                                                  len(regions), regions)
                     else:
-                        b = v.VkBufferMemoryBarrier2(
-                            srcStageMask=src_stages, srcAccessMask=src_access,
-                            dstStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, dstAccessMask=v.VK_ACCESS_2_TRANSFER_READ_BIT,
-                            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-                            buffer=r.handle, offset=0, size=names.WHOLE_SIZE)
-                        dep = v.VkDependencyInfo(bufferMemoryBarrierCount=1, pBufferMemoryBarriers=[b])
-                        keep.append((b, dep))
-                        v.vkCmdPipelineBarrier2(cb, dep)
+                        keep.append(_buffer_barrier(cb, r, src, copy_read))
                         v.vkCmdCopyBuffer(cb, r.handle, buf.handle, 1, [v.VkBufferCopy(srcOffset=0, dstOffset=0,
                                                                                       size=size)])
 
@@ -682,21 +642,58 @@ def _needs_graphics_copy(r: Any, device: Device, queue: str) -> bool:
             and not device.same_family(queue, "graphics"))
 
 
-def _ownership_barrier(cb: Any, r: Any, rng: Any, device: Device, src: str, dst: str, release: bool) -> tuple:
-    """The release (on ``src``) or acquire (on ``dst``) half of an ownership transfer of an
-    initialised image, layout kept at TRANSFER_DST_OPTIMAL; returns the structs to keep alive."""
+def _record_barriers(cb: Any, batches: list[BarrierBatch]) -> None:
+    for b in batches:
+        vk().vkCmdPipelineBarrier2(cb, b.dependency)
+
+
+def _whole_range(r: Any) -> Any:
+    return vk().VkImageSubresourceRange(aspectMask=names.aspect_mask(r.plan["format"]), baseMipLevel=0,
+                                        levelCount=r.plan["mips"], baseArrayLayer=0, layerCount=r.plan["layers"])
+
+
+def _image_barrier(cb: Any, r: Any, rng: Any, src: tuple[int, int], dst: tuple[int, int], old_layout: int,
+                   new_layout: int, families: tuple[int, int] | None = None) -> tuple:
+    """Record one image barrier (``src``/``dst``: (stage mask, access mask); ``families``: an
+    ownership transfer's (src, dst) queue families, else IGNORED); the structs to keep alive."""
     v = vk()
-    b = v.VkImageMemoryBarrier2(
-        srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT if release else 0,
-        srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT if release else 0,
-        dstStageMask=0 if release else v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-        dstAccessMask=0 if release else v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
-        oldLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-        srcQueueFamilyIndex=device.families[src], dstQueueFamilyIndex=device.families[dst],
-        image=r.handle, subresourceRange=rng)
+    src_family, dst_family = families or (v.VK_QUEUE_FAMILY_IGNORED, v.VK_QUEUE_FAMILY_IGNORED)
+    b = v.VkImageMemoryBarrier2(srcStageMask=src[0], srcAccessMask=src[1], dstStageMask=dst[0], dstAccessMask=dst[1],
+                                oldLayout=old_layout, newLayout=new_layout, srcQueueFamilyIndex=src_family,
+                                dstQueueFamilyIndex=dst_family, image=r.handle, subresourceRange=rng)
     dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[b])
     v.vkCmdPipelineBarrier2(cb, dep)
     return b, dep
+
+
+def _buffer_barrier(cb: Any, r: Any, src: tuple[int, int], dst: tuple[int, int]) -> tuple:
+    """Record one whole-buffer barrier (``src``/``dst``: (stage mask, access mask))."""
+    v = vk()
+    b = v.VkBufferMemoryBarrier2(srcStageMask=src[0], srcAccessMask=src[1], dstStageMask=dst[0], dstAccessMask=dst[1],
+                                 srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                                 dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                                 buffer=r.handle, offset=0, size=names.WHOLE_SIZE)
+    dep = v.VkDependencyInfo(bufferMemoryBarrierCount=1, pBufferMemoryBarriers=[b])
+    v.vkCmdPipelineBarrier2(cb, dep)
+    return b, dep
+
+
+def _copy_write() -> tuple[int, int]:
+    v = vk()
+    return v.VK_PIPELINE_STAGE_2_COPY_BIT, v.VK_ACCESS_2_TRANSFER_WRITE_BIT
+
+
+def _any_access() -> tuple[int, int]:
+    v = vk()
+    return v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT
+
+
+def _ownership_barrier(cb: Any, r: Any, rng: Any, device: Device, src: str, dst: str, release: bool) -> tuple:
+    """The release (on ``src``) or acquire (on ``dst``) half of an ownership transfer of an
+    initialised image, layout kept at TRANSFER_DST_OPTIMAL; returns the structs to keep alive."""
+    layout = vk().VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL
+    return _image_barrier(cb, r, rng, _copy_write() if release else (0, 0), (0, 0) if release else _any_access(),
+                          layout, layout, (device.families[src], device.families[dst]))
 
 
 def _acquire_initialised(cb: Any, items: list, device: Device, queue: str) -> list:
@@ -704,19 +701,10 @@ def _acquire_initialised(cb: Any, items: list, device: Device, queue: str) -> li
     v = vk()
     keep: list = []
     for r in items:
-        rng = v.VkImageSubresourceRange(aspectMask=names.aspect_mask(r.plan["format"]), baseMipLevel=0,
-                                        levelCount=r.plan["mips"], baseArrayLayer=0, layerCount=r.plan["layers"])
+        rng = _whole_range(r)
         keep.append(_ownership_barrier(cb, r, rng, device, "graphics", queue, False))
-        b = v.VkImageMemoryBarrier2(
-            srcStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, srcAccessMask=0,
-            dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-            dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT | v.VK_ACCESS_2_MEMORY_WRITE_BIT,
-            oldLayout=v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=names.layout(r.plan["final"]["layout"]),
-            srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-            image=r.handle, subresourceRange=rng)
-        dep = v.VkDependencyInfo(imageMemoryBarrierCount=1, pImageMemoryBarriers=[b])
-        v.vkCmdPipelineBarrier2(cb, dep)
-        keep.append((b, dep))
+        keep.append(_image_barrier(cb, r, rng, (v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0), _any_access(),
+                                   v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, names.layout(r.plan["final"]["layout"])))
     return keep
 
 

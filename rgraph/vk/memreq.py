@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 from rgraph.vk import names
@@ -63,11 +64,10 @@ class DeviceMemoryRequirements:
         return int(req.size), int(req.alignment), int(req.memoryTypeBits)
 
 
-def compile_for_device(graph: Any, device_index: int | None = None, **options: Any) -> dict:
-    """``compile_graph(graph, **options)`` with sizes and alignments from the live device that
-    ``execute_plan(..., device_index=device_index)`` will use (a plan compiled for another
-    device's profile is refused by the runtime's requirements cross-check)."""
-    from rgraph.compile.pipeline import compile_graph
+@contextmanager
+def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceMemoryRequirements, Device]]:
+    """The memory-requirements provider of the live device that ``execute_plan(...,
+    device_index=device_index)`` will use, and that device; both destroyed on exit."""
     from rgraph.vk.device import create_device
     from rgraph.vk.instance import create_instance
 
@@ -75,8 +75,18 @@ def compile_for_device(graph: Any, device_index: int | None = None, **options: A
     try:
         device = create_device(instance, device_index, verbose=False)
         try:
-            return compile_graph(graph, memory=DeviceMemoryRequirements(device), **options)
+            yield DeviceMemoryRequirements(device), device
         finally:
             device.destroy()
     finally:
         instance.destroy()
+
+
+def compile_for_device(graph: Any, device_index: int | None = None, **options: Any) -> dict:
+    """``compile_graph(graph, **options)`` with sizes and alignments from the live device that
+    ``execute_plan(..., device_index=device_index)`` will use (a plan compiled for another
+    device's profile is refused by the runtime's requirements cross-check)."""
+    from rgraph.compile.pipeline import compile_graph
+
+    with live_requirements(device_index) as (memory, _device):
+        return compile_graph(graph, memory=memory, **options)

@@ -17,7 +17,7 @@ from rgraph.vk import names
 from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
-from rgraph.vk.resources import HostBuffer, Resource, ResourceSet
+from rgraph.vk.resources import HostBuffer, Resource, ResourceSet, destroy_owned
 from rgraph.vk.shaders import compile_shader, find_shader
 
 DESCRIPTOR_KINDS = ("sampled", "storage_image", "storage_buffer", "uniform_buffer")
@@ -341,13 +341,7 @@ class PassSetup:
 
     # ------------------------------------------------------------- teardown
     def destroy(self) -> None:
-        v = vk()
-        for destroy, handle in reversed(self._objects):
-            getattr(v, destroy)(self.device.handle, handle, None)
-        self._objects = []
-        for buf in reversed(self._host_buffers):
-            buf.destroy()
-        self._host_buffers = []
+        destroy_owned(self.device, self._objects, self._host_buffers)
 
 
 def pack(fmt: str, *values: Any) -> bytes:

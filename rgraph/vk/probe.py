@@ -20,7 +20,7 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.probe_glsl import ProbeShaders, generate
 from rgraph.vk.record import RecordContext
-from rgraph.vk.resources import HostBuffer, Resource, ResourceSet
+from rgraph.vk.resources import HostBuffer, Resource, ResourceSet, destroy_owned
 
 _GENERATED = Path(tempfile.gettempdir()) / "rgraph-probe-glsl"
 
@@ -406,10 +406,4 @@ class ProbePass:
                 ctx.copy_buffer(src.handle, buf.handle, [v.VkBufferCopy(srcOffset=0, dstOffset=0, size=buf.size)])
 
     def destroy(self) -> None:
-        v = vk()
-        for destroy, handle in reversed(self.objects):
-            getattr(v, destroy)(self.device.handle, handle, None)
-        self.objects = []
-        for buf in reversed(self.host_buffers):
-            buf.destroy()
-        self.host_buffers = []
+        destroy_owned(self.device, self.objects, self.host_buffers)

@@ -220,6 +220,18 @@ class ResourceSet:
         self.memories = []
 
 
+def destroy_owned(device: Device, objects: list[tuple[str, Any]], host_buffers: list[HostBuffer]) -> None:
+    """Destroy a pass's own objects ((vkDestroy* name, handle), newest first) and host
+    buffers, and empty both lists."""
+    v = vk()
+    for destroy, handle in reversed(objects):
+        getattr(v, destroy)(device.handle, handle, None)
+    objects.clear()
+    for buf in reversed(host_buffers):
+        buf.destroy()
+    host_buffers.clear()
+
+
 def _aliased(residents: list[dict]) -> set[str]:
     """Names of resources whose memory range overlaps another resident's."""
     out = set()

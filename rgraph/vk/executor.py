@@ -22,18 +22,13 @@ from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.impl_pass import ImplPass
 from rgraph.vk.instance import Instance, ValidationMessage, create_instance
+from rgraph.vk.layer_races import avoid_layer_races, touched_resources
 from rgraph.vk.loader import vk
 from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
 from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
 from rgraph.vk.resources import HostBuffer, ResourceSet
-from rgraph.vk.semaphore_edges import (
-    BatchSync,
-    batch_semaphores,
-    semaphore_count,
-    semaphore_edges,
-    submission_order,
-)
+from rgraph.vk.semaphore_edges import BatchSync, batch_semaphores, semaphore_count
 from rgraph.vk.texels import decode, encode
 
 FRAMES_IN_FLIGHT = 2
@@ -109,6 +104,7 @@ class Executor:
         self.fence_arrays: list[Any] = []
         self.submit_calls: list[list[SubmitCall]] = []
         self.value_slots: list[list[tuple[Any, int]]] = []
+        self.layer_edges = 0  # semaphore edges added only to avoid the 1.3.239 layer's racing false positive
         self.sampler = None
         self.host_buffers: list[HostBuffer] = []
         self.batches: list[Batch] = []
@@ -340,7 +336,8 @@ class Executor:
         driver's per-call cost is paid once per queue), or, with it off, one call per run of
         consecutive batches on one VkQueue in submission order.
         Semaphores: one per edge (rgraph.vk.semaphore_edges), value = frame + offset, written
-        straight into the cffi structs.
+        straight into the cffi structs; edges the 1.3.239 layer's racing check needs to see a
+        sync are added where its model predicts a false report (rgraph.vk.layer_races).
         """
         v = vk()
         ffi = v.ffi
@@ -348,11 +345,11 @@ class Executor:
         handle_of = {q: int(ffi.cast("uintptr_t", vk_queue)) for q, vk_queue in dev.queues.items()}
         syncs = [BatchSync(b.queue, handle_of[b.queue],
                            tuple((w["queue"], w["value"], names.stages(w["stages"])) for w in b.passes[0]["waits"]),
-                           tuple((sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in b.passes[-1]["signals"]))
+                           tuple((sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in b.passes[-1]["signals"]),
+                           touched_resources(b.passes))
                  for b in self.batches]
         try:
-            edges = semaphore_edges(syncs, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT)
-            order = submission_order(syncs, edges)
+            edges, order, self.layer_edges = avoid_layer_races(syncs, v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT)
         except ValueError as exc:
             raise ExecutionError(f"plan semaphores: {exc}") from None
         semaphores = [dev.new_timeline() for _ in range(semaphore_count(edges, FRAMES_IN_FLIGHT))]

@@ -23,7 +23,7 @@ next frame; frame 0 waits for value 0, which every timeline starts at.
 
 from __future__ import annotations
 
-from collections.abc import Hashable
+from collections.abc import Hashable, Iterable
 from dataclasses import dataclass
 
 
@@ -31,12 +31,13 @@ from dataclasses import dataclass
 class BatchSync:
     """What the executor knows of one batch: its plan queue, the VkQueue it runs on, the plan
     waits of its first pass and the plan signals of its last pass as (plan queue, value, stage
-    mask)."""
+    mask), and the resources its passes access or transition (for rgraph.vk.layer_races)."""
 
     plan_queue: str
     vk_queue: Hashable
     waits: tuple[tuple[str, int, int], ...]
     signals: tuple[tuple[str, int, int], ...]
+    resources: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -57,9 +58,11 @@ class SemaphoreUse:
     stages: int
 
 
-def semaphore_edges(batches: list[BatchSync], all_commands: int) -> list[SemaphoreEdge]:
+def semaphore_edges(batches: list[BatchSync], all_commands: int,
+                    extra: Iterable[tuple[int, int]] = ()) -> list[SemaphoreEdge]:
     """The edges of one frame (see the module docstring); ``all_commands`` is the stage mask
-    of frame edges."""
+    of frame edges and of ``extra`` in-frame edges (signal batch, wait batch) that the plan
+    does not need (rgraph.vk.layer_races adds them; they merge like plan waits)."""
     signalled_by: dict[tuple[str, int], int] = {}
     for bi, batch in enumerate(batches):
         for queue, value, _stages in batch.signals:
@@ -80,6 +83,10 @@ def semaphore_edges(batches: list[BatchSync], all_commands: int) -> list[Semapho
                 prev_source, prev_signal, prev_wait = latest[key]
                 source, signal_stages, stages = max(source, prev_source), signal_stages | prev_signal, stages | prev_wait
             latest[key] = (source, signal_stages, stages)
+    for source, bi in extra:
+        key = (bi, batches[source].vk_queue)
+        prev_source, prev_signal, prev_wait = latest.get(key, (source, 0, 0))
+        latest[key] = (max(source, prev_source), prev_signal | all_commands, prev_wait | all_commands)
     edges = [SemaphoreEdge(source, wait, signal_stages, wait_stages, False)
              for (wait, _q), (source, signal_stages, wait_stages) in sorted(latest.items(), key=lambda kv: kv[0][0])]
     first: dict[Hashable, int] = {}

@@ -1,12 +1,14 @@
 """Per-frame CPU cost of resubmitting a compiled plan, and GPU busy fraction at 1920x1080.
 
-CPU: main-thread CPU time (time.thread_time) between consecutive frame starts of one run of
-the surgery plan (no validation), median over many frames. The driver's worker threads are
-not counted. Each frame is split into: blocked (the vkWaitForFences call: the CPU is ahead
-of the GPU and waits for the frame two back; a driver that spins while it waits bills this
-as CPU time), and the runtime's work, everything else - target <= 50 us: timestamp read and
-fence reset, updates (scene animation and pass ``update`` hooks: with ``--passes real`` the
-pass implementations' cost), semaphore values, and the vkQueueSubmit2 calls (driver time).
+CPU: the main thread's wall time (time.perf_counter) between consecutive frame starts of the
+surgery plan (no validation), median over many frames, split by marks around every Vulkan
+call of the frame loop (``Executor.run_frames``) into: blocked (the vkWaitForFences call: the
+CPU is ahead of the GPU and waits for the frame two back), the other Vulkan calls (timestamp
+read, fence and query resets, the vkQueueSubmit2 calls: driver time), and Python - everything
+else: updates (scene animation and pass ``update`` hooks: with ``--passes real`` the pass
+implementations' cost), semaphore values, the loop itself; target <= 50 us. The runtime is
+Python plus the Vulkan calls. The first measurement is followed by ``--rounds`` rounds that
+alternate one vkQueueSubmit2 per VkQueue (the default) with one per run of batches.
 
 ``--passes probe`` (default) runs every pass with the probe implementation, so the figure is
 the runtime's resubmission cost alone; ``--passes real`` keeps the graph's implementations.
@@ -33,7 +35,7 @@ import time
 from typing import Any
 
 from rgraph.compile.pipeline import compile_graph
-from rgraph.vk.executor import Executor
+from rgraph.vk.executor import FRAME_CALLS, Executor, marks_per_frame
 from rgraph.vk.memreq import live_requirements
 
 
@@ -50,8 +52,8 @@ def probe_only(plan: dict) -> dict:
 
 
 def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, Any]:
-    """Main-thread CPU microseconds per frame (frame start to next frame start) and its parts;
-    ``calls``: vkQueueSubmit2 calls per frame."""
+    """Per frame (microseconds, frame start to next frame start): blocked in the fence wait,
+    each Vulkan call, and Python (the rest); ``calls``: vkQueueSubmit2 calls per frame."""
     executor = Executor(plan, validate=False, device_index=None, verbose=False, one_call_per_queue=one_call_per_queue)
     marks: list[float] = []
     try:
@@ -59,20 +61,29 @@ def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> di
         calls = len(executor.submit_calls[0])
     finally:
         executor.close()
-    starts, blocked, read, updated, valued = (marks[k::5] for k in range(5))
-    skip = 10  # warm-up
-    frame = [(b - a) * 1e6 for a, b in zip(starts, starts[1:], strict=False)]
-    gpu_wait = [(b - a) * 1e6 for a, b in zip(starts, blocked, strict=False)][:len(frame)]
-    return {
-        "calls": calls,
-        "frame": frame[skip:],
-        "gpu_wait": gpu_wait[skip:],
-        "runtime": [f - w for f, w in zip(frame, gpu_wait, strict=True)][skip:],
-        "readback": [(b - a) * 1e6 for a, b in zip(blocked, read, strict=False)][skip:-1],
-        "updates": [(b - a) * 1e6 for a, b in zip(read, updated, strict=False)][skip:-1],
-        "values": [(b - a) * 1e6 for a, b in zip(updated, valued, strict=False)][skip:-1],
-        "submit": [(b - a) * 1e6 for a, b in zip(valued, starts[1:], strict=False)][skip:],
-    }
+    return frame_parts(marks, calls)
+
+
+def frame_parts(marks: list[float], calls: int, skip: int = 10) -> dict[str, Any]:
+    """Split ``Executor.run_frames`` marks into per-frame parts (``skip`` warm-up frames)."""
+    m = marks_per_frame(calls)
+    frames = [marks[i:i + m] for i in range(0, len(marks), m)]
+    parts: dict[str, Any] = {"calls": calls, "frame": [], "gpu_wait": [], "runtime": [], "python": [],
+                             "vulkan": [], "submit": [], **{name: [] for name in FRAME_CALLS[1:]}}
+    for this, nxt in zip(frames[skip:], frames[skip + 1:], strict=False):
+        pairs = [(this[1 + 2 * k], this[2 + 2 * k]) for k in range(len(FRAME_CALLS) + calls)]
+        spans = [(b - a) * 1e6 for a, b in pairs]
+        frame = (nxt[0] - this[0]) * 1e6
+        blocked, others = spans[0], spans[1:]
+        parts["frame"].append(frame)
+        parts["gpu_wait"].append(blocked)
+        parts["runtime"].append(frame - blocked)
+        parts["vulkan"].append(sum(others))
+        parts["python"].append(frame - blocked - sum(others))
+        for name, span in zip(FRAME_CALLS[1:], others, strict=False):
+            parts[name].append(span)
+        parts["submit"].append(sum(others[len(FRAME_CALLS) - 1:]))
+    return parts
 
 
 def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
@@ -126,7 +137,8 @@ def main() -> None:
     parser.add_argument("--passes", choices=("probe", "real"), default="probe",
                         help="probe: every pass by the probe (the runtime's own cost); real: the graph's passes")
     parser.add_argument("--compare-sync", metavar="WxH", help="compare normal and --sync naive plans at this size")
-    parser.add_argument("--rounds", type=int, default=3, help="rounds of --compare-sync (default 3)")
+    parser.add_argument("--rounds", type=int, default=3,
+                        help="rounds of the CPU measurement and of --compare-sync (default 3)")
     args = parser.parse_args()
     if args.compare_sync:
         cw, ch = (int(x) for x in args.compare_sync.lower().split("x"))
@@ -141,18 +153,29 @@ def main() -> None:
     print(f"device: {device}")
     print(f"surgery {w}x{h} ({args.passes} passes): {passes} passes, "
           f"{sum(len(p['barriers']) for p in plan['passes'])} barriers")
-    print(f"frame CPU (main thread, {len(parts['frame'])} frames): {_summary(parts['frame'])}")
+    print(f"frame wall time, main thread ({len(parts['frame'])} frames): {_summary(parts['frame'])}")
     print(f"  blocked in vkWaitForFences (GPU still busy):       {_summary(parts['gpu_wait'])}")
-    print(f"  runtime (frame minus the fence wait):              {_summary(parts['runtime'])} (target <= 50 us)")
-    print(f"    timestamp read, fence reset:                     {_summary(parts['readback'])}")
-    print(f"    updates (scene, pass update hooks):              {_summary(parts['updates'])}")
-    print(f"    semaphore values:                                {_summary(parts['values'])}")
-    calls = f"    vkQueueSubmit2 calls ({parts['calls']} per frame):"
+    print(f"  runtime (frame minus the fence wait):              {_summary(parts['runtime'])}")
+    print(f"    Python (runtime minus Vulkan calls):             {_summary(parts['python'])} (target <= 50 us)")
+    print(f"    Vulkan calls (driver):                           {_summary(parts['vulkan'])}")
+    for name in FRAME_CALLS[1:]:
+        print(f"      {name + ':':<47}{_summary(parts[name])}")
+    calls = f"      vkQueueSubmit2 ({parts['calls']} calls per frame):"
     print(f"{calls:<53}{_summary(parts['submit'])}")
-    runs = frame_cpu_us(plan, args.frames, one_call_per_queue=False)  # same process, for the ratio
-    print(f"  one call per run of consecutive batches ({runs['calls']} calls): runtime "
-          f"{_summary(runs['runtime'])}, submit calls median {statistics.median(runs['submit']):.1f} us; "
-          f"runtime per-queue/per-run {statistics.median(parts['runtime']) / statistics.median(runs['runtime']):.2f}")
+    rounds = {"per queue": [parts], "per run": []}
+    for r in range(args.rounds):  # same process: rounds alternate one call per queue / per run of batches
+        for mode in ("per run", "per queue") if r % 2 == 0 else ("per queue", "per run"):
+            if r or mode == "per run":
+                rounds[mode].append(frame_cpu_us(plan, args.frames, one_call_per_queue=mode == "per queue"))
+    for mode, measured in rounds.items():
+        python = [statistics.median(m["python"]) for m in measured]
+        runtime = [statistics.median(m["runtime"]) for m in measured]
+        print(f"  one call {mode} ({measured[0]['calls']} calls), {len(measured)} rounds: median Python "
+              + ", ".join(f"{x:.1f}" for x in python) + " us; median runtime "
+              + ", ".join(f"{x:.1f}" for x in runtime) + " us")
+    ratio = (statistics.median(statistics.median(m["runtime"]) for m in rounds["per queue"])
+             / statistics.median(statistics.median(m["runtime"]) for m in rounds["per run"]))
+    print(f"  runtime per-queue/per-run (median of round medians): {ratio:.2f}")
     if not is_gpu:
         print("GPU busy fraction: skipped (CPU device: lavapipe runs the frame on CPU threads)")
         return

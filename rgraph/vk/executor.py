@@ -32,6 +32,13 @@ from rgraph.vk.semaphore_edges import BatchSync, batch_semaphores, semaphore_cou
 from rgraph.vk.texels import decode, encode
 
 FRAMES_IN_FLIGHT = 2
+#: Vulkan calls bracketed in ``Executor.run_frames`` marks before the submits, in order.
+FRAME_CALLS = ("vkWaitForFences", "vkGetQueryPoolResults", "vkResetFences", "vkResetQueryPool")
+
+
+def marks_per_frame(submit_calls: int) -> int:
+    """Marks ``Executor.run_frames`` takes per frame: the start, then a pair per Vulkan call."""
+    return 1 + 2 * (len(FRAME_CALLS) + submit_calls)
 
 
 @dataclass
@@ -419,15 +426,19 @@ class Executor:
 
     # ----------------------------------------------------------------- frames
     def run_frames(self, frames: int, marks: list[float] | None = None) -> dict[str, Any]:
-        """Submit ``frames`` frames; per-pass GPU medians from timestamps. ``marks`` (if given)
-        gets the main thread's CPU time (time.thread_time) five times per frame: at its start,
-        after its fence wait (time blocked on the GPU), after the timestamp read and fence reset,
-        after the per-frame updates (scene and pass ``update`` hooks) and after writing the
-        semaphore values (the rest of the frame is the vkQueueSubmit2 calls).
+        """Submit ``frames`` frames; per-pass GPU medians from timestamps.
+
+        ``marks`` (if given) gets time.perf_counter() readings, ``marks_per_frame(calls)`` per
+        frame (``FRAME_MARKS``): the frame's start, then a (before, after) pair around each
+        Vulkan call - the fence wait (time blocked on the GPU), the timestamp read, the fence
+        reset, the query reset, each vkQueueSubmit2 - with the per-frame updates (scene and
+        pass ``update`` hooks) and semaphore values between them. A call a frame skips (no
+        timestamps yet) still gets its pair, an empty interval. benchmarks/frame_cpu.py splits
+        a frame into blocked, Vulkan calls and Python from them.
 
         The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
         wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
-        timeline values, and one vkQueueSubmit2 per run of batches.
+        timeline values, and one vkQueueSubmit2 per call of ``submit_calls``.
         """
         import numpy as np
 
@@ -453,42 +464,57 @@ class Executor:
         wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
         get_queries, reset_queries = lib.vkGetQueryPoolResults, lib.vkResetQueryPool
         timeout = 10**11
-        perf, thread_time = time.perf_counter, time.thread_time
+        perf = time.perf_counter
+        timed = marks is not None
+        mark = marks.append if marks is not None else None
         for frame in range(frames):
             s = frame % FRAMES_IN_FLIGHT
-            if marks is not None:
-                marks.append(thread_time())
-            log.context = f"frame {frame}"  # also a hook: tests/test_soak.py samples RSS on it
             t0 = perf()
-            if fence_counts[s]:
+            if timed:
+                mark(t0)
+            log.context = f"frame {frame}"  # also a hook: tests/test_soak.py samples RSS on it
+            fenced = fence_counts[s] > 0
+            if timed:
+                mark(perf())
+            if fenced:
                 _check(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
-                if marks is not None:
-                    marks.append(thread_time())
-                if submitted[s] and timestamps:
-                    if get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
-                        rows[collected] = query_view
-                        collected += 1
+            if timed:
+                mark(perf())
+                mark(perf())
+            if fenced and submitted[s] and timestamps:
+                read = get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0
+                if timed:
+                    mark(perf())
+                if read:
+                    rows[collected] = query_view
+                    collected += 1
+            elif timed:
+                mark(perf())
+            if timed:
+                mark(perf())
+            if fenced:
                 _check(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
-                if timestamps:
-                    reset_queries(handle, pools[s], 0, 2 * n)
-            elif marks is not None:
-                marks.append(thread_time())
-            if marks is not None:
-                marks.append(thread_time())
+            if timed:
+                mark(perf())
+                mark(perf())
+            if fenced and timestamps:
+                reset_queries(handle, pools[s], 0, 2 * n)
+            if timed:
+                mark(perf())
             if scene is not None:
                 scene.update(frame, s)
             for p in updaters:
                 p.update(frame, s)
-            if marks is not None:
-                marks.append(thread_time())
             for slot, offset in self.value_slots[s]:
                 slot.value = frame + offset
-            if marks is not None:
-                marks.append(thread_time())
             for call in self.submit_calls[s]:
                 if validate:
                     log.context = f"frame {frame} {call.context}"
+                if timed:
+                    mark(perf())
                 _check(submit2(call.queue, call.count, call.infos, call.fence), "vkQueueSubmit2")
+                if timed:
+                    mark(perf())
             submitted[s] = True
             cpu_s[frame] = perf() - t0
         log.context = "finishing"

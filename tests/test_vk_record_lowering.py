@@ -226,3 +226,41 @@ def test_first_frame_releases_are_the_wrap_around_handoffs(seed, passes, policy,
     shared = {r["name"] for r in plan["resources"] if r["lifetime"] in SHARED}
     got = first_frame_releases(plan, shared)
     assert {q: [(b["resource"], b["dst"]["queue"]) for b in bs] for q, bs in got.items()} == expected
+
+
+def _access(resource, stages, write, layers=(0, 1)):
+    return {"resource": resource, "subresource": {"mips": [0, 1], "layers": list(layers)}, "stages": stages,
+            "write": write}
+
+
+def _barrier(resource, src_stages, src_access, old, new, layers=(0, 1)):
+    return {"resource": resource, "subresource": {"mips": [0, 1], "layers": list(layers)}, "aliases": None,
+            "src": {"stages": src_stages, "access": src_access, "layout": old, "queue": "graphics"},
+            "dst": {"stages": ["FRAGMENT_SHADER"], "access": ["SHADER_SAMPLED_READ"], "layout": new,
+                    "queue": "graphics"}}
+
+
+def test_transition_after_reads_of_a_write_names_that_write():
+    """Random graph seed 2936/17 on the H100: write (compute) -> barrier -> reads (compute) ->
+    a semaphore wait -> transition. The transition names the write's stages and MEMORY_WRITE;
+    a post-write barrier that lost its src access (a mutation) is not repaired; another
+    layer's reads do not count."""
+    from rgraph.vk.after_reads import writers_before_reads
+
+    plan = {"passes": [
+        {"accesses": [_access("a", ["COMPUTE_SHADER"], True)], "barriers": []},
+        {"accesses": [_access("a", ["COMPUTE_SHADER"], False)],
+         "barriers": [_barrier("a", ["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "GENERAL", "GENERAL")]},
+        {"accesses": [_access("a", ["FRAGMENT_SHADER"], False), _access("b", ["FRAGMENT_SHADER"], False)],
+         "barriers": [_barrier("a", ["COMPUTE_SHADER"], [], "GENERAL", "SHADER_READ_ONLY_OPTIMAL"),
+                      _barrier("b", ["COMPUTE_SHADER"], [], "GENERAL", "SHADER_READ_ONLY_OPTIMAL")]},
+        {"accesses": [_access("b", ["COMPUTE_SHADER"], True, (1, 2))], "barriers": []},
+    ]}
+    writers = writers_before_reads(plan)
+    assert writers[2] == {0: ("COMPUTE_SHADER",)}  # b's only write is to another layer
+    (group,) = lower_barriers(plan["passes"][2]["barriers"], "barrier", TWO_FAMILIES, writers=writers[2])
+    assert [(s.resource, s.src_stages, s.src_access) for s in group] == [
+        ("a", ("COMPUTE_SHADER",), ("MEMORY_READ", "MEMORY_WRITE")), ("b", ("COMPUTE_SHADER",), ("MEMORY_READ",))]
+    mutated = {"passes": [plan["passes"][0], {**plan["passes"][1], "barriers": [
+        _barrier("a", ["COMPUTE_SHADER"], [], "GENERAL", "SHADER_READ_ONLY_OPTIMAL")]}]}
+    assert writers_before_reads(mutated)[1] == {}

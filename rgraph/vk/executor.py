@@ -18,6 +18,7 @@ from rgraph.probe.semantics import mip_extent, subresources
 from rgraph.probe.simulate import simulate
 from rgraph.probe.values import codec, initial_value, modulus
 from rgraph.vk import names
+from rgraph.vk.after_reads import writers_before_reads
 from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.impl_pass import ImplPass
@@ -298,6 +299,7 @@ class Executor:
         v = vk()
         dev = self.device
         index_of = {id(p): i for i, p in enumerate(self.plan["passes"])}
+        writers = writers_before_reads(self.plan)
         for s in range(FRAMES_IN_FLIGHT):
             for bi, batch in enumerate(self.batches):
                 pool = self._pool(dev.families[batch.queue], s)
@@ -317,7 +319,8 @@ class Executor:
                     if timestamps:
                         v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
                     waited = [st for w in p["waits"] if not dev.same_queue(w["queue"], p["queue"]) for st in w["stages"]]
-                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", p["queue"], waited):
+                    for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", p["queue"], waited,
+                                                   writers[i]):
                         self.barrier_batches.append(barriers)
                         v.vkCmdPipelineBarrier2(cb, barriers.dependency)
                     self.passes[i].record(ctx, s)

@@ -50,7 +50,8 @@ class BarrierSpec:
 
 def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
                    wait_stages: Sequence[str] = (),
-                   capabilities: frozenset[str] = CAPABILITIES) -> list[list[BarrierSpec]]:
+                   capabilities: frozenset[str] = CAPABILITIES,
+                   writers: Mapping[int, tuple[str, ...]] | None = None) -> list[list[BarrierSpec]]:
     """Plan barriers -> the vkCmdPipelineBarrier2 calls that execute them, in recording order.
 
     ``role`` is "barrier" (before the pass) or "release" (after it); ``families`` maps plan
@@ -75,7 +76,9 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
       out of the pair also keeps a layer that does not model ownership transfers (1.3.239,
       DESIGN.md) from counting one transition twice; release/acquire access masks follow the
       spec (release: no dst access, acquire: no src access).
-    - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``).
+    - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``)
+      and, where ``writers`` (barrier index -> stages, ``rgraph.vk.after_reads``) knows the
+      write those reads read, that write too: its stages and MEMORY_WRITE.
     - ``wait_stages``: the stages of the pass's semaphore waits on another VkQueue. Every
       barrier before the pass with a src scope adds them to its src stages, so it chains to
       the wait: a plan barrier's src stages may name another queue's stages (an aliased
@@ -90,13 +93,14 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
     first: list[BarrierSpec] = []
     after: list[BarrierSpec] = []
     chain = tuple(sorted(set(wait_stages)))
-    for b in barriers:
+    for index, b in enumerate(barriers):
         for group, spec in _lower_one(b, role, families):
             if chain and group == 0 and spec.src_stages and spec.src_family is None:
                 spec = replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(chain))))
+            spec = _after_reads(spec, (writers or {}).get(index, ()))
             if capabilities != CAPABILITIES:
                 spec = _fit(spec, capabilities)
-            (first if group == 0 else after).append(_after_reads(spec))
+            (first if group == 0 else after).append(spec)
     return [group for group in (first, after) if group]
 
 
@@ -106,11 +110,13 @@ def _fit(spec: BarrierSpec, capabilities: frozenset[str]) -> BarrierSpec:
     return replace(spec, src_stages=src_stages, src_access=src_access, dst_stages=dst_stages, dst_access=dst_access)
 
 
-#: srcAccessMask of a layout transition that follows reads (see ``_after_reads``).
+#: srcAccessMask of a layout transition that follows reads (see ``_after_reads``); with the
+#: write those reads read, when it is known.
 AFTER_READS_ACCESS = ("MEMORY_READ",)
+AFTER_WRITE_READS_ACCESS = ("MEMORY_READ", "MEMORY_WRITE")
 
 
-def _after_reads(spec: BarrierSpec) -> BarrierSpec:
+def _after_reads(spec: BarrierSpec, write_stages: tuple[str, ...] = ()) -> BarrierSpec:
     """A layout transition whose src scope is reads only (src stages, no src access) gets
     srcAccessMask MEMORY_READ. By the spec this is a no-op: availability operations concern
     writes, the write before those reads was made available by the barrier in front of them,
@@ -122,11 +128,14 @@ def _after_reads(spec: BarrierSpec) -> BarrierSpec:
     transition" (random graphs seed 0 and 9, tests/test_run_fuzz.py), and likewise for an
     aliased resource's first transition (from UNDEFINED) after the previous occupant's reads
     (seeds 0 and 32 with 10 passes, aliased). Naming the reads in srcAccessMask records the
-    same dependency in the form the layer understands."""
+    same dependency in the form the layer understands. ``write_stages``: the stages of the
+    write those reads read (``rgraph.vk.after_reads``, which says why the layer needs it);
+    given, the src scope names that write as well (its stages, MEMORY_WRITE)."""
     if spec.old_layout is not None and spec.old_layout != spec.new_layout and spec.src_stages and not spec.src_access:
-        return BarrierSpec(spec.resource, spec.subresource, spec.src_stages, AFTER_READS_ACCESS, spec.dst_stages,
-                           spec.dst_access, spec.old_layout, spec.new_layout, spec.src_family, spec.dst_family,
-                           spec.aspect_layout)
+        if write_stages and spec.old_layout != "UNDEFINED":
+            return replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(write_stages))),
+                           src_access=AFTER_WRITE_READS_ACCESS)
+        return replace(spec, src_access=AFTER_READS_ACCESS)
     return spec
 
 
@@ -165,12 +174,13 @@ class BarrierBatch:
 
 
 def build_barriers(device: Device, resources: ResourceSet, set_index: int, barriers: list[dict],
-                   role: str, queue: str, wait_stages: Sequence[str] = ()) -> list[BarrierBatch]:
+                   role: str, queue: str, wait_stages: Sequence[str] = (),
+                   writers: Mapping[int, tuple[str, ...]] | None = None) -> list[BarrierBatch]:
     """Sync2 structs for plan barriers recorded on plan queue ``queue`` (see ``lower_barriers``):
     one batch per vkCmdPipelineBarrier2, to be recorded in order; [] when there is nothing."""
     return [_dependency(resources, set_index, group)
             for group in lower_barriers(barriers, role, device.families, wait_stages,
-                                        device.capabilities.get(queue, CAPABILITIES))]
+                                        device.capabilities.get(queue, CAPABILITIES), writers)]
 
 
 def _family(index: int | None) -> int:

@@ -1,0 +1,52 @@
+"""Which plan barriers follow reads of an earlier write, and that write's stages.
+
+The compiler's barrier after reads names the reads' stages and no access: the write before
+those reads was made available and visible by the barrier in front of them, and the new
+barrier is ordered after the write through the reads (an execution dependency chain).
+Khronos validation 1.3.239 loses that chain when the queue waits on a semaphore in between:
+the waiting queue imports the other queue's copy of the same write, and its own dependency
+chain for the write is replaced by the wait's stages (H100 fuzz, random graph seed 2936 with
+17 passes: "storage write on graphics -> barrier -> storage reads -> graphics waits for
+compute, which had imported the write -> transition" reported WRITE_AFTER_WRITE against the
+write). The runtime then names the write itself in the transition's src scope (its stages,
+MEMORY_WRITE): a second availability operation for a write that is already available, a
+no-op by the spec, in the form that layer checks first (``rgraph.vk.record``).
+
+Only barriers whose latest earlier access to an overlapping subresource is a read count, so
+a barrier that lost its src access (a mutation, a generator bug) is never repaired here.
+"""
+
+from __future__ import annotations
+
+from rgraph.probe.semantics import subresources
+
+
+def _overlaps(a: dict | None, b: dict | None) -> bool:
+    if a is None or b is None:
+        return True
+    return all(a[k][0] < b[k][1] and b[k][0] < a[k][1] for k in ("mips", "layers") if k in a and k in b)
+
+
+def _subresource(access: dict) -> dict | None:
+    return access.get("subresource") if subresources(access) != [None] else None
+
+
+def writers_before_reads(plan: dict) -> list[dict[int, tuple[str, ...]]]:
+    """Per pass, barrier index -> stages of the writes to that resource's overlapping
+    subresources (anywhere in the plan, a frame wraps around), for every barrier whose latest
+    earlier access (in plan order, else from the previous frame) to an overlapping
+    subresource is a read."""
+    passes = plan["passes"]
+    out: list[dict[int, tuple[str, ...]]] = []
+    for i, p in enumerate(passes):
+        found: dict[int, tuple[str, ...]] = {}
+        for bi, b in enumerate(p["barriers"]):
+            sub = b.get("subresource")
+            touching = [(j, a) for j, q in enumerate(passes) for a in q["accesses"]
+                        if a["resource"] == b["resource"] and _overlaps(_subresource(a), sub)]
+            writes = sorted({s for _j, a in touching if a["write"] for s in a["stages"]})
+            before = [a for j, a in touching if j < i] or [a for j, a in touching if j >= i]
+            if writes and before and not before[-1]["write"]:
+                found[bi] = tuple(writes)
+        out.append(found)
+    return out

@@ -264,3 +264,15 @@ def test_transition_after_reads_of_a_write_names_that_write():
     mutated = {"passes": [plan["passes"][0], {**plan["passes"][1], "barriers": [
         _barrier("a", ["COMPUTE_SHADER"], [], "GENERAL", "SHADER_READ_ONLY_OPTIMAL")]}]}
     assert writers_before_reads(mutated)[1] == {}
+
+
+def test_transition_whose_src_access_the_family_cannot_perform_still_names_memory_read():
+    """H100 fuzz seed 111329/13 (aliased): img1's first use on a compute family, placed over
+    img3 that graphics wrote as a color attachment. Fitted to the compute family the src scope
+    keeps only the semaphore wait's stage and no access; the transition gets MEMORY_READ."""
+    barrier = _barrier("img1", ["COLOR_ATTACHMENT_OUTPUT"], ["COLOR_ATTACHMENT_WRITE"], "UNDEFINED", "GENERAL")
+    barrier["dst"] = {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_STORAGE_WRITE"], "layout": "GENERAL",
+                      "queue": "compute"}
+    barrier["src"]["queue"] = "compute"
+    (group,) = lower_barriers([barrier], "barrier", TWO_FAMILIES, ["COMPUTE_SHADER"], frozenset({"compute"}))
+    assert [(s.src_stages, s.src_access) for s in group] == [(("COMPUTE_SHADER",), ("MEMORY_READ",))]

@@ -97,10 +97,10 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
         for group, spec in _lower_one(b, role, families):
             if chain and group == 0 and spec.src_stages and spec.src_family is None:
                 spec = replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(chain))))
-            spec = _after_reads(spec, (writers or {}).get(index, ()))
+            spec = _name_read_write(spec, (writers or {}).get(index, ()))
             if capabilities != CAPABILITIES:
                 spec = _fit(spec, capabilities)
-            (first if group == 0 else after).append(spec)
+            (first if group == 0 else after).append(_after_reads(spec))
     return [group for group in (first, after) if group]
 
 
@@ -111,12 +111,29 @@ def _fit(spec: BarrierSpec, capabilities: frozenset[str]) -> BarrierSpec:
 
 
 #: srcAccessMask of a layout transition that follows reads (see ``_after_reads``); with the
-#: write those reads read, when it is known.
+#: write those reads read, when it is known (``_name_read_write``).
 AFTER_READS_ACCESS = ("MEMORY_READ",)
 AFTER_WRITE_READS_ACCESS = ("MEMORY_READ", "MEMORY_WRITE")
 
 
-def _after_reads(spec: BarrierSpec, write_stages: tuple[str, ...] = ()) -> BarrierSpec:
+def _is_transition_after_reads(spec: BarrierSpec) -> bool:
+    return (spec.old_layout is not None and spec.old_layout != spec.new_layout and bool(spec.src_stages)
+            and not spec.src_access)
+
+
+def _name_read_write(spec: BarrierSpec, write_stages: tuple[str, ...]) -> BarrierSpec:
+    """A layout transition after reads whose write ``write_stages`` names
+    (``rgraph.vk.after_reads``, which says why the 1.3.239 layer needs it) also names that
+    write in its src scope: its stages and MEMORY_WRITE (a repeated availability operation for
+    a write already available, a no-op by the spec). Transitions from UNDEFINED (aliased
+    memory after the previous occupant's reads) are left to ``_after_reads``."""
+    if write_stages and spec.old_layout != "UNDEFINED" and _is_transition_after_reads(spec):
+        return replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(write_stages))),
+                       src_access=AFTER_WRITE_READS_ACCESS)
+    return spec
+
+
+def _after_reads(spec: BarrierSpec) -> BarrierSpec:
     """A layout transition whose src scope is reads only (src stages, no src access) gets
     srcAccessMask MEMORY_READ. By the spec this is a no-op: availability operations concern
     writes, the write before those reads was made available by the barrier in front of them,
@@ -128,13 +145,9 @@ def _after_reads(spec: BarrierSpec, write_stages: tuple[str, ...] = ()) -> Barri
     transition" (random graphs seed 0 and 9, tests/test_run_fuzz.py), and likewise for an
     aliased resource's first transition (from UNDEFINED) after the previous occupant's reads
     (seeds 0 and 32 with 10 passes, aliased). Naming the reads in srcAccessMask records the
-    same dependency in the form the layer understands. ``write_stages``: the stages of the
-    write those reads read (``rgraph.vk.after_reads``, which says why the layer needs it);
-    given, the src scope names that write as well (its stages, MEMORY_WRITE)."""
-    if spec.old_layout is not None and spec.old_layout != spec.new_layout and spec.src_stages and not spec.src_access:
-        if write_stages and spec.old_layout != "UNDEFINED":
-            return replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(write_stages))),
-                           src_access=AFTER_WRITE_READS_ACCESS)
+    same dependency in the form the layer understands. Applied after fitting the barrier to
+    the queue family, so that a src scope left without accesses there gets it too."""
+    if _is_transition_after_reads(spec):
         return replace(spec, src_access=AFTER_READS_ACCESS)
     return spec
 

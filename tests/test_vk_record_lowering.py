@@ -276,3 +276,28 @@ def test_transition_whose_src_access_the_family_cannot_perform_still_names_memor
     barrier["src"]["queue"] = "compute"
     (group,) = lower_barriers([barrier], "barrier", TWO_FAMILIES, ["COMPUTE_SHADER"], frozenset({"compute"}))
     assert [(s.src_stages, s.src_access) for s in group] == [(("COMPUTE_SHADER",), ("MEMORY_READ",))]
+
+
+def test_buffer_barrier_before_a_write_after_reads_names_the_earlier_write():
+    """H100 fuzz seed 1/22: a persistent buffer written by compute, read as indirect and
+    uniform, then written again; the write-after-read barrier (execution only in the plan)
+    names the earlier write's stages and MEMORY_WRITE."""
+    from rgraph.vk.after_reads import writers_before_reads
+
+    def access(stages, write):
+        return {"resource": "buf", "subresource": None, "stages": stages, "write": write}
+
+    def barrier(src_stages, src_access):
+        return {"resource": "buf", "subresource": None, "aliases": None,
+                "src": {"stages": src_stages, "access": src_access, "layout": None, "queue": "graphics"},
+                "dst": {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_STORAGE_WRITE"], "layout": None,
+                        "queue": "graphics"}}
+    plan = {"passes": [
+        {"accesses": [access(["DRAW_INDIRECT"], False)], "barriers": [barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"])]},
+        {"accesses": [access(["COMPUTE_SHADER"], True)], "barriers": [barrier(["DRAW_INDIRECT"], [])]},
+    ]}
+    writers = writers_before_reads(plan)
+    assert writers == [{}, {0: ("COMPUTE_SHADER",)}]
+    (group,) = lower_barriers(plan["passes"][1]["barriers"], "barrier", TWO_FAMILIES, writers=writers[1])
+    assert [(s.src_stages, s.src_access) for s in group] == [
+        (("COMPUTE_SHADER", "DRAW_INDIRECT"), ("MEMORY_READ", "MEMORY_WRITE"))]

@@ -8,9 +8,12 @@ the waiting queue imports the other queue's copy of the same write, and its own 
 chain for the write is replaced by the wait's stages (H100 fuzz, random graph seed 2936 with
 17 passes: "storage write on graphics -> barrier -> storage reads -> graphics waits for
 compute, which had imported the write -> transition" reported WRITE_AFTER_WRITE against the
-write). The runtime then names the write itself in the transition's src scope (its stages,
-MEMORY_WRITE): a second availability operation for a write that is already available, a
-no-op by the spec, in the form that layer checks first (``rgraph.vk.record``).
+write; seed 1 with 22 passes: a persistent buffer's storage write in one frame, indirect and
+uniform reads in the next, a wait for compute in between, and the next storage write was
+reported WRITE_AFTER_WRITE against the previous frame's). The runtime then names the write
+itself in the barrier's src scope (its stages, MEMORY_WRITE): a second availability operation
+for a write that is already available, a no-op by the spec, in the form that layer checks
+first (``rgraph.vk.record``).
 
 Only barriers whose latest earlier access to an overlapping subresource is a read count, so
 a barrier that lost its src access (a mutation, a generator bug) is never repaired here.

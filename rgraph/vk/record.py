@@ -77,8 +77,8 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
       DESIGN.md) from counting one transition twice; release/acquire access masks follow the
       spec (release: no dst access, acquire: no src access).
     - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``)
-      and, where ``writers`` (barrier index -> stages, ``rgraph.vk.after_reads``) knows the
-      write those reads read, that write too: its stages and MEMORY_WRITE.
+      Any ordinary barrier after reads whose write ``writers`` (barrier index -> stages,
+      ``rgraph.vk.after_reads``) knows names that write too: its stages and MEMORY_WRITE.
     - ``wait_stages``: the stages of the pass's semaphore waits on another VkQueue. Every
       barrier before the pass with a src scope adds them to its src stages, so it chains to
       the wait: a plan barrier's src stages may name another queue's stages (an aliased
@@ -122,12 +122,15 @@ def _is_transition_after_reads(spec: BarrierSpec) -> bool:
 
 
 def _name_read_write(spec: BarrierSpec, write_stages: tuple[str, ...]) -> BarrierSpec:
-    """A layout transition after reads whose write ``write_stages`` names
-    (``rgraph.vk.after_reads``, which says why the 1.3.239 layer needs it) also names that
-    write in its src scope: its stages and MEMORY_WRITE (a repeated availability operation for
-    a write already available, a no-op by the spec). Transitions from UNDEFINED (aliased
-    memory after the previous occupant's reads) are left to ``_after_reads``."""
-    if write_stages and spec.old_layout != "UNDEFINED" and _is_transition_after_reads(spec):
+    """An ordinary barrier after reads (src stages, no src access) whose reads read a write
+    with stages ``write_stages`` (``rgraph.vk.after_reads``, which says why the 1.3.239 layer
+    needs it) also names that write in its src scope: its stages and MEMORY_READ|MEMORY_WRITE
+    (a repeated availability operation for a write already available, a no-op by the spec).
+    Layout transitions and buffer or same-layout barriers before a write alike. Transitions
+    from UNDEFINED (aliased memory after the previous occupant's reads) are left to
+    ``_after_reads``, and ownership transfers keep their spec-mandated masks."""
+    if (write_stages and spec.src_stages and not spec.src_access and spec.old_layout != "UNDEFINED"
+            and spec.src_family is None and spec.dst_family is None):
         return replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(write_stages))),
                        src_access=AFTER_WRITE_READS_ACCESS)
     return spec

@@ -88,6 +88,13 @@ REGRESSIONS = [
     # compute in between, written again: WRITE_AFTER_WRITE against the previous frame's write
     # (runtime: every barrier after reads names the write, not only layout transitions)
     (1, 22, "dedicated"),
+    # NVIDIA, session 4: the readback barrier on a compute family named the resource's final
+    # INDEX_INPUT read (runtime: readback src scope fitted to the queue family)
+    (32, 32, "dedicated"),
+    # NVIDIA, session 4: a buffer written on compute, read on graphics, two more waits for
+    # compute, written on graphics: each wait replaced the layer's chain for the write
+    # (runtime: barriers after reads also name the waits made on their queue)
+    (231271, 12, "dedicated"),
 ]
 
 

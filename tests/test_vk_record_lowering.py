@@ -301,3 +301,33 @@ def test_buffer_barrier_before_a_write_after_reads_names_the_earlier_write():
     (group,) = lower_barriers(plan["passes"][1]["barriers"], "barrier", TWO_FAMILIES, writers=writers[1])
     assert [(s.src_stages, s.src_access) for s in group] == [
         (("COMPUTE_SHADER", "DRAW_INDIRECT"), ("MEMORY_READ", "MEMORY_WRITE"))]
+
+
+def test_barrier_after_reads_also_names_the_waits_made_on_its_queue():
+    """H100 fuzz seed 231271/12: compute writes, graphics reads it (indirect), waits for compute
+    twice more, then writes: the write-after-read barrier names the stages of every wait made
+    so far on the graphics VkQueue (the layer's chain for the write is the last wait's)."""
+    from rgraph.vk.after_reads import src_additions
+
+    def access(stages, write):
+        return {"resource": "buf", "subresource": None, "stages": stages, "write": write}
+
+    def barrier(src_stages, src_access, queue="graphics"):
+        return {"resource": "buf", "subresource": None, "aliases": None,
+                "src": {"stages": src_stages, "access": src_access, "layout": None, "queue": queue},
+                "dst": {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_STORAGE_WRITE"], "layout": None,
+                        "queue": "graphics"}}
+
+    def wait(stages):
+        return {"queue": "compute", "value": 1, "stages": stages}
+    plan = {"passes": [
+        {"queue": "compute", "waits": [], "accesses": [access(["COMPUTE_SHADER"], True)], "barriers": []},
+        {"queue": "graphics", "waits": [wait(["DRAW_INDIRECT"])], "accesses": [access(["DRAW_INDIRECT"], False)],
+         "barriers": [barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "compute")]},
+        {"queue": "graphics", "waits": [wait(["COLOR_ATTACHMENT_OUTPUT"])], "accesses": [], "barriers": []},
+        {"queue": "graphics", "waits": [], "accesses": [access(["COMPUTE_SHADER"], True)],
+         "barriers": [barrier(["DRAW_INDIRECT"], [])]},
+    ]}
+    assert src_additions(plan, lambda queue: queue)[3] == {
+        0: ("COLOR_ATTACHMENT_OUTPUT", "COMPUTE_SHADER", "DRAW_INDIRECT")}
+    assert src_additions(plan, lambda queue: 0)[3] == {0: ("COMPUTE_SHADER",)}  # one VkQueue: no imports

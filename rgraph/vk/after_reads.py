@@ -21,6 +21,8 @@ a barrier that lost its src access (a mutation, a generator bug) is never repair
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable
+
 from rgraph.probe.semantics import subresources
 
 
@@ -52,4 +54,23 @@ def writers_before_reads(plan: dict) -> list[dict[int, tuple[str, ...]]]:
             if writes and before and not before[-1]["write"]:
                 found[bi] = tuple(writes)
         out.append(found)
+    return out
+
+
+def src_additions(plan: dict, queue_key: Callable[[str], Hashable]) -> list[dict[int, tuple[str, ...]]]:
+    """``writers_before_reads`` plus, for each such barrier, the stages of every semaphore wait
+    on another VkQueue (``queue_key``: plan queue -> VkQueue) made so far in the frame on the
+    barrier's VkQueue. Each such wait re-imports the other queue's copy of a write that queue
+    once imported or made, and the 1.3.239 layer then replaces this queue's dependency chain
+    for the write with that wait's stages (H100 fuzz seed 231271/12: a buffer written on
+    compute, read as indirect on graphics, two waits for compute later, the next write on
+    graphics reported WRITE_AFTER_WRITE); a src scope that names those stages chains to it."""
+    writers = writers_before_reads(plan)
+    imported: dict[Hashable, set[str]] = {}
+    out: list[dict[int, tuple[str, ...]]] = []
+    for p, found in zip(plan["passes"], writers, strict=True):
+        key = queue_key(p["queue"])
+        waited = imported.setdefault(key, set())
+        waited.update(s for w in p["waits"] if queue_key(w["queue"]) != key for s in w["stages"])
+        out.append({bi: tuple(sorted(set(stages) | waited)) for bi, stages in found.items()})
     return out

@@ -17,8 +17,9 @@ from typing import Any
 from rgraph.probe.semantics import mip_extent, subresources
 from rgraph.probe.simulate import simulate
 from rgraph.probe.values import codec, initial_value, modulus
+from rgraph.stages import CAPABILITIES, fit_to_queue
 from rgraph.vk import names
-from rgraph.vk.after_reads import writers_before_reads
+from rgraph.vk.after_reads import src_additions
 from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.impl_pass import ImplPass
@@ -299,7 +300,8 @@ class Executor:
         v = vk()
         dev = self.device
         index_of = {id(p): i for i, p in enumerate(self.plan["passes"])}
-        writers = writers_before_reads(self.plan)
+        ffi = v.ffi
+        writers = src_additions(self.plan, lambda queue: int(ffi.cast("uintptr_t", dev.queues[queue])))
         for s in range(FRAMES_IN_FLIGHT):
             for bi, batch in enumerate(self.batches):
                 pool = self._pool(dev.families[batch.queue], s)
@@ -569,14 +571,18 @@ class Executor:
                 self.host_buffers.append(buf)
                 jobs.append((res, r, buf, regions, size))
 
-            def record(cb, jobs=jobs):
+            capabilities = self.device.capabilities.get(queue, CAPABILITIES)
+
+            def record(cb, jobs=jobs, capabilities=capabilities):
                 keep = []
                 for res, r, buf, regions, size in jobs:
-                    final = res["final"]
-                    src = names.stages(final["stages"]), names.accesses(final["access"])
+                    # the final state may name stages of another family (a graphics read of a
+                    # resource whose last queue is compute: INDEX_INPUT, H100 fuzz seed 32/32)
+                    stages, access = fit_to_queue(res["final"]["stages"], res["final"]["access"], capabilities)
+                    src = names.stages(stages), names.accesses(access)
                     copy_read = v.VK_PIPELINE_STAGE_2_COPY_BIT, v.VK_ACCESS_2_TRANSFER_READ_BIT
                     if r.is_image:
-                        keep.append(_image_barrier(cb, r, _whole_range(r), src, copy_read, names.layout(final["layout"]),
+                        keep.append(_image_barrier(cb, r, _whole_range(r), src, copy_read, names.layout(res["final"]["layout"]),
                                                    v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL))
                         v.vkCmdCopyImageToBuffer(cb, r.handle, v.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf.handle,
                                                  len(regions), regions)

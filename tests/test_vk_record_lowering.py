@@ -331,3 +331,21 @@ def test_barrier_after_reads_also_names_the_waits_made_on_its_queue():
     assert src_additions(plan, lambda queue: queue)[3] == {
         0: ("COLOR_ATTACHMENT_OUTPUT", "COMPUTE_SHADER", "DRAW_INDIRECT")}
     assert src_additions(plan, lambda queue: 0)[3] == {0: ("COMPUTE_SHADER",)}  # one VkQueue: no imports
+
+
+def test_aliased_first_use_after_reads_names_the_waits_made_on_its_queue():
+    """H100 fuzz seed 0/28 (aliased): a first use from UNDEFINED after the previous occupant's
+    reads names the stages of the waits made on its VkQueue; its src access stays MEMORY_READ."""
+    from rgraph.vk.after_reads import src_additions
+
+    first_use = _barrier("b", ["COMPUTE_SHADER"], [], "UNDEFINED", "GENERAL")
+    plan = {"passes": [
+        {"queue": "graphics", "waits": [{"queue": "compute", "value": 1, "stages": ["VERTEX_SHADER"]}],
+         "accesses": [], "barriers": []},
+        {"queue": "graphics", "waits": [], "accesses": [_access("b", ["FRAGMENT_SHADER"], False)],
+         "barriers": [first_use]},
+    ]}
+    extra = src_additions(plan, lambda queue: queue)[1]
+    assert extra == {0: ("VERTEX_SHADER",)}
+    (group,) = lower_barriers([first_use], "barrier", TWO_FAMILIES, writers=extra)
+    assert [(s.src_stages, s.src_access) for s in group] == [(("COMPUTE_SHADER", "VERTEX_SHADER"), ("MEMORY_READ",))]

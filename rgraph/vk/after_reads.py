@@ -72,5 +72,15 @@ def src_additions(plan: dict, queue_key: Callable[[str], Hashable]) -> list[dict
         key = queue_key(p["queue"])
         waited = imported.setdefault(key, set())
         waited.update(s for w in p["waits"] if queue_key(w["queue"]) != key for s in w["stages"])
-        out.append({bi: tuple(sorted(set(stages) | waited)) for bi, stages in found.items()})
+        extra = {bi: tuple(sorted(set(found.get(bi, ())) | waited)) for bi, b in enumerate(p["barriers"])
+                 if bi in found or (_after_reads_from_undefined(b) and waited)}
+        out.append(extra)
     return out
+
+
+def _after_reads_from_undefined(barrier: dict) -> bool:
+    """A first use from UNDEFINED ordered after reads (aliased memory: the previous occupant's
+    last reads; H100 fuzz seed 0/28 aliased: the layer, which tracks that memory here, had
+    replaced its chain for the previous occupant's write with the last wait's stages)."""
+    src = barrier["src"]
+    return src["layout"] == "UNDEFINED" and bool(src["stages"]) and not src["access"]

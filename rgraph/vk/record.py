@@ -126,13 +126,15 @@ def _name_read_write(spec: BarrierSpec, write_stages: tuple[str, ...]) -> Barrie
     with stages ``write_stages`` (``rgraph.vk.after_reads``, which says why the 1.3.239 layer
     needs it) also names that write in its src scope: its stages and MEMORY_READ|MEMORY_WRITE
     (a repeated availability operation for a write already available, a no-op by the spec).
-    Layout transitions and buffer or same-layout barriers before a write alike. Transitions
-    from UNDEFINED (aliased memory after the previous occupant's reads) are left to
-    ``_after_reads``, and ownership transfers keep their spec-mandated masks."""
-    if (write_stages and spec.src_stages and not spec.src_access and spec.old_layout != "UNDEFINED"
-            and spec.src_family is None and spec.dst_family is None):
-        return replace(spec, src_stages=tuple(sorted(set(spec.src_stages) | set(write_stages))),
-                       src_access=AFTER_WRITE_READS_ACCESS)
+    Layout transitions and buffer or same-layout barriers before a write alike. A transition
+    from UNDEFINED (aliased memory after the previous occupant's reads) gets the stages only
+    (``_after_reads`` names MEMORY_READ); ownership transfers keep their spec-mandated masks."""
+    if (write_stages and spec.src_stages and not spec.src_access and spec.src_family is None
+            and spec.dst_family is None):
+        stages = tuple(sorted(set(spec.src_stages) | set(write_stages)))
+        if spec.old_layout == "UNDEFINED":  # aliased memory: the stages only, _after_reads names MEMORY_READ
+            return replace(spec, src_stages=stages)
+        return replace(spec, src_stages=stages, src_access=AFTER_WRITE_READS_ACCESS)
     return spec
 
 

@@ -98,6 +98,10 @@ REGRESSIONS = [
     # NVIDIA, session 4: the same for an aliased first use from UNDEFINED after the previous
     # occupant's reads (runtime: that transition names the waits made on its queue too)
     (0, 28, "aliased"),
+    # OPEN on NVIDIA (session 4): p00015's transition reported WRITE_AFTER_WRITE against p00008's
+    # storage write (2 messages, data check ok); passes on lavapipe. Investigate with
+    # benchmarks/nvidia_seed.py 0 32 aliased
+    (0, 32, "aliased"),
 ]
 
 

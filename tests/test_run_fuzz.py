@@ -98,9 +98,9 @@ REGRESSIONS = [
     # NVIDIA, session 4: the same for an aliased first use from UNDEFINED after the previous
     # occupant's reads (runtime: that transition names the waits made on its queue too)
     (0, 28, "aliased"),
-    # OPEN on NVIDIA (session 4): p00015's transition reported WRITE_AFTER_WRITE against p00008's
-    # storage write (2 messages, data check ok); passes on lavapipe. Investigate with
-    # benchmarks/nvidia_seed.py 0 32 aliased
+    # session 4 (H100 and lavapipe): an aliased first use whose previous occupants ended with
+    # an attachment write and with storage reads named only the write in its src access; the
+    # layer did not credit the chain through the reads (runtime: MEMORY_READ added as well)
     (0, 32, "aliased"),
 ]
 

@@ -349,3 +349,13 @@ def test_aliased_first_use_after_reads_names_the_waits_made_on_its_queue():
     assert extra == {0: ("VERTEX_SHADER",)}
     (group,) = lower_barriers([first_use], "barrier", TWO_FAMILIES, writers=extra)
     assert [(s.src_stages, s.src_access) for s in group] == [(("COMPUTE_SHADER", "VERTEX_SHADER"), ("MEMORY_READ",))]
+
+
+def test_aliased_first_use_after_a_write_and_reads_names_memory_read_too():
+    """Random graph seed 0/32 (aliased, lavapipe and H100): the previous occupants ended with
+    an attachment write and with storage reads; the transition keeps the write's access and
+    adds MEMORY_READ."""
+    first_use = _barrier("img1", ["COLOR_ATTACHMENT_OUTPUT", "FRAGMENT_SHADER"], ["COLOR_ATTACHMENT_WRITE"],
+                         "UNDEFINED", "COLOR_ATTACHMENT_OPTIMAL")
+    (group,) = lower_barriers([first_use], "barrier", TWO_FAMILIES)
+    assert group[0].src_access == ("COLOR_ATTACHMENT_WRITE", "MEMORY_READ")

@@ -154,6 +154,10 @@ def _after_reads(spec: BarrierSpec) -> BarrierSpec:
     the queue family, so that a src scope left without accesses there gets it too."""
     if _is_transition_after_reads(spec):
         return replace(spec, src_access=AFTER_READS_ACCESS)
+    if spec.old_layout == "UNDEFINED" and spec.src_stages and "MEMORY_READ" not in spec.src_access:
+        # aliased memory whose previous occupants ended with reads and with writes (seed 0/32
+        # aliased, lavapipe and H100): the reads need naming as well
+        return replace(spec, src_access=tuple(sorted((*spec.src_access, *AFTER_READS_ACCESS))))
     return spec
 
 

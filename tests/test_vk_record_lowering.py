@@ -240,6 +240,18 @@ def _barrier(resource, src_stages, src_access, old, new, layers=(0, 1)):
                     "queue": "graphics"}}
 
 
+def _buffer_access(stages, write):
+    return {"resource": "buf", "subresource": None, "stages": stages, "write": write}
+
+
+def _buffer_barrier(src_stages, src_access, queue="graphics"):
+    """A barrier on "buf" before a compute storage write."""
+    return {"resource": "buf", "subresource": None, "aliases": None,
+            "src": {"stages": src_stages, "access": src_access, "layout": None, "queue": queue},
+            "dst": {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_STORAGE_WRITE"], "layout": None,
+                    "queue": "graphics"}}
+
+
 def test_transition_after_reads_of_a_write_names_that_write():
     """Random graph seed 2936/17 on the H100: write (compute) -> barrier -> reads (compute) ->
     a semaphore wait -> transition. The transition names the write's stages and MEMORY_WRITE;
@@ -284,17 +296,10 @@ def test_buffer_barrier_before_a_write_after_reads_names_the_earlier_write():
     names the earlier write's stages and MEMORY_WRITE."""
     from rgraph.vk.after_reads import writers_before_reads
 
-    def access(stages, write):
-        return {"resource": "buf", "subresource": None, "stages": stages, "write": write}
-
-    def barrier(src_stages, src_access):
-        return {"resource": "buf", "subresource": None, "aliases": None,
-                "src": {"stages": src_stages, "access": src_access, "layout": None, "queue": "graphics"},
-                "dst": {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_STORAGE_WRITE"], "layout": None,
-                        "queue": "graphics"}}
     plan = {"passes": [
-        {"accesses": [access(["DRAW_INDIRECT"], False)], "barriers": [barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"])]},
-        {"accesses": [access(["COMPUTE_SHADER"], True)], "barriers": [barrier(["DRAW_INDIRECT"], [])]},
+        {"accesses": [_buffer_access(["DRAW_INDIRECT"], False)],
+         "barriers": [_buffer_barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"])]},
+        {"accesses": [_buffer_access(["COMPUTE_SHADER"], True)], "barriers": [_buffer_barrier(["DRAW_INDIRECT"], [])]},
     ]}
     writers = writers_before_reads(plan)
     assert writers == [{}, {0: ("COMPUTE_SHADER",)}]
@@ -309,24 +314,15 @@ def test_barrier_after_reads_also_names_the_waits_made_on_its_queue():
     so far on the graphics VkQueue (the layer's chain for the write is the last wait's)."""
     from rgraph.vk.after_reads import src_additions
 
-    def access(stages, write):
-        return {"resource": "buf", "subresource": None, "stages": stages, "write": write}
-
-    def barrier(src_stages, src_access, queue="graphics"):
-        return {"resource": "buf", "subresource": None, "aliases": None,
-                "src": {"stages": src_stages, "access": src_access, "layout": None, "queue": queue},
-                "dst": {"stages": ["COMPUTE_SHADER"], "access": ["SHADER_STORAGE_WRITE"], "layout": None,
-                        "queue": "graphics"}}
-
     def wait(stages):
         return {"queue": "compute", "value": 1, "stages": stages}
     plan = {"passes": [
-        {"queue": "compute", "waits": [], "accesses": [access(["COMPUTE_SHADER"], True)], "barriers": []},
-        {"queue": "graphics", "waits": [wait(["DRAW_INDIRECT"])], "accesses": [access(["DRAW_INDIRECT"], False)],
-         "barriers": [barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "compute")]},
+        {"queue": "compute", "waits": [], "accesses": [_buffer_access(["COMPUTE_SHADER"], True)], "barriers": []},
+        {"queue": "graphics", "waits": [wait(["DRAW_INDIRECT"])], "accesses": [_buffer_access(["DRAW_INDIRECT"], False)],
+         "barriers": [_buffer_barrier(["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "compute")]},
         {"queue": "graphics", "waits": [wait(["COLOR_ATTACHMENT_OUTPUT"])], "accesses": [], "barriers": []},
-        {"queue": "graphics", "waits": [], "accesses": [access(["COMPUTE_SHADER"], True)],
-         "barriers": [barrier(["DRAW_INDIRECT"], [])]},
+        {"queue": "graphics", "waits": [], "accesses": [_buffer_access(["COMPUTE_SHADER"], True)],
+         "barriers": [_buffer_barrier(["DRAW_INDIRECT"], [])]},
     ]}
     assert src_additions(plan, lambda queue: queue)[3] == {
         0: ("COLOR_ATTACHMENT_OUTPUT", "COMPUTE_SHADER", "DRAW_INDIRECT")}

@@ -23,8 +23,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Hashable
 
-from rgraph.probe.semantics import subresources
-
 
 def _overlaps(a: dict | None, b: dict | None) -> bool:
     if a is None or b is None:
@@ -32,23 +30,22 @@ def _overlaps(a: dict | None, b: dict | None) -> bool:
     return all(a[k][0] < b[k][1] and b[k][0] < a[k][1] for k in ("mips", "layers") if k in a and k in b)
 
 
-def _subresource(access: dict) -> dict | None:
-    return access.get("subresource") if subresources(access) != [None] else None
-
-
 def writers_before_reads(plan: dict) -> list[dict[int, tuple[str, ...]]]:
     """Per pass, barrier index -> stages of the writes to that resource's overlapping
     subresources (anywhere in the plan, a frame wraps around), for every barrier whose latest
     earlier access (in plan order, else from the previous frame) to an overlapping
     subresource is a read."""
-    passes = plan["passes"]
+    by_resource: dict[str, list[tuple[int, dict]]] = {}  # resource -> (pass index, access), plan order
+    for j, q in enumerate(plan["passes"]):
+        for a in q["accesses"]:
+            by_resource.setdefault(a["resource"], []).append((j, a))
     out: list[dict[int, tuple[str, ...]]] = []
-    for i, p in enumerate(passes):
+    for i, p in enumerate(plan["passes"]):
         found: dict[int, tuple[str, ...]] = {}
         for bi, b in enumerate(p["barriers"]):
             sub = b.get("subresource")
-            touching = [(j, a) for j, q in enumerate(passes) for a in q["accesses"]
-                        if a["resource"] == b["resource"] and _overlaps(_subresource(a), sub)]
+            touching = [(j, a) for j, a in by_resource.get(b["resource"], ())
+                        if _overlaps(a.get("subresource"), sub)]
             writes = sorted({s for _j, a in touching if a["write"] for s in a["stages"]})
             before = [a for j, a in touching if j < i] or [a for j, a in touching if j >= i]
             if writes and before and not before[-1]["write"]:

@@ -300,8 +300,8 @@ class Executor:
         v = vk()
         dev = self.device
         index_of = {id(p): i for i, p in enumerate(self.plan["passes"])}
-        ffi = v.ffi
-        writers = src_additions(self.plan, lambda queue: int(ffi.cast("uintptr_t", dev.queues[queue])))
+        queue_ids = _queue_ids(dev)
+        writers = src_additions(self.plan, queue_ids.__getitem__)
         for s in range(FRAMES_IN_FLIGHT):
             for bi, batch in enumerate(self.batches):
                 pool = self._pool(dev.families[batch.queue], s)
@@ -354,7 +354,7 @@ class Executor:
         v = vk()
         ffi = v.ffi
         dev = self.device
-        handle_of = {q: int(ffi.cast("uintptr_t", vk_queue)) for q, vk_queue in dev.queues.items()}
+        handle_of = _queue_ids(dev)
         syncs = [BatchSync(b.queue, handle_of[b.queue],
                            tuple((w["queue"], w["value"], names.stages(w["stages"])) for w in b.passes[0]["waits"]),
                            tuple((sg["queue"], sg["value"], names.stages(sg["stages"])) for sg in b.passes[-1]["signals"]),
@@ -434,7 +434,7 @@ class Executor:
         """Submit ``frames`` frames; per-pass GPU medians from timestamps.
 
         ``marks`` (if given) gets time.perf_counter() readings, ``marks_per_frame(calls)`` per
-        frame (``FRAME_MARKS``): the frame's start, then a (before, after) pair around each
+        frame (calls in ``FRAME_CALLS`` order): the frame's start, then a (before, after) pair around each
         Vulkan call - the fence wait (time blocked on the GPU), the timestamp read, the fence
         reset, the query reset, each vkQueueSubmit2 - with the per-frame updates (scene and
         pass ``update`` hooks) and semaphore values between them. A call a frame skips (no
@@ -738,6 +738,12 @@ def _acquire_initialised(cb: Any, items: list, device: Device, queue: str) -> li
         keep.append(_image_barrier(cb, r, rng, (v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0), _any_access(),
                                    v.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, names.layout(r.plan["final"]["layout"])))
     return keep
+
+
+def _queue_ids(device: Device) -> dict[str, int]:
+    """Plan queue -> its VkQueue handle as an int (plan queues sharing a VkQueue share it)."""
+    ffi = vk().ffi
+    return {q: int(ffi.cast("uintptr_t", vk_queue)) for q, vk_queue in device.queues.items()}
 
 
 def _check(result: int, call: str) -> None:

@@ -76,7 +76,7 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
       out of the pair also keeps a layer that does not model ownership transfers (1.3.239,
       DESIGN.md) from counting one transition twice; release/acquire access masks follow the
       spec (release: no dst access, acquire: no src access).
-    - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``)
+    - A layout transition after reads names MEMORY_READ as its src access (``_after_reads``).
       Any ordinary barrier after reads whose write ``writers`` (barrier index -> stages,
       ``rgraph.vk.after_reads``) knows names that write too: its stages and MEMORY_WRITE.
     - ``wait_stages``: the stages of the pass's semaphore waits on another VkQueue. Every
@@ -152,12 +152,11 @@ def _after_reads(spec: BarrierSpec) -> BarrierSpec:
     (seeds 0 and 32 with 10 passes, aliased). Naming the reads in srcAccessMask records the
     same dependency in the form the layer understands. Applied after fitting the barrier to
     the queue family, so that a src scope left without accesses there gets it too."""
-    if _is_transition_after_reads(spec):
-        return replace(spec, src_access=AFTER_READS_ACCESS)
-    if spec.old_layout == "UNDEFINED" and spec.src_stages and "MEMORY_READ" not in spec.src_access:
-        # aliased memory whose previous occupants ended with reads and with writes (seed 0/32
-        # aliased, lavapipe and H100): the reads need naming as well
-        return replace(spec, src_access=tuple(sorted((*spec.src_access, *AFTER_READS_ACCESS))))
+    # from UNDEFINED even with a src access: aliased memory whose previous occupants ended
+    # with reads and with writes (seed 0/32 aliased, lavapipe and H100) names the reads too
+    if (_is_transition_after_reads(spec) or (spec.old_layout == "UNDEFINED" and spec.src_stages)) \
+            and "MEMORY_READ" not in spec.src_access:
+        return replace(spec, src_access=tuple(sorted({*spec.src_access, *AFTER_READS_ACCESS})))
     return spec
 
 

@@ -147,4 +147,6 @@ class ProfileMemoryRequirements:
         if unknown:
             raise self._error(f"device profile {self.name!r}: no buffer rule for usage {', '.join(unknown)}")
         alignment = max([rule["alignment_by_usage"][u] for u in usage_names] + [rule["alignment"]])
-        return align_up(max(int(size), 1), rule["size_align"]), alignment, int(rule["memory_type_bits"])
+        by_usage = rule.get("size_align_by_usage")  # older profiles: one rounding for every usage
+        size_align = max(by_usage[u] for u in usage_names) if by_usage and usage_names else rule["size_align"]
+        return align_up(max(int(size), 1), size_align), alignment, int(rule["memory_type_bits"])

@@ -18,11 +18,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rgraph import formats
     from rgraph.vk.device import create_device
     from rgraph.vk.errors import VulkanUnavailable
     from rgraph.vk.instance import create_instance
-    from rgraph.vk.profile_capture import capture_profile
+    from rgraph.vk.profile_capture import ProfileCaptureError, capture_profile
 
+    fmts = [f.strip() for f in args.formats.split(",") if f.strip()] if args.formats else None
+    unknown = [f for f in fmts or () if not _known_format(formats, f)]
+    if unknown:
+        print(f"rgraph: error: --formats: unknown format {', '.join(unknown)}", file=sys.stderr)
+        return 2
     try:
         instance = create_instance(validate=False)
     except VulkanUnavailable as exc:
@@ -32,10 +38,13 @@ def run(args: argparse.Namespace) -> int:
     try:
         device = create_device(instance, args.device)
         name = args.name or ("lavapipe" if "llvmpipe" in device.name else device.name.split()[0].lower())
-        fmts = [f.strip() for f in args.formats.split(",")] if args.formats else None
         profile = capture_profile(device, name, fmts)
     except VulkanUnavailable as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
+        return 1
+    except ProfileCaptureError as exc:
+        print(f"rgraph: error: cannot capture a profile of {device.name if device else 'the device'}: {exc}",
+              file=sys.stderr)
         return 1
     finally:
         if device is not None:
@@ -50,3 +59,11 @@ def run(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _known_format(formats, name: str) -> bool:  # noqa: ANN001 - the rgraph.formats module
+    try:
+        formats.lookup(name)
+    except KeyError:
+        return False
+    return True

@@ -104,31 +104,54 @@ def _measure_format(req: DeviceMemoryRequirements, device: Device, info: formats
     }
 
 
+class ProfileCaptureError(RuntimeError):
+    """The device's requirements follow no rule a profile can describe (message says which)."""
+
+
+def _size_align(pairs: list[tuple[int, int]]) -> int:
+    """The smallest power of two that rounds every requested size to the measured one; 0: none."""
+    return next((a for a in (1 << i for i in range(17)) if all(align_up(max(n, 1), a) == got for n, got in pairs)), 0)
+
+
 def _measure_buffers(req: DeviceMemoryRequirements) -> dict[str, Any]:
+    """Per usage: size rounding and alignment, fitted and verified; combinations of usages must
+    take the largest of each (checked on every pair and on all usages together)."""
     by_usage: dict[str, int] = {}
+    size_by_usage: dict[str, int] = {}
     bits = set()
     measured = []
     for usage in BUFFER_USAGES:
+        pairs = []
         for size in BUFFER_SIZES:
             got_size, alignment, got_bits = req.buffer(size, [usage])
             measured.append([usage, size, got_size, alignment, got_bits])
+            pairs.append((size, got_size))
             by_usage[usage] = max(by_usage.get(usage, 1), alignment)
             bits.add(got_bits)
-    size_align = next((a for a in (1 << i for i in range(17))
-                       if all(align_up(max(m[1], 1), a) == m[2] for m in measured)), 0)
-    if not size_align:
-        raise RuntimeError("buffer sizes follow no power-of-two rounding; profile cannot describe them")
-    all_alignment = max(req.buffer(64, BUFFER_USAGES)[1], 1)
-    rule = {"alignment_by_usage": by_usage, "alignment": 1, "size_align": size_align,
-            "memory_type_bits": min(bits), "samples": measured}
-    # Verify: the rule predicts every single-usage sample and the all-usage alignment.
-    for usage, size, got_size, alignment, _bits in measured:
-        predicted = -(-max(size, 1) // size_align) * size_align
-        if predicted != got_size or by_usage[usage] != alignment:
-            raise RuntimeError(f"buffer rule mispredicts {usage} size {size}: {predicted} != {got_size}")
-    if max(by_usage.values()) != all_alignment or len(bits) != 1:
-        raise RuntimeError("buffer alignment depends on usage combinations; profile cannot describe it")
-    return rule
+        size_by_usage[usage] = _size_align(pairs)
+        if not size_by_usage[usage]:
+            raise ProfileCaptureError(f"buffer sizes for usage {usage} follow no power-of-two rounding: "
+                                      + ", ".join(f"{n} -> {got}" for n, got in pairs))
+    for usage, size, _got, alignment, _bits in measured:
+        if by_usage[usage] != alignment:
+            raise ProfileCaptureError(f"buffer alignment for usage {usage} depends on size ({size}: {alignment})")
+    combos = [[a, b] for i, a in enumerate(BUFFER_USAGES) for b in BUFFER_USAGES[i + 1:]] + [list(BUFFER_USAGES)]
+    combined = []
+    for usages in combos:
+        for size in (1, 100, 65537):
+            got_size, alignment, got_bits = req.buffer(size, usages)
+            combined.append([usages, size, got_size, alignment, got_bits])
+            want_size = align_up(size, max(size_by_usage[u] for u in usages))
+            want_alignment = max(by_usage[u] for u in usages)
+            if (got_size, alignment) != (want_size, want_alignment) or got_bits not in bits:
+                raise ProfileCaptureError(
+                    f"buffer requirements for usages {'+'.join(usages)} size {size} are {got_size} bytes aligned "
+                    f"{alignment}, not the largest of the single usages ({want_size}, {want_alignment})")
+    if len(bits) != 1:
+        raise ProfileCaptureError(f"buffer memory type bits depend on usage: {sorted(bits)}")
+    return {"alignment_by_usage": by_usage, "alignment": 1, "size_align_by_usage": size_by_usage,
+            "size_align": max(size_by_usage.values()), "memory_type_bits": min(bits), "samples": measured,
+            "combined_samples": combined}
 
 
 def capture_profile(device: Device, name: str, format_names: list[str] | None = None) -> dict[str, Any]:

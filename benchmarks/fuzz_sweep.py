@@ -9,7 +9,7 @@ requirements, as the fuzz tests do. Prints one line per failing graph and a summ
 result as JSON lines under ``--out``; exits 1 if any graph failed.
 
     python benchmarks/fuzz_sweep.py [--start 0] [--count 1000] [--workers 8]
-        [--max-passes 40] [--seconds 500] [--out fuzz-out]
+        [--max-passes 40] [--seconds 500] [--out fuzz-out] [--seeds 156,333]
 """
 
 from __future__ import annotations
@@ -68,6 +68,7 @@ def run_case(entry: tuple[int, int, str]) -> dict[str, Any]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", default=None, help="comma-separated seeds instead of --start/--count")
     parser.add_argument("--start", type=int, default=0)
     parser.add_argument("--count", type=int, default=1000)
     parser.add_argument("--workers", type=int, default=8)
@@ -76,7 +77,9 @@ def main() -> int:
     parser.add_argument("--out", type=Path, default=Path("fuzz-out"))
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    entries = [case(seed, args.max_passes) for seed in range(args.start, args.start + args.count)]
+    seeds = ([int(x) for x in args.seeds.split(",")] if args.seeds
+             else list(range(args.start, args.start + args.count)))
+    entries = [case(seed, args.max_passes) for seed in seeds]
     deadline = time.perf_counter() + args.seconds
     done: list[dict[str, Any]] = []
     with (args.out / "results.jsonl").open("w") as log, \
@@ -95,7 +98,7 @@ def main() -> int:
                 break
     failed = [r for r in done if not r["ok"]]
     passes = sorted(r["passes"] for r in done)
-    print(f"{len(done)} graphs (seeds {args.start}..{args.start + args.count - 1}, {args.workers} workers, "
+    print(f"{len(done)} graphs (seeds {seeds[0]}..{seeds[-1]}, {args.workers} workers, "
           f"passes 1..{args.max_passes}, median {passes[len(passes) // 2] if passes else 0}): "
           f"{len(done) - len(failed)} clean, {len(failed)} failed")
     return 1 if failed or not done else 0

@@ -54,23 +54,60 @@ def writers_before_reads(plan: dict) -> list[dict[int, tuple[str, ...]]]:
     return out
 
 
+def _names(aliases: str | list[str] | None) -> list[str]:
+    return [] if not aliases else [aliases] if isinstance(aliases, str) else list(aliases)
+
+
 def src_additions(plan: dict, queue_key: Callable[[str], Hashable]) -> list[dict[int, tuple[str, ...]]]:
-    """``writers_before_reads`` plus, for each such barrier, the stages of every semaphore wait
-    on another VkQueue (``queue_key``: plan queue -> VkQueue) made so far in the frame on the
-    barrier's VkQueue. Each such wait re-imports the other queue's copy of a write that queue
-    once imported or made, and the 1.3.239 layer then replaces this queue's dependency chain
-    for the write with that wait's stages (H100 fuzz seed 231271/12: a buffer written on
-    compute, read as indirect on graphics, two waits for compute later, the next write on
-    graphics reported WRITE_AFTER_WRITE); a src scope that names those stages chains to it."""
+    """Per pass, barrier index -> stages its src scope also names, for the barriers whose src
+    scope relies on an execution chain the 1.3.239 layer can lose:
+
+    - ``writers_before_reads``: the reads' write stages;
+    - a first use of aliased memory after the previous occupants' reads (src stages, no src
+      access; the latest access of the previous occupants in the frame is a read, so an
+      emptied post-write scope, a mutation, is not repaired): their write stages;
+    - a barrier whose src is another VkQueue (its layout change after a queue family
+      ownership acquire, src = the acquire's dst stages: H100 fuzz 422/25 and 156/32);
+
+    each with the stages of every semaphore wait on another VkQueue (``queue_key``: plan queue
+    -> VkQueue) that the barrier's VkQueue makes in the frame (frames repeat, so also those
+    after it). Each such wait re-imports the other queue's copy of a write that queue once
+    imported or made, and the layer then replaces this queue's dependency chain for the write
+    with that wait's stages (H100 fuzz seed 231271/12: a buffer written on compute, read as
+    indirect on graphics, two waits for compute later, the next write on graphics reported
+    WRITE_AFTER_WRITE; 885/24 aliased: a buffer's first use after its previous occupant's
+    uniform reads); a src scope that names those stages chains to it."""
     writers = writers_before_reads(plan)
-    imported: dict[Hashable, set[str]] = {}
-    out: list[dict[int, tuple[str, ...]]] = []
-    for p, found in zip(plan["passes"], writers, strict=True):
+    waits: dict[Hashable, set[str]] = {}
+    for p in plan["passes"]:
         key = queue_key(p["queue"])
-        waited = imported.setdefault(key, set())
-        waited.update(s for w in p["waits"] if queue_key(w["queue"]) != key for s in w["stages"])
-        extra = {bi: tuple(sorted(set(found.get(bi, ())) | waited)) for bi, b in enumerate(p["barriers"])
-                 if bi in found or (_after_reads_from_undefined(b) and waited)}
+        waits.setdefault(key, set()).update(
+            s for w in p["waits"] if queue_key(w["queue"]) != key for s in w["stages"])
+    by_resource: dict[str, list[tuple[int, dict]]] = {}
+    for j, q in enumerate(plan["passes"]):
+        for a in q["accesses"]:
+            by_resource.setdefault(a["resource"], []).append((j, a))
+    out: list[dict[int, tuple[str, ...]]] = []
+    for i, (p, found) in enumerate(zip(plan["passes"], writers, strict=True)):
+        key = queue_key(p["queue"])
+        waited = waits.get(key, set())
+        extra: dict[int, tuple[str, ...]] = {}
+        for bi, b in enumerate(p["barriers"]):
+            stages = set(found.get(bi, ()))
+            relies = bi in found
+            if b["src"]["stages"] and not b["src"]["access"]:
+                earlier = [a for _j, a in sorted(((j, a) for name in _names(b.get("aliases"))
+                                                  for j, a in by_resource.get(name, ()) if j < i),
+                                                 key=lambda ja: ja[0])]
+                if earlier and not earlier[-1]["write"]:
+                    relies = True
+                    stages.update(s for a in earlier if a["write"] for s in a["stages"])
+                elif _after_reads_from_undefined(b):
+                    relies = True
+            if b["src"]["stages"] and queue_key(b["src"]["queue"]) != key:
+                relies = True
+            if relies and (stages or waited):
+                extra[bi] = tuple(sorted(stages | waited))
         out.append(extra)
     return out
 

@@ -26,6 +26,7 @@ from rgraph.vk.impl_pass import ImplPass
 from rgraph.vk.instance import Instance, ValidationMessage, create_instance
 from rgraph.vk.layer_races import avoid_layer_races, touched_resources
 from rgraph.vk.loader import vk
+from rgraph.vk.packed_ranges import partial_handoffs
 from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
 from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
@@ -302,6 +303,7 @@ class Executor:
         index_of = {id(p): i for i, p in enumerate(self.plan["passes"])}
         queue_ids = _queue_ids(dev)
         writers = src_additions(self.plan, queue_ids.__getitem__)
+        handoffs = partial_handoffs(self.plan)
         for s in range(FRAMES_IN_FLIGHT):
             for bi, batch in enumerate(self.batches):
                 pool = self._pool(dev.families[batch.queue], s)
@@ -322,7 +324,7 @@ class Executor:
                         v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, self.query_pools[s], 2 * i)
                     waited = [st for w in p["waits"] if not dev.same_queue(w["queue"], p["queue"]) for st in w["stages"]]
                     for barriers in build_barriers(dev, self.resources, s, p["barriers"], "barrier", p["queue"], waited,
-                                                   writers[i]):
+                                                   writers[i], handoffs[i]):
                         self.barrier_batches.append(barriers)
                         v.vkCmdPipelineBarrier2(cb, barriers.dependency)
                     self.passes[i].record(ctx, s)

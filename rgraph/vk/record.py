@@ -6,7 +6,7 @@ push constants. It has no barrier calls: the graph owns synchronization.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping, Sequence, Set
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -28,14 +28,15 @@ def _aspect_for_layout(format_name: str, layout: str) -> int:
 
 @dataclass(frozen=True)
 class BarrierSpec:
-    """One VkImageMemoryBarrier2 / VkBufferMemoryBarrier2 in plan names (pure data, no Vulkan).
+    """One VkImageMemoryBarrier2 / VkBufferMemoryBarrier2 in plan names (pure data, no Vulkan);
+    with ``resource`` None, a global VkMemoryBarrier2 (``rgraph.vk.packed_ranges``).
 
     ``src_family``/``dst_family``: a queue family index, or None for VK_QUEUE_FAMILY_IGNORED.
     ``aspect_layout``: the layout that picks the image aspect (the plan barrier's dst layout,
     else its src layout), so that every struct derived from one plan barrier names one aspect.
     """
 
-    resource: str
+    resource: str | None
     subresource: dict | None
     src_stages: tuple[str, ...]
     src_access: tuple[str, ...]
@@ -51,7 +52,8 @@ class BarrierSpec:
 def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
                    wait_stages: Sequence[str] = (),
                    capabilities: frozenset[str] = CAPABILITIES,
-                   writers: Mapping[int, tuple[str, ...]] | None = None) -> list[list[BarrierSpec]]:
+                   writers: Mapping[int, tuple[str, ...]] | None = None,
+                   partial_handoffs: Set[int] = frozenset()) -> list[list[BarrierSpec]]:
     """Plan barriers -> the vkCmdPipelineBarrier2 calls that execute them, in recording order.
 
     ``role`` is "barrier" (before the pass) or "release" (after it); ``families`` maps plan
@@ -84,6 +86,9 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
       the wait: a plan barrier's src stages may name another queue's stages (an aliased
       resource's previous occupant read on the compute queue, say), which on this queue are
       ordered after nothing the semaphore covers (an H100 run: WRITE_AFTER_READ in forward).
+    - ``partial_handoffs``: indices of aliasing hand-offs the 1.3.239 layer sees only in part
+      (``rgraph.vk.packed_ranges``): each also gets a global memory barrier with its src scope
+      and dst ALL_COMMANDS / MEMORY_READ|MEMORY_WRITE, in the same call.
     - ``capabilities``: what the recording queue's family does (graphics/compute/transfer).
       Stages it does not run, and the accesses only they perform, are dropped from both
       scopes (``rgraph.stages.fit_to_queue``): a release on a compute-only family after
@@ -100,8 +105,22 @@ def lower_barriers(barriers: list[dict], role: str, families: Mapping[str, int],
             spec = _name_read_write(spec, (writers or {}).get(index, ()))
             if capabilities != CAPABILITIES:
                 spec = _fit(spec, capabilities)
-            (first if group == 0 else after).append(_after_reads(spec))
+            spec = _after_reads(spec)
+            (first if group == 0 else after).append(spec)
+            if index in partial_handoffs and group == 0 and spec.src_stages:
+                first.append(_global_after(spec))
     return [group for group in (first, after) if group]
+
+
+#: dst scope of the global barrier that completes a partly seen hand-off: every later command.
+GLOBAL_DST_STAGES = ("ALL_COMMANDS",)
+GLOBAL_DST_ACCESS = ("MEMORY_READ", "MEMORY_WRITE")
+
+
+def _global_after(spec: BarrierSpec) -> BarrierSpec:
+    """A global memory barrier with ``spec``'s src scope, ordering it before every later command."""
+    return BarrierSpec(None, None, spec.src_stages, spec.src_access, GLOBAL_DST_STAGES, GLOBAL_DST_ACCESS,
+                       None, None)
 
 
 def _fit(spec: BarrierSpec, capabilities: frozenset[str]) -> BarrierSpec:
@@ -196,12 +215,13 @@ class BarrierBatch:
 
 def build_barriers(device: Device, resources: ResourceSet, set_index: int, barriers: list[dict],
                    role: str, queue: str, wait_stages: Sequence[str] = (),
-                   writers: Mapping[int, tuple[str, ...]] | None = None) -> list[BarrierBatch]:
+                   writers: Mapping[int, tuple[str, ...]] | None = None,
+                   partial_handoffs: Set[int] = frozenset()) -> list[BarrierBatch]:
     """Sync2 structs for plan barriers recorded on plan queue ``queue`` (see ``lower_barriers``):
     one batch per vkCmdPipelineBarrier2, to be recorded in order; [] when there is nothing."""
     return [_dependency(resources, set_index, group)
             for group in lower_barriers(barriers, role, device.families, wait_stages,
-                                        device.capabilities.get(queue, CAPABILITIES), writers)]
+                                        device.capabilities.get(queue, CAPABILITIES), writers, partial_handoffs)]
 
 
 def _family(index: int | None) -> int:
@@ -210,12 +230,15 @@ def _family(index: int | None) -> int:
 
 def _dependency(resources: ResourceSet, set_index: int, specs: list[BarrierSpec]) -> BarrierBatch:
     v = vk()
-    images, buffers = [], []
+    images, buffers, memory = [], [], []
     for b in specs:
-        r = resources.get(b.resource, set_index)
         masks = {"srcStageMask": names.stages(b.src_stages), "srcAccessMask": names.accesses(b.src_access),
-                 "dstStageMask": names.stages(b.dst_stages), "dstAccessMask": names.accesses(b.dst_access),
-                 "srcQueueFamilyIndex": _family(b.src_family), "dstQueueFamilyIndex": _family(b.dst_family)}
+                 "dstStageMask": names.stages(b.dst_stages), "dstAccessMask": names.accesses(b.dst_access)}
+        if b.resource is None:
+            memory.append(v.VkMemoryBarrier2(**masks))
+            continue
+        r = resources.get(b.resource, set_index)
+        masks |= {"srcQueueFamilyIndex": _family(b.src_family), "dstQueueFamilyIndex": _family(b.dst_family)}
         if r.is_image:
             sub = b.subresource
             rng = v.VkImageSubresourceRange(
@@ -228,9 +251,10 @@ def _dependency(resources: ResourceSet, set_index: int, specs: list[BarrierSpec]
         else:
             buffers.append(v.VkBufferMemoryBarrier2(buffer=r.handle, offset=0, size=names.WHOLE_SIZE, **masks))
     dep = v.VkDependencyInfo(
+        memoryBarrierCount=len(memory), pMemoryBarriers=memory or None,
         imageMemoryBarrierCount=len(images), pImageMemoryBarriers=images or None,
         bufferMemoryBarrierCount=len(buffers), pBufferMemoryBarriers=buffers or None)
-    return BarrierBatch(dep, [images, buffers], len(images) + len(buffers))
+    return BarrierBatch(dep, [images, buffers, memory], len(images) + len(buffers) + len(memory))
 
 
 class RecordContext:

@@ -355,3 +355,80 @@ def test_aliased_first_use_after_a_write_and_reads_names_memory_read_too():
                          "UNDEFINED", "COLOR_ATTACHMENT_OPTIMAL")
     (group,) = lower_barriers([first_use], "barrier", TWO_FAMILIES)
     assert group[0].src_access == ("COLOR_ATTACHMENT_WRITE", "MEMORY_READ")
+
+
+def _wait(stages):
+    return {"queue": "compute", "value": 1, "stages": stages}
+
+
+def test_aliased_buffer_first_use_after_reads_names_waits_and_the_write():
+    """H100 fuzz 885/24 aliased: buf6 written (fragment), read as a uniform, graphics waits for
+    compute, then buf1 (same memory) is first written by a dispatch. Its barrier (reads' stages,
+    no access) names the wait's stages and buf6's write; an emptied post-write scope does not."""
+    from rgraph.vk.after_reads import src_additions
+
+    def buf(name, stages, write):
+        return {"resource": name, "subresource": None, "stages": stages, "write": write}
+
+    first_use = {**_buffer_barrier(["FRAGMENT_SHADER", "VERTEX_SHADER"], []), "resource": "buf1", "aliases": "buf6"}
+    plan = {"passes": [
+        {"queue": "graphics", "waits": [], "accesses": [buf("buf6", ["FRAGMENT_SHADER"], True)], "barriers": []},
+        {"queue": "graphics", "waits": [], "accesses": [buf("buf6", ["VERTEX_SHADER"], False)], "barriers": []},
+        {"queue": "graphics", "waits": [_wait(["COLOR_ATTACHMENT_OUTPUT"])], "accesses": [], "barriers": []},
+        {"queue": "graphics", "waits": [], "accesses": [buf("buf1", ["COMPUTE_SHADER"], True)],
+         "barriers": [first_use]},
+    ]}
+    assert src_additions(plan, lambda queue: queue)[3] == {0: ("COLOR_ATTACHMENT_OUTPUT", "FRAGMENT_SHADER")}
+    (group,) = lower_barriers([first_use], "barrier", TWO_FAMILIES, writers={0: ("COLOR_ATTACHMENT_OUTPUT",)})
+    assert group[0].src_access == ("MEMORY_READ", "MEMORY_WRITE")
+    after_write = {**plan, "passes": [plan["passes"][0], plan["passes"][2], plan["passes"][3]]}
+    assert src_additions(after_write, lambda queue: queue)[2] == {}  # latest access a write: not repaired
+
+
+def test_layout_change_after_an_acquire_names_the_waits_of_its_queue():
+    """H100 fuzz 422/25 and 156/32: a persistent image written on compute in one frame and
+    acquired by graphics in the next, after graphics waited for compute elsewhere. The layout
+    change recorded after the acquire names every wait stage of the graphics VkQueue."""
+    from rgraph.vk.after_reads import src_additions
+
+    acquire = _barrier("img", ["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "GENERAL", "SHADER_READ_ONLY_OPTIMAL")
+    acquire["src"]["queue"] = "compute"
+    plan = {"passes": [
+        {"queue": "graphics", "waits": [_wait(["COLOR_ATTACHMENT_OUTPUT"])], "accesses": [], "barriers": []},
+        {"queue": "graphics", "waits": [], "accesses": [_access("img", ["FRAGMENT_SHADER"], False)],
+         "barriers": [acquire]},
+        {"queue": "compute", "waits": [], "accesses": [_access("img", ["COMPUTE_SHADER"], True)], "barriers": []},
+        {"queue": "graphics", "waits": [_wait(["VERTEX_SHADER"])], "accesses": [], "barriers": []},
+    ]}
+    extra = src_additions(plan, lambda queue: queue)[1]
+    assert extra == {0: ("COLOR_ATTACHMENT_OUTPUT", "VERTEX_SHADER")}  # frames repeat: the later wait too
+    acquire_call, transition_call = lower_barriers([acquire], "barrier", TWO_FAMILIES, writers=extra)
+    assert acquire_call[0].src_access == () and acquire_call[0].src_family == 1  # spec-mandated masks kept
+    assert transition_call[0].src_stages == ("COLOR_ATTACHMENT_OUTPUT", "FRAGMENT_SHADER", "VERTEX_SHADER")
+    assert transition_call[0].src_access == ("MEMORY_READ", "MEMORY_WRITE")
+
+
+def test_partly_seen_handoff_gets_a_global_barrier_in_the_same_call():
+    """H100 fuzz 1289/37 aliased: img16 (8x8 RGBA8, two mips: 2,048 bytes on NVIDIA, 320
+    packed) takes over img6 (8x8 RGBA16F, two layers: 1,024 bytes, packed alike). The layer
+    applies img16's hand-off to its 320 packed bytes only, so the hand-off also records a
+    global memory barrier: the hand-off's src scope before ALL_COMMANDS."""
+    from rgraph.vk.packed_ranges import packed_bytes, partial_handoffs
+
+    img6 = {"name": "img6", "kind": "image", "format": "R16G16B16A16_SFLOAT", "extent": [8, 8, 1], "mips": 1,
+            "layers": 2, "bytes": 1024, "heap": 1, "offset": 0}
+    img16 = {**img6, "name": "img16", "format": "R8G8B8A8_UNORM", "mips": 2, "layers": 1, "bytes": 2048}
+    assert (packed_bytes(img6), packed_bytes(img16)) == (1024, 320)
+    assert packed_bytes({**img6, "format": "D24_UNORM_S8_UINT", "layers": 1}) == 8 * 8 * (4 + 1)
+    handoff = _barrier("img16", ["COLOR_ATTACHMENT_OUTPUT"], ["COLOR_ATTACHMENT_WRITE"], "UNDEFINED", "GENERAL")
+    handoff["aliases"] = "img6"
+    plan = {"resources": [img6, img16], "passes": [{"barriers": [handoff]}]}
+    assert partial_handoffs(plan) == [{0}]
+    roomy = {**img16, "format": "R16G16B16A16_SFLOAT", "mips": 1, "layers": 2}  # packs over all of img6
+    assert partial_handoffs({**plan, "resources": [img6, {**roomy, "name": "img16"}]}) == [set()]
+    (group,) = lower_barriers([handoff], "barrier", TWO_FAMILIES, partial_handoffs={0})
+    image, memory = group
+    assert image.resource == "img16" and memory.resource is None
+    assert (memory.src_stages, memory.src_access) == (image.src_stages, image.src_access)
+    assert (memory.dst_stages, memory.dst_access) == (("ALL_COMMANDS",), ("MEMORY_READ", "MEMORY_WRITE"))
+    assert lower_barriers([handoff], "barrier", TWO_FAMILIES) == [[image]]

@@ -36,10 +36,16 @@ def case(seed: int, max_passes: int) -> tuple[int, int, str]:
 
 
 def _open_worker() -> None:
+    """Open the worker's device for memory requirements; a failure is kept and reported with
+    every case (an initializer that raises makes the pool respawn workers forever)."""
     from rgraph.vk.memreq import live_requirements
 
     stack = ExitStack()
-    memory, _device = stack.enter_context(live_requirements())
+    try:
+        memory, _device = stack.enter_context(live_requirements())
+    except Exception as exc:  # noqa: BLE001 - reported per case by run_case
+        _worker.update(error=f"worker could not open the device: {type(exc).__name__}: {exc}")
+        return
     _worker.update(stack=stack, memory=memory, tmp=Path(tempfile.mkdtemp(prefix="rgraph-fuzz-")))
 
 
@@ -52,6 +58,8 @@ def run_case(entry: tuple[int, int, str]) -> dict[str, Any]:
     seed, passes, policy = entry
     record: dict[str, Any] = {"seed": seed, "passes": passes, "policy": policy}
     started = time.perf_counter()
+    if "error" in _worker:
+        return record | {"messages": [], "data_ok": False, "error": _worker["error"], "ok": False, "seconds": 0.0}
     try:
         path = _worker["tmp"] / f"g_{seed}_{passes}.yaml"
         path.write_text(to_yaml(random_graph(seed, passes)))
@@ -84,11 +92,17 @@ def main() -> int:
     done: list[dict[str, Any]] = []
     with (args.out / "results.jsonl").open("w") as log, \
             multiprocessing.get_context("spawn").Pool(args.workers, initializer=_open_worker) as pool:
-        for record in pool.imap_unordered(run_case, entries):
+        results = pool.imap_unordered(run_case, entries)
+        while True:
+            try:
+                record = results.next(timeout=max(1.0, deadline - time.perf_counter()))
+            except (StopIteration, multiprocessing.TimeoutError):
+                pool.terminate()
+                break
             done.append(record)
             log.write(json.dumps(record) + "\n")
             log.flush()
-            if not record["ok"]:
+            if not record["ok"] and sum(not r["ok"] for r in done) <= 50:  # the rest: results.jsonl
                 first = (record["messages"] or record.get("mismatches") or [record.get("error", "")])[:1]
                 print(f"FAIL seed {record['seed']}/{record['passes']} {record['policy']}: "
                       f"{len(record['messages'])} messages, data_ok={record['data_ok']}; {first[0][:400] if first else ''}",

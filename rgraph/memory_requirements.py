@@ -81,6 +81,44 @@ def fit_image_rule(samples: Sequence[Sample], block_bytes: int, block_extent: Se
     return None
 
 
+def _pow2_at_least(value: int) -> int:
+    n = 1
+    while n < value:
+        n *= 2
+    return n
+
+
+#: The images a block-linear rule covers: one mip, one sample, 2D (mip chains and MSAA differ).
+BLOCK_LINEAR_DOMAIN = {"mips": 1, "samples": 1, "depth": 1}
+
+
+def predict_block_linear(rule: dict[str, int], block_bytes: int, block_extent: Sequence[int],
+                         extent: Sequence[int], layers: int) -> int:
+    """Block-linear tiling (NVIDIA): rows of ``gob_bytes`` and blocks of ``gob_rows`` rows times
+    a block height in GOBs that is the smallest power of two covering the image's height, at
+    most ``max_block_gobs``; layers one after another; the total aligned to ``size_align``."""
+    bw, bh = (list(block_extent) + [1, 1])[:2]
+    bx, by = -(-int(extent[0]) // bw), -(-int(extent[1]) // bh)
+    gobs = min(rule["max_block_gobs"], _pow2_at_least(-(-by // rule["gob_rows"])))
+    layer = align_up(bx * block_bytes, rule["gob_bytes"]) * align_up(by, rule["gob_rows"] * gobs)
+    return align_up(layer * int(layers), rule["size_align"])
+
+
+def fit_block_linear_rule(samples: Sequence[Sample], block_bytes: int, block_extent: Sequence[int]) -> dict | None:
+    """A block-linear rule predicting every sample in ``BLOCK_LINEAR_DOMAIN`` (None if none
+    does, or no sample lies in it)."""
+    inside = [s for s in samples if s[3] == 1 and s[5] == 1 and s[2] == 1]
+    if not inside:
+        return None
+    for gob_bytes, gob_rows, max_gobs, size_align in ((64, 8, 16, 512), (64, 8, 32, 512), (64, 8, 16, 1),
+                                                      (64, 8, 32, 1)):
+        rule = {"family": "block_linear", "gob_bytes": gob_bytes, "gob_rows": gob_rows,
+                "max_block_gobs": max_gobs, "size_align": size_align, "domain": dict(BLOCK_LINEAR_DOMAIN)}
+        if all(predict_block_linear(rule, block_bytes, block_extent, s[0:3], s[4]) == s[6] for s in inside):
+            return rule
+    return None
+
+
 @dataclass
 class ProfileMemoryRequirements:
     """The memory-requirements provider backed by a device profile (same API as the device one)."""
@@ -137,7 +175,16 @@ class ProfileMemoryRequirements:
             )
         if int(samples) > 1 and int(samples) not in entry.get("sample_counts", [1]):
             raise self._error(f"device profile {self.name!r}: {key} does not support {samples} samples")
-        size = predict_image(rule, entry["block_bytes"], entry["block_extent"], ext, mips, layers, samples)
+        if rule.get("family") == "block_linear":
+            if [int(mips), int(samples), ext[2]] != [rule["domain"]["mips"], rule["domain"]["samples"],
+                                                     rule["domain"]["depth"]]:
+                raise self._error(
+                    f"device profile {self.name!r}: the size rule of {key} covers single-mip, single-sample 2D "
+                    f"images only; extent {ext} mips {mips} layers {layers} samples {samples} was not measured "
+                    "(compile on the device instead)")
+            size = predict_block_linear(rule, entry["block_bytes"], entry["block_extent"], ext, layers)
+        else:
+            size = predict_image(rule, entry["block_bytes"], entry["block_extent"], ext, mips, layers, samples)
         return size, int(entry["alignment"]), int(entry["memory_type_bits"])
 
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:

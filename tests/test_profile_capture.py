@@ -85,3 +85,32 @@ def test_captured_profile_compiles_the_plan_the_live_device_gets(tmp_path: Path)
     layout = lambda plan: [(r["name"], r["bytes"], r.get("heap"), r.get("offset")) for r in plan["resources"]]  # noqa: E731
     assert layout(offline) == layout(live)
     assert offline["heaps"] == live["heaps"]
+
+
+H100_SAMPLES = Path(__file__).parent / "data" / "h100_samples.json"  # measured: rgraph device-profile, H100
+
+
+@pytest.mark.parametrize("fmt", ["R8G8B8A8_UNORM", "R16G16B16A16_SFLOAT", "D32_SFLOAT"])
+def test_block_linear_rule_predicts_measured_h100_sizes(fmt: str) -> None:
+    """NVIDIA's image sizes fit no rule of the packed family (the H100 capture kept 0 rules);
+    the block-linear rule (64-byte x 8-row GOBs, block height adapting to the height) predicts
+    every measured single-mip, single-sample size, and a profile using it refuses mip chains
+    and MSAA at extents it did not measure instead of guessing."""
+    from rgraph.memory_requirements import fit_block_linear_rule, fit_image_rule, predict_block_linear
+
+    data = json.loads(H100_SAMPLES.read_text())
+    entry = data["formats"][fmt]
+    samples = [tuple(s) for s in entry["samples"]]
+    assert fit_image_rule(samples, entry["block_bytes"], entry["block_extent"]) is None
+    rule = fit_block_linear_rule(samples, entry["block_bytes"], entry["block_extent"])
+    assert rule is not None and rule["family"] == "block_linear"
+    entry["rule"] = rule
+    profile = ProfileMemoryRequirements(data, str(H100_SAMPLES))
+    inside = [s for s in samples if s[3] == 1 and s[5] == 1]
+    assert len(inside) >= 10
+    assert [predict_block_linear(rule, entry["block_bytes"], entry["block_extent"], s[0:3], s[4]) for s in inside] \
+        == [s[6] for s in inside]
+    unmeasured = profile.image(fmt, (96, 48, 1), 1, 2, 1, ["sampled"])  # 2D, one mip: the rule answers
+    assert unmeasured[0] == predict_block_linear(rule, entry["block_bytes"], entry["block_extent"], (96, 48, 1), 2)
+    with pytest.raises(Exception, match="single-mip, single-sample"):
+        profile.image(fmt, (96, 48, 1), 3, 1, 1, ["sampled"])

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph import formats
-from rgraph.memory_requirements import align_up, fit_image_rule
+from rgraph.memory_requirements import align_up, fit_block_linear_rule, fit_image_rule
 from rgraph.vk.device import Device
 from rgraph.vk.loader import vk
 from rgraph.vk.memreq import DeviceMemoryRequirements
@@ -93,7 +93,8 @@ def _measure_format(req: DeviceMemoryRequirements, device: Device, info: formats
         samples.append([*extent, mips, layers, count, size, alignment, bits])
     alignments = {s[7] for s in samples}
     bits = {s[8] for s in samples}
-    rule = fit_image_rule([tuple(s) for s in samples], info.block_bytes, info.block_extent)
+    rule = (fit_image_rule([tuple(s) for s in samples], info.block_bytes, info.block_extent)
+            or fit_block_linear_rule([tuple(s) for s in samples], info.block_bytes, info.block_extent))
     if len(alignments) != 1 or len(bits) != 1:
         rule = None
     return {

@@ -30,15 +30,21 @@ def _overlaps(a: dict | None, b: dict | None) -> bool:
     return all(a[k][0] < b[k][1] and b[k][0] < a[k][1] for k in ("mips", "layers") if k in a and k in b)
 
 
+def _accesses_by_resource(plan: dict) -> dict[str, list[tuple[int, dict]]]:
+    """resource -> (pass index, access), in plan order."""
+    by_resource: dict[str, list[tuple[int, dict]]] = {}
+    for j, q in enumerate(plan["passes"]):
+        for a in q["accesses"]:
+            by_resource.setdefault(a["resource"], []).append((j, a))
+    return by_resource
+
+
 def writers_before_reads(plan: dict) -> list[dict[int, tuple[str, ...]]]:
     """Per pass, barrier index -> stages of the writes to that resource's overlapping
     subresources (anywhere in the plan, a frame wraps around), for every barrier whose latest
     earlier access (in plan order, else from the previous frame) to an overlapping
     subresource is a read."""
-    by_resource: dict[str, list[tuple[int, dict]]] = {}  # resource -> (pass index, access), plan order
-    for j, q in enumerate(plan["passes"]):
-        for a in q["accesses"]:
-            by_resource.setdefault(a["resource"], []).append((j, a))
+    by_resource = _accesses_by_resource(plan)
     out: list[dict[int, tuple[str, ...]]] = []
     for i, p in enumerate(plan["passes"]):
         found: dict[int, tuple[str, ...]] = {}
@@ -54,7 +60,8 @@ def writers_before_reads(plan: dict) -> list[dict[int, tuple[str, ...]]]:
     return out
 
 
-def _names(aliases: str | list[str] | None) -> list[str]:
+def alias_names(aliases: str | list[str] | None) -> list[str]:
+    """A barrier's ``aliases``: one name, a list, or none."""
     return [] if not aliases else [aliases] if isinstance(aliases, str) else list(aliases)
 
 
@@ -83,10 +90,7 @@ def src_additions(plan: dict, queue_key: Callable[[str], Hashable]) -> list[dict
         key = queue_key(p["queue"])
         waits.setdefault(key, set()).update(
             s for w in p["waits"] if queue_key(w["queue"]) != key for s in w["stages"])
-    by_resource: dict[str, list[tuple[int, dict]]] = {}
-    for j, q in enumerate(plan["passes"]):
-        for a in q["accesses"]:
-            by_resource.setdefault(a["resource"], []).append((j, a))
+    by_resource = _accesses_by_resource(plan)
     out: list[dict[int, tuple[str, ...]]] = []
     for i, (p, found) in enumerate(zip(plan["passes"], writers, strict=True)):
         key = queue_key(p["queue"])
@@ -96,7 +100,7 @@ def src_additions(plan: dict, queue_key: Callable[[str], Hashable]) -> list[dict
             stages = set(found.get(bi, ()))
             relies = bi in found
             if b["src"]["stages"] and not b["src"]["access"]:
-                earlier = [a for _j, a in sorted(((j, a) for name in _names(b.get("aliases"))
+                earlier = [a for _j, a in sorted(((j, a) for name in alias_names(b.get("aliases"))
                                                   for j, a in by_resource.get(name, ()) if j < i),
                                                  key=lambda ja: ja[0])]
                 if earlier and not earlier[-1]["write"]:

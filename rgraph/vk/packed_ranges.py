@@ -20,6 +20,7 @@ ordered them before the new occupant; the global one adds only that later comman
 from __future__ import annotations
 
 from rgraph import formats
+from rgraph.vk.after_reads import alias_names
 
 
 def packed_bytes(resource: dict) -> int:
@@ -59,8 +60,7 @@ def partial_handoffs(plan: dict) -> list[set[int]]:
                 continue
             real = _span(new, int(new["bytes"]))
             packed = _span(new, packed_bytes(new))
-            aliases = b["aliases"]
-            for name in [aliases] if isinstance(aliases, str) else aliases:  # one name, or a list
+            for name in alias_names(b["aliases"]):
                 old = resources.get(name)
                 if old is None or old.get("heap") != new.get("heap") or old.get("offset") is None:
                     continue

@@ -73,7 +73,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def compile_plan(args: argparse.Namespace, block_mib: int, mix: str, memory: Any) -> dict:
     """The graph compiled with this run's ``alloc.*`` params."""
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
 
     params = {"alloc.block_mib": str(block_mib), "alloc.meshes": str(args.meshes),
               "alloc.segments": str(args.segments), "alloc.deformable_fraction": str(MIXES[mix]),

@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rgraph.compile.pipeline import compile_spec, frontend  # noqa: E402
+from rgraph.compiler.pipeline import compile_spec, frontend  # noqa: E402
 from rgraph.random_graph import random_graph, to_yaml  # noqa: E402
 
 

@@ -34,7 +34,7 @@ import statistics
 import time
 from typing import Any
 
-from rgraph.compile.pipeline import compile_graph
+from rgraph.compiler.pipeline import compile_graph
 from rgraph.vk.executor import FRAME_CALLS, Executor, marks_per_frame
 from rgraph.vk.memreq import live_requirements
 

@@ -51,7 +51,7 @@ def _open_worker() -> None:
 
 def run_case(entry: tuple[int, int, str]) -> dict[str, Any]:
     """Compile and run one graph; its messages, data check and any exception."""
-    from rgraph.compile.pipeline import compile_spec, frontend
+    from rgraph.compiler.pipeline import compile_spec, frontend
     from rgraph.random_graph import random_graph, to_yaml
     from rgraph.vk.executor import execute_plan
 

@@ -51,7 +51,7 @@ def instances(quick: bool) -> list[tuple[str, str, list[Block]]]:
 
 def graph_instances(size: tuple[int, int] = (1920, 1080)) -> list[tuple[str, list[Block]]]:
     """The transient resources of each bundled graph (default scene) at ``size``, as blocks."""
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
     from rgraph.resources import bundled_graphs
 
     out = []
@@ -68,7 +68,7 @@ def graph_instances(size: tuple[int, int] = (1920, 1080)) -> list[tuple[str, lis
 
 def print_graph_savings(size: tuple[int, int] = (1920, 1080)) -> None:
     """Whole-plan memory of each bundled graph per policy: peak, bound and saving vs unaliased."""
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
     from rgraph.resources import bundled_graphs
 
     for name in bundled_graphs():

@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 from functools import lru_cache
 from typing import Any
 
-from rgraph.compile.sync import Barrier, State, SyncResult
+from rgraph.compiler.sync import Barrier, State, SyncResult
 from rgraph.ir.cull import Culling
 from rgraph.memory.model import Placement
 from rgraph.spec.specialize import PassSpec, ResourceSpec, Spec

@@ -6,7 +6,7 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
-from rgraph.compile.pipeline import compile_graph
+from rgraph.compiler.pipeline import compile_graph
 
 
 def compile_text(tmp_path: Path, text: str, *, size=(64, 64), policy="dedicated", scene: str | None = None, **kw) -> dict[str, Any]:

@@ -14,7 +14,7 @@ def run_graph(graph: str, size: tuple[int, int], inputs: dict[str, np.ndarray],
               params: dict[str, Any] | None = None) -> dict[str, np.ndarray]:
     """Compile ``pass_graphs/<graph>.yaml`` at ``size`` (w, h), run one frame under validation,
     assert no validation messages, and return the decoded outputs (float32 (h, w, c))."""
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
     from rgraph.vk.executor import execute_plan
 
     plan = compile_graph(GRAPHS / f"{graph}.yaml", size=size,

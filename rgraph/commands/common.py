@@ -47,7 +47,7 @@ def add_sync_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def compile_from_args(args: argparse.Namespace) -> dict:
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
 
     return compile_graph(
         args.graph,

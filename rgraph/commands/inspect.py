@@ -55,7 +55,7 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
                 COMMAND_LINE, f"{', '.join(compile_flags)} only apply when compiling a graph, not to a plan file"
             )
         return load_plan(target)
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
 
     options: dict[str, Any] = {"params": parse_params(args.params), "policy": args.policy}
     if args.size:

@@ -43,7 +43,7 @@ def _choices(text: str, allowed: tuple[str, ...], option: str) -> list[str]:
 
 
 def _compile(args: argparse.Namespace, need_device: bool) -> dict:
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
 
     kwargs = dict(scene_path=args.scene, params=parse_params(args.param), size=parse_size(args.size),
                   policy=args.policy)

@@ -36,7 +36,7 @@ def _load_plan(args: argparse.Namespace) -> dict:
         if plan.get("format") != "rgraph-plan/1":
             raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
         if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
-            from rgraph.compile.pipeline import apply_sync_mode
+            from rgraph.compiler.pipeline import apply_sync_mode
 
             plan = apply_sync_mode(plan, "naive")
         return plan

@@ -14,7 +14,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.compile.pipeline import frontend
+    from rgraph.compiler.pipeline import frontend
     from rgraph.ir.cull import cull
 
     front = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size))

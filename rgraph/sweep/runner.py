@@ -180,7 +180,7 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
 
 def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, dict]:
     """Plans by params key, compiled with the live device's memory requirements."""
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
     from rgraph.vk.memreq import live_requirements
 
     source = load_graph(resolve_graph(request.graph))

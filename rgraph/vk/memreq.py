@@ -86,7 +86,7 @@ def compile_for_device(graph: Any, device_index: int | None = None, **options: A
     """``compile_graph(graph, **options)`` with sizes and alignments from the live device that
     ``execute_plan(..., device_index=device_index)`` will use (a plan compiled for another
     device's profile is refused by the runtime's requirements cross-check)."""
-    from rgraph.compile.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph
 
     with live_requirements(device_index) as (memory, _device):
         return compile_graph(graph, memory=memory, **options)

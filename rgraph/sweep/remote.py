@@ -1,0 +1,115 @@
+"""One sweep setting rendered in a worker process (``--workers``, ``--ray``).
+
+The parent sends a :class:`RenderJob` per distinct setting; the worker compiles the setting
+with its own device's memory requirements and renders it exactly as the one-process sweep
+does (``runner._compile_all``, ``runner._render``),
+then hands the rendering (plan, times, messages, images) back.
+
+A worker is a fresh interpreter: the job carries the parent's ``sys.path`` and the modules
+that registered pass implementations there (a user's passes, a test fixture), and imports
+them first.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import signal
+import sys
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rgraph.sweep.settings import Setting
+
+#: Test-only fault injection, read by the parent (never from a graph file): ``LABEL=MARKER``
+#: SIGKILLs the worker of setting LABEL once (it creates MARKER first; a retry finds it);
+#: ``LABEL`` alone kills every attempt.
+KILL_ENV = "RGRAPH_TEST_KILL_ONCE"
+
+
+@dataclass(frozen=True)
+class RenderJob:
+    request: Any  # rgraph.sweep.runner.SweepRequest
+    setting: Setting
+    sys_path: tuple[str, ...]
+    modules: tuple[str, ...]
+    fault: str | None = None
+
+
+def implementation_modules() -> tuple[str, ...]:
+    """Modules outside rgraph that registered pass implementations in this process."""
+    from rgraph import impl
+
+    names = {cls.__module__ for cls in impl._REGISTRY.values()}
+    return tuple(sorted(n for n in names if not n.startswith(("rgraph.", "__main__")) and n != "__mp_main__"))
+
+
+def jobs(request: Any, settings: Mapping[Any, Setting], env: Mapping[str, str] | None = None
+         ) -> Iterator[tuple[Any, RenderJob]]:
+    """(params key, job) per distinct setting, in the given order (the reference first)."""
+    env = os.environ if env is None else env
+    fault = env.get(KILL_ENV) or None
+    sys_path = tuple(p for p in sys.path if p)
+    modules = implementation_modules()
+    for key, setting in settings.items():
+        yield key, RenderJob(request, setting, sys_path, modules, fault)
+
+
+def _prepare(job: RenderJob) -> None:
+    for entry in reversed(job.sys_path):
+        if entry not in sys.path and Path(entry).exists():
+            sys.path.insert(0, entry)
+    for module in job.modules:
+        importlib.import_module(module)
+
+
+def _inject_fault(job: RenderJob) -> None:
+    if not job.fault:
+        return
+    label, sep, marker = job.fault.partition("=")
+    if label != job.setting.label:
+        return
+    if sep:
+        if Path(marker).exists():
+            return
+        Path(marker).write_text(f"killed {label} once (pid {os.getpid()})\n")
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def _device_index(request: Any) -> int | None:
+    """``--device`` when given; in a Ray GPU task, the Vulkan GPU of Ray's GPU id."""
+    from rgraph.sweep.parallel import assigned_gpu
+
+    if request.device is not None:
+        return request.device
+    gpu = assigned_gpu()
+    if gpu is None:
+        return None
+    from rgraph.vk.device import list_physical_devices
+    from rgraph.vk.instance import create_instance
+
+    instance = create_instance(validate=False)
+    try:
+        gpus = [d.index for d in list_physical_devices(instance) if d.device_type in ("discrete", "integrated")]
+    finally:
+        instance.destroy()
+    return gpus[gpu] if gpu < len(gpus) else None
+
+
+def render_job(job: RenderJob) -> Any:
+    """Compile and render one setting (in a worker process): a runner ``_Rendering``."""
+    import dataclasses
+
+    from rgraph.sweep.runner import _compile_all, _render
+
+    _prepare(job)
+    _inject_fault(job)
+    request = job.request
+    index = _device_index(request)
+    if index != request.device:
+        request = dataclasses.replace(request, device=index)
+    plans = _compile_all(request, [job.setting])
+    (plan,) = plans.values()
+    return _render(request, plan)

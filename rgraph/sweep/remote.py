@@ -23,9 +23,9 @@ from typing import Any
 
 from rgraph.sweep.settings import Setting
 
-#: Test-only fault injection, read by the parent (never from a graph file): ``LABEL=MARKER``
-#: SIGKILLs the worker of setting LABEL once (it creates MARKER first; a retry finds it);
-#: ``LABEL`` alone kills every attempt.
+#: Test-only fault injection, read by the parent (never from a graph file): ``LABEL@MARKER``
+#: SIGKILLs the worker of setting LABEL once (it creates the file MARKER first; the retry finds
+#: it); ``LABEL`` alone kills every attempt.
 KILL_ENV = "RGRAPH_TEST_KILL_ONCE"
 
 
@@ -68,7 +68,7 @@ def _prepare(job: RenderJob) -> None:
 def _inject_fault(job: RenderJob) -> None:
     if not job.fault:
         return
-    label, sep, marker = job.fault.partition("=")
+    label, sep, marker = job.fault.partition("@")
     if label != job.setting.label:
         return
     if sep:

@@ -1,0 +1,106 @@
+"""``rgraph sweep --workers N`` on lavapipe under validation: the same outputs as the
+one-process sweep except measured times; a killed worker is retried; one killed twice is
+reported for its setting while the others finish; Ray is never imported."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+
+import pytest
+import sweep_fixtures.passes as zoneplate  # registers the fixture's pass implementations
+from locations import ROOT, TESTS
+from sweep_same import assert_same_sweep, timeless_csv, timeless_md
+
+from rgraph.cli import main
+from rgraph.sweep.remote import KILL_ENV
+
+pytestmark = pytest.mark.vulkan
+
+ARGS = [str(zoneplate.GRAPH), "--size", "48x48", "--frames", "2", "--knob", "aa.samples=1,4",
+        "--reference", "aa.samples=8", "--hdr", "hdr", "--validate", "--no-progress"]
+
+
+def sweep(argv):
+    from rgraph.vk.errors import VulkanUnavailable
+
+    try:
+        return main(["sweep", *argv])
+    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
+        pytest.skip(str(exc))
+
+
+@pytest.fixture(scope="module")
+def one_process(tmp_path_factory):
+    out = tmp_path_factory.mktemp("one") / "sweep"
+    assert sweep([*ARGS, "-o", str(out)]) == 0
+    return out
+
+
+def rows(out):
+    with (out / "sweep.csv").open() as f:
+        return {r["setting"]: r for r in csv.DictReader(f)}
+
+
+def test_same_sweep_masks_times_only(one_process):
+    table = timeless_csv(one_process / "sweep.csv")
+    assert table and not any(k.startswith("ms.") or k == "total_ms" for k in table[0])
+    assert {"psnr", "ssim", "hdr_rel_mse", "messages", "image"} <= set(table[0])
+    md = (one_process / "sweep.md").read_text()
+    masked = timeless_md(md)
+    total = rows(one_process)["aa.samples=4"]["total_ms"]
+    assert total in md and total not in masked  # the measured time is masked...
+    psnr = rows(one_process)["aa.samples=4"]["psnr"]
+    assert psnr in masked  # ...the error is not
+
+
+def test_workers_give_the_one_process_sweep(one_process, tmp_path, capsys):
+    out = tmp_path / "w"
+    assert sweep([*ARGS, "--workers", "2", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "in 2 local worker processes" in err and "0 validation message(s)" in err
+    assert_same_sweep(one_process, out)
+    assert (out / "errors" / "aa.samples=1_absdiff.png").is_file()
+
+
+def test_killed_worker_is_retried(one_process, tmp_path, monkeypatch, capsys):
+    marker = tmp_path / "killed-once"
+    monkeypatch.setenv(KILL_ENV, f"aa.samples=1@{marker}")
+    out = tmp_path / "w"
+    assert sweep([*ARGS, "--workers", "2", "-o", str(out)]) == 0, capsys.readouterr().err
+    assert marker.is_file()  # its first worker really died
+    assert_same_sweep(one_process, out)
+
+
+def test_worker_killed_twice_is_reported_for_its_setting(one_process, tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv(KILL_ENV, "aa.samples=4")
+    out = tmp_path / "w"
+    assert sweep([*ARGS, "--workers", "3", "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert ("setting aa.samples=4 failed: attempt 1: worker process killed by signal 9; "
+            "attempt 2: worker process killed by signal 9") in err
+    got, want = rows(out), rows(one_process)
+    assert list(got) == list(want)
+    assert got["aa.samples=4"]["total_ms"] == got["aa.samples=4"]["psnr"] == got["aa.samples=4"]["image"] == ""
+    for label in ("reference", "default", "aa.samples=1"):  # the others finished
+        assert got[label]["psnr"] == want[label]["psnr"] and got[label]["image"] == want[label]["image"]
+    assert "aa.samples=4: not rendered: attempt 1:" in (out / "sweep.md").read_text()
+
+
+def test_no_ray_without_ray(tmp_path):
+    """A plain sweep and a --workers one import no Ray (Ray is installed here)."""
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); import sweep_fixtures.passes; "
+            "from rgraph.cli import main; rc = main(sys.argv[2:]); "
+            "assert 'ray' not in sys.modules, 'ray imported'; sys.exit(rc)")
+    for extra in ([], ["--workers", "1"]):
+        argv = ["sweep", *ARGS[:-1], "--knob", "zone.intensity=2", *extra, "--no-progress",
+                "-o", str(tmp_path / f"o{len(extra)}")]
+        done = subprocess.run([sys.executable, "-c", code, str(TESTS), *argv], cwd=ROOT, capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+
+
+def test_bad_worker_count_is_a_located_error(tmp_path, capsys):
+    assert sweep([*ARGS, "--workers", "0", "-o", str(tmp_path / "x")]) == 2
+    assert "<command line>:1:1: error: --workers must be at least 1, got 0" in capsys.readouterr().err

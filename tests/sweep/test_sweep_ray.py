@@ -1,0 +1,64 @@
+"""``rgraph sweep --ray`` on a local Ray cluster (``ray.init(num_cpus=2)``, one for the
+module) on lavapipe under validation: the same outputs as the one-process sweep except
+measured times; a task whose worker is SIGKILLed once is retried."""
+
+from __future__ import annotations
+
+import pytest
+import sweep_fixtures.passes as zoneplate  # registers the fixture's pass implementations
+from sweep_same import assert_same_sweep
+
+from rgraph.cli import main
+from rgraph.sweep.remote import KILL_ENV
+
+ray = pytest.importorskip("ray")
+pytestmark = pytest.mark.vulkan
+
+ARGS = [str(zoneplate.GRAPH), "--size", "48x48", "--frames", "2", "--knob", "aa.samples=1,2",
+        "--reference", "aa.samples=8", "--hdr", "hdr", "--validate", "--no-progress"]
+
+
+def sweep(argv):
+    from rgraph.vk.errors import VulkanUnavailable
+
+    try:
+        return main(["sweep", *argv])
+    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
+        pytest.skip(str(exc))
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        yield
+    finally:
+        ray.shutdown()
+
+
+@pytest.fixture(scope="module")
+def one_process(tmp_path_factory):
+    out = tmp_path_factory.mktemp("one") / "sweep"
+    assert sweep([*ARGS, "-o", str(out)]) == 0
+    return out
+
+
+def test_ray_sweep_gives_the_one_process_sweep(cluster, one_process, tmp_path, monkeypatch, capsys):
+    """The reference's task is SIGKILLed once: retried, and the outputs are still the same."""
+    marker = tmp_path / "killed-once"
+    monkeypatch.setenv(KILL_ENV, f"reference@{marker}")
+    out = tmp_path / "ray"
+    assert sweep([*ARGS, "--ray", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "in Ray (local), one task per worker process, num_cpus=1" in err
+    assert "0 validation message(s)" in err
+    assert marker.is_file()  # the first attempt's worker really died
+    assert_same_sweep(one_process, out)
+    assert ray.is_initialized()  # a cluster the caller started is left running
+
+
+def test_ray_task_killed_twice_is_reported(cluster, tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv(KILL_ENV, "aa.samples=1")
+    assert sweep([*ARGS, "--ray", "-o", str(tmp_path / "ray")]) == 1
+    err = capsys.readouterr().err
+    assert "setting aa.samples=1 failed: attempt 1: Ray task lost: " in err and "attempt 2: Ray task lost" in err

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from rgraph.sweep import images as image_io
+from rgraph.sweep.affected import changed_passes
 from rgraph.sweep.compare import METRICS, Images, compare
 from rgraph.sweep.runner import Row, SweepRequest, SweepResult, _Rendering, extreme_labels
 from rgraph.sweep.settings import Setting, params_key
@@ -125,9 +126,15 @@ class Collector:
         position = {p["name"]: i for i, p in enumerate(first.plan["passes"])}
         pass_names.sort(key=lambda n: position.get(n, len(position)))
         outputs = image_io.output_image_resources(first.plan)
-        return SweepResult(
+        result = SweepResult(
             request=self.request, graph_name=first.plan["graph"], scene=first.plan.get("scene"),
             device=first.device, defaults=self.params["default"], rows=rows, pass_names=pass_names, notes=notes,
             error_maps={s.label: self.error_maps[s.label] for s in self.settings if s.label in self.error_maps},
             output_name=outputs[0]["name"] if outputs else None, reference_params=self.params["reference"],
             failures=failures, plans={k: self.renderings[k].plan for k in self.order if k in self.renderings})
+        for knob in self.request.knobs:
+            done = [self.renderings[k] for k in dict.fromkeys(params_key(r.params) for r in result.rows_for_knob(knob.name))
+                    if k in self.renderings]
+            result.knob_passes[knob.name] = changed_passes(knob.name, [r.plan for r in done],
+                                                           [r.params_read for r in done])
+        return result

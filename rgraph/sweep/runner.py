@@ -68,6 +68,7 @@ class SweepResult:
     reference_params: dict[str, Any] = field(default_factory=dict)
     failures: dict[str, str] = field(default_factory=dict)  # setting label -> why it was not rendered
     plans: dict[tuple, dict] = field(default_factory=dict)  # params key -> compiled plan
+    knob_passes: dict[str, list[str]] = field(default_factory=dict)  # knob -> passes it changes (affected.py)
 
     @property
     def renderings(self) -> int:
@@ -103,6 +104,7 @@ class _Rendering:
     device: str
     images: Images
     notes: list[str] = field(default_factory=list)
+    params_read: dict[str, list[str]] = field(default_factory=dict)  # pass -> params its impl looked up
 
 
 def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: bool) -> list[str]:
@@ -188,7 +190,7 @@ def _render(request: SweepRequest, plan: dict) -> _Rendering:
     timings = result.timings or {}
     pass_ms = {p["name"]: timings.get("passes", {}).get(p["name"]) for p in plan["passes"]}
     return _Rendering(plan, pass_ms, timings.get("total_ms"), [str(m) for m in result.messages],
-                      result.device_name, Images(ldr, hdr), notes)
+                      result.device_name, Images(ldr, hdr), notes, result.params_read)
 
 
 class _progress_bar:

@@ -5,16 +5,17 @@ reported for its setting while the others finish; Ray is never imported."""
 from __future__ import annotations
 
 import csv
+import shutil
 import subprocess
 import sys
 
 import pytest
 import sweep_fixtures.passes as zoneplate  # registers the fixture's pass implementations
 from locations import ROOT, TESTS
-from sweep_same import assert_same_sweep, timeless_csv, timeless_md
 
 from rgraph.cli import main
 from rgraph.sweep.remote import KILL_ENV
+from rgraph.sweep.same import differences, timeless_csv, timeless_md
 
 pytestmark = pytest.mark.vulkan
 
@@ -55,12 +56,27 @@ def test_same_sweep_masks_times_only(one_process):
     assert psnr in masked  # ...the error is not
 
 
+def test_differences_sees_all_but_times(one_process, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(one_process, copy)
+    assert differences(one_process, copy) == []
+    text = (copy / "sweep.csv").read_text()
+    total = rows(one_process)["aa.samples=1"]["total_ms"]
+    (copy / "sweep.csv").write_text(text.replace(total, "12345.6"))
+    (copy / "sweep.md").write_text((copy / "sweep.md").read_text().replace(total, "12345.6"))
+    assert differences(one_process, copy) == []  # a time changed
+    (copy / "sweep.csv").write_text(text.replace(rows(one_process)["aa.samples=1"]["ssim"], "0.5"))
+    (copy / "images" / "default.png").write_bytes(b"x")
+    (copy / "pareto_aa.samples.png").write_bytes(b"x")  # time-placed: only its presence counts
+    assert differences(one_process, copy) == ["sweep.csv", "images/default.png"]
+
+
 def test_workers_give_the_one_process_sweep(one_process, tmp_path, capsys):
     out = tmp_path / "w"
     assert sweep([*ARGS, "--workers", "2", "-o", str(out)]) == 0
     err = capsys.readouterr().err
     assert "in 2 local worker processes" in err and "0 validation message(s)" in err
-    assert_same_sweep(one_process, out)
+    assert differences(one_process, out) == []
     assert (out / "errors" / "aa.samples=1_absdiff.png").is_file()
 
 
@@ -70,7 +86,7 @@ def test_killed_worker_is_retried(one_process, tmp_path, monkeypatch, capsys):
     out = tmp_path / "w"
     assert sweep([*ARGS, "--workers", "2", "-o", str(out)]) == 0, capsys.readouterr().err
     assert marker.is_file()  # its first worker really died
-    assert_same_sweep(one_process, out)
+    assert differences(one_process, out) == []
 
 
 def test_worker_killed_twice_is_reported_for_its_setting(one_process, tmp_path, monkeypatch, capsys):

@@ -1,8 +1,10 @@
-"""What "the same sweep" means for a parallel sweep and the one-process one: every output
-file but the Pareto plots byte-identical after measured times are masked (CSV columns
-``ms.*``/``*_ms``, Markdown table columns headed with ``ms``, the per-pass time table), and
-the same files written (the Pareto plots place points by time, so only their presence is
-compared)."""
+"""Whether two sweep output folders are the same sweep: every output but the measured times.
+
+CSV columns ``ms.*``/``*_ms``, Markdown table columns headed with ``ms`` and the per-pass
+time table are masked; images and error maps must be byte-identical; the Pareto plots place
+points by time, so only their presence is compared. A sweep in worker processes
+(``--workers``, ``--ray``) gives the same sweep as the one-process one (tests/sweep); on a GPU
+``benchmarks/sweep_throughput.py`` checks it too."""
 
 from __future__ import annotations
 
@@ -51,10 +53,24 @@ def files(out: Path) -> dict[str, bytes | None]:
             for p in sorted(out.rglob("*")) if p.is_file() and p.suffix == ".png"}
 
 
-def assert_same_sweep(one: Path, other: Path) -> None:
-    assert timeless_csv(one / "sweep.csv") == timeless_csv(other / "sweep.csv")
-    assert timeless_md((one / "sweep.md").read_text()) == timeless_md((other / "sweep.md").read_text())
+def differences(one: Path, other: Path) -> list[str]:
+    """What differs between two sweeps' outputs besides measured times (empty: the same)."""
+    out = []
+    if timeless_csv(one / "sweep.csv") != timeless_csv(other / "sweep.csv"):
+        out.append("sweep.csv")
+    if timeless_md((one / "sweep.md").read_text()) != timeless_md((other / "sweep.md").read_text()):
+        out.append("sweep.md")
     a, b = files(one), files(other)
-    assert sorted(a) == sorted(b)
-    different = [name for name in a if a[name] != b[name]]
-    assert not different, f"differ: {different}"
+    out += [f"{name} (only in one)" for name in sorted(set(a) ^ set(b))]
+    out += [name for name in sorted(set(a) & set(b)) if a[name] != b[name]]
+    return out
+
+
+def relative_time_changes(one: Path, other: Path) -> list[float]:
+    """|t_other - t_one| / t_one of every setting's frame GPU time present in both."""
+    def times(path: Path) -> dict[str, float]:
+        with (path / "sweep.csv").open() as f:
+            return {r["setting"]: float(r["total_ms"]) for r in csv.DictReader(f) if r["total_ms"]}
+
+    a, b = times(one), times(other)
+    return [abs(b[k] - a[k]) / a[k] for k in a if k in b and a[k] > 0]

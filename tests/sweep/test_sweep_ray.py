@@ -5,26 +5,15 @@ measured times; a task whose worker is SIGKILLed once is retried."""
 from __future__ import annotations
 
 import pytest
-import sweep_fixtures.passes as zoneplate  # registers the fixture's pass implementations
+import sweep_helpers
+from sweep_helpers import ARGS, sweep
 
-from rgraph.cli import main
 from rgraph.sweep.remote import KILL_ENV
 from rgraph.sweep.same import differences
 
 ray = pytest.importorskip("ray")
 pytestmark = pytest.mark.vulkan
-
-ARGS = [str(zoneplate.GRAPH), "--size", "48x48", "--frames", "2", "--knob", "aa.samples=1,2",
-        "--reference", "aa.samples=8", "--hdr", "hdr", "--validate", "--no-progress"]
-
-
-def sweep(argv):
-    from rgraph.vk.errors import VulkanUnavailable
-
-    try:
-        return main(["sweep", *argv])
-    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
-        pytest.skip(str(exc))
+one_process = sweep_helpers.one_process  # the module-scoped one-process sweep (a fixture)
 
 
 @pytest.fixture(scope="module")
@@ -34,13 +23,6 @@ def cluster():
         yield
     finally:
         ray.shutdown()
-
-
-@pytest.fixture(scope="module")
-def one_process(tmp_path_factory):
-    out = tmp_path_factory.mktemp("one") / "sweep"
-    assert sweep([*ARGS, "-o", str(out)]) == 0
-    return out
 
 
 def test_ray_sweep_gives_the_one_process_sweep(cluster, one_process, tmp_path, monkeypatch, capsys):

@@ -4,44 +4,20 @@ reported for its setting while the others finish; Ray is never imported."""
 
 from __future__ import annotations
 
-import csv
 import shutil
 import subprocess
 import sys
 
 import pytest
-import sweep_fixtures.passes as zoneplate  # registers the fixture's pass implementations
+import sweep_helpers
 from locations import ROOT, TESTS
+from sweep_helpers import ARGS, rows, sweep
 
-from rgraph.cli import main
 from rgraph.sweep.remote import KILL_ENV
 from rgraph.sweep.same import differences, timeless_csv, timeless_md
 
 pytestmark = pytest.mark.vulkan
-
-ARGS = [str(zoneplate.GRAPH), "--size", "48x48", "--frames", "2", "--knob", "aa.samples=1,2",
-        "--reference", "aa.samples=8", "--hdr", "hdr", "--validate", "--no-progress"]
-
-
-def sweep(argv):
-    from rgraph.vk.errors import VulkanUnavailable
-
-    try:
-        return main(["sweep", *argv])
-    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
-        pytest.skip(str(exc))
-
-
-@pytest.fixture(scope="module")
-def one_process(tmp_path_factory):
-    out = tmp_path_factory.mktemp("one") / "sweep"
-    assert sweep([*ARGS, "-o", str(out)]) == 0
-    return out
-
-
-def rows(out):
-    with (out / "sweep.csv").open() as f:
-        return {r["setting"]: r for r in csv.DictReader(f)}
+one_process = sweep_helpers.one_process  # the module-scoped one-process sweep (a fixture)
 
 
 def test_same_sweep_masks_times_only(one_process):
@@ -111,7 +87,7 @@ def test_no_ray_without_ray(tmp_path):
             "assert main(argv) == 0; assert 'ray' not in sys.modules, 'ray imported by a plain sweep'; "
             "assert main([*argv[:-1], argv[-1] + 'w', '--workers', '1']) == 0; "
             "assert 'ray' not in sys.modules, 'ray imported by --workers'")
-    argv = ["sweep", str(zoneplate.GRAPH), "--size", "16x16", "--frames", "1", "--knob", "aa.samples=1",
+    argv = ["sweep", ARGS[0], "--size", "16x16", "--frames", "1", "--knob", "aa.samples=1",
             "--no-progress", "-o", str(tmp_path / "o")]
     done = subprocess.run([sys.executable, "-c", code, str(TESTS), *argv], cwd=ROOT, capture_output=True,
                           text=True, timeout=300)

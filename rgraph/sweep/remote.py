@@ -12,11 +12,12 @@ them first.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import os
 import signal
 import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -51,10 +52,16 @@ def jobs(request: Any, settings: Mapping[Any, Setting], env: Mapping[str, str] |
     """(params key, job) per distinct setting, in the given order (the reference first)."""
     env = os.environ if env is None else env
     fault = env.get(KILL_ENV) or None
+    request = dataclasses.replace(request, graph=_absolute(request.graph), scene=_absolute(request.scene))
     sys_path = tuple(p for p in sys.path if p)
     modules = implementation_modules()
     for key, setting in settings.items():
         yield key, RenderJob(request, setting, sys_path, modules, fault)
+
+
+def _absolute(path: str | None) -> str | None:
+    """A file path made absolute (a worker may start elsewhere); names (``surgery``) as given."""
+    return str(Path(path).resolve()) if path and Path(path).is_file() else path
 
 
 def _prepare(job: RenderJob) -> None:
@@ -78,6 +85,12 @@ def _inject_fault(job: RenderJob) -> None:
     os.kill(os.getpid(), signal.SIGKILL)
 
 
+def gpu_device_index(devices: Sequence[Any], gpu: int) -> int | None:
+    """The Vulkan index of the ``gpu``-th GPU (discrete or integrated, in Vulkan's order)."""
+    gpus = [d.index for d in devices if d.device_type in ("discrete", "integrated")]
+    return gpus[gpu] if 0 <= gpu < len(gpus) else None
+
+
 def _device_index(request: Any) -> int | None:
     """``--device`` when given; in a Ray GPU task, the Vulkan GPU of Ray's GPU id."""
     from rgraph.sweep.parallel import assigned_gpu
@@ -92,16 +105,13 @@ def _device_index(request: Any) -> int | None:
 
     instance = create_instance(validate=False)
     try:
-        gpus = [d.index for d in list_physical_devices(instance) if d.device_type in ("discrete", "integrated")]
+        return gpu_device_index(list_physical_devices(instance), gpu)
     finally:
         instance.destroy()
-    return gpus[gpu] if gpu < len(gpus) else None
 
 
 def render_job(job: RenderJob) -> Any:
     """Compile and render one setting (in a worker process): a runner ``_Rendering``."""
-    import dataclasses
-
     from rgraph.sweep.runner import _compile_all, _render
 
     _prepare(job)

@@ -80,3 +80,13 @@ def test_process_backend_one_process_per_task_and_lost_workers():
 
 def _pid(_arg):
     return os.getpid()
+
+
+def test_a_ray_gpu_is_the_vulkan_gpu_of_that_ordinal():
+    from rgraph.sweep.remote import gpu_device_index
+    from rgraph.vk.device import PhysicalDeviceInfo
+
+    devices = [PhysicalDeviceInfo(0, None, "llvmpipe", "cpu", (1, 4, 0)),
+               PhysicalDeviceInfo(1, None, "H200 a", "discrete", (1, 4, 0)),
+               PhysicalDeviceInfo(2, None, "H200 b", "discrete", (1, 4, 0))]
+    assert [gpu_device_index(devices, g) for g in (0, 1, 2)] == [1, 2, None]

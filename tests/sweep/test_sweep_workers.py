@@ -98,3 +98,9 @@ def test_no_ray_without_ray(tmp_path):
 def test_bad_worker_count_is_a_located_error(tmp_path, capsys):
     assert sweep([*ARGS, "--workers", "0", "-o", str(tmp_path / "x")]) == 2
     assert "<command line>:1:1: error: --workers must be at least 1, got 0" in capsys.readouterr().err
+
+
+def test_ray_missing_is_one_line(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "ray", None)  # as if Ray were not installed
+    assert sweep([*ARGS, "--ray", "-o", str(tmp_path / "x")]) == 2
+    assert "rgraph: error: --ray needs Ray: pip install 'rgraph[ray]'" in capsys.readouterr().err

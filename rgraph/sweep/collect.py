@@ -19,6 +19,8 @@ from rgraph.sweep.settings import Setting, params_key
 
 
 class Collector:
+    """Takes renderings (or failures) by params key as they come; :meth:`result` at the end."""
+
     def __init__(self, request: SweepRequest, settings: list[Setting], resolved_params: dict[str, dict],
                  out_dir: Path) -> None:
         self.request, self.settings, self.params, self.out_dir = request, settings, resolved_params, out_dir

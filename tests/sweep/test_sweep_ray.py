@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 import sweep_helpers
-from sweep_helpers import ARGS, sweep
+from sweep_helpers import ARGS, rows, sweep
 
 from rgraph.sweep.remote import KILL_ENV
 from rgraph.sweep.same import differences
@@ -25,8 +25,12 @@ def cluster():
         ray.shutdown()
 
 
-def test_ray_sweep_gives_the_one_process_sweep(cluster, one_process, tmp_path, monkeypatch, capsys):
-    """The reference's task is SIGKILLed once: retried, and the outputs are still the same."""
+def test_ray_sweep(cluster, one_process, tmp_path, monkeypatch, capsys):
+    """One test, so that one cluster starts even when xdist spreads a module's tests.
+
+    The reference's task is SIGKILLed once: it is retried and the outputs are the
+    one-process sweep's but its times. Then a setting's task is killed on both attempts: it
+    is reported and the others render."""
     marker = tmp_path / "killed-once"
     monkeypatch.setenv(KILL_ENV, f"reference@{marker}")
     out = tmp_path / "ray"
@@ -38,9 +42,8 @@ def test_ray_sweep_gives_the_one_process_sweep(cluster, one_process, tmp_path, m
     assert differences(one_process, out) == []
     assert ray.is_initialized()  # a cluster the caller started is left running
 
-
-def test_ray_task_killed_twice_is_reported(cluster, tmp_path, monkeypatch, capsys):
     monkeypatch.setenv(KILL_ENV, "aa.samples=1")
-    assert sweep([*ARGS, "--ray", "-o", str(tmp_path / "ray")]) == 1
+    assert sweep([*ARGS, "--ray", "-o", str(tmp_path / "twice")]) == 1
     err = capsys.readouterr().err
     assert "setting aa.samples=1 failed: attempt 1: Ray task lost: " in err and "attempt 2: Ray task lost" in err
+    assert rows(tmp_path / "twice")["reference"]["image"] == "images/reference.png"

@@ -6,14 +6,15 @@ does (``runner._compile_all``, ``runner._render``),
 then hands the rendering (plan, times, messages, images) back.
 
 A worker is a fresh interpreter: the job carries the parent's ``sys.path`` and the modules
-that registered pass implementations there (a user's passes, a test fixture), and imports
-them first.
+that registered the graph's pass implementations there (a user's passes, a test fixture),
+by name and file, and imports them first.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import importlib
+import importlib.util
 import os
 import signal
 import sys
@@ -35,16 +36,30 @@ class RenderJob:
     request: Any  # rgraph.sweep.runner.SweepRequest
     setting: Setting
     sys_path: tuple[str, ...]
-    modules: tuple[str, ...]
+    modules: tuple[tuple[str, str | None], ...]  # (name, file) of modules registering the graph's impls
     fault: str | None = None
 
 
-def implementation_modules() -> tuple[str, ...]:
-    """Modules outside rgraph that registered pass implementations in this process."""
+def implementation_modules(impls: set[str]) -> tuple[tuple[str, str | None], ...]:
+    """(module, file) of the implementations ``impls`` registered in this process outside
+    rgraph (whose own passes every process loads)."""
     from rgraph import impl
 
-    names = {cls.__module__ for cls in impl._REGISTRY.values()}
-    return tuple(sorted(n for n in names if not n.startswith(("rgraph.", "__main__")) and n != "__mp_main__"))
+    modules = {impl._REGISTRY[name].__module__ for name in impls if name in impl._REGISTRY}
+    out = []
+    for name in sorted(modules):
+        if name.startswith("rgraph.") or name in ("__main__", "__mp_main__"):
+            continue
+        out.append((name, getattr(sys.modules.get(name), "__file__", None)))
+    return tuple(out)
+
+
+def _graph_impls(request: Any) -> set[str]:
+    from rgraph.resources import resolve_graph
+    from rgraph.spec.loader import load_graph
+
+    source = load_graph(resolve_graph(request.graph))
+    return {p.model.impl for p in source.passes.values() if getattr(p.model, "impl", None)}
 
 
 def jobs(request: Any, settings: Mapping[Any, Setting], env: Mapping[str, str] | None = None
@@ -54,7 +69,7 @@ def jobs(request: Any, settings: Mapping[Any, Setting], env: Mapping[str, str] |
     fault = env.get(KILL_ENV) or None
     request = dataclasses.replace(request, graph=_absolute(request.graph), scene=_absolute(request.scene))
     sys_path = tuple(p for p in sys.path if p)
-    modules = implementation_modules()
+    modules = implementation_modules(_graph_impls(request))
     for key, setting in settings.items():
         yield key, RenderJob(request, setting, sys_path, modules, fault)
 
@@ -68,8 +83,18 @@ def _prepare(job: RenderJob) -> None:
     for entry in reversed(job.sys_path):
         if entry not in sys.path and Path(entry).exists():
             sys.path.insert(0, entry)
-    for module in job.modules:
-        importlib.import_module(module)
+    for module, file in job.modules:
+        if module in sys.modules:
+            continue
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError:
+            if not file:
+                raise
+            spec = importlib.util.spec_from_file_location(module, file)
+            loaded = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+            sys.modules[module] = loaded
+            spec.loader.exec_module(loaded)  # type: ignore[union-attr]
 
 
 def _inject_fault(job: RenderJob) -> None:

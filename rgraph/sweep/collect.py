@@ -66,7 +66,7 @@ class Collector:
             if self.keys[s.label] == key:
                 self._write_images(s, reference, rendering)
         if key != self.reference_key:
-            rendering.images = Images(None, None)  # compared and written: free the pixels
+            rendering.images, rendering.png = Images(None, None), None  # compared and written: free the pixels
 
     def _write_images(self, s: Setting, reference: _Rendering | None, rendering: _Rendering) -> None:
         from rgraph.sweep import plots  # matplotlib: only when sweeping
@@ -74,7 +74,7 @@ class Collector:
         test = rendering.images.ldr
         if test is None:
             return
-        image_io.save_png(self.out_dir / f"images/{s.slug}.png", test)
+        image_io.save_png(self.out_dir / f"images/{s.slug}.png", rendering.png or test)
         ref = reference.images.ldr if reference is not None else None
         if s.label in self.extremes and ref is not None and ref.shape == test.shape:
             self.error_maps[s.label] = plots.write_error_maps(self.out_dir, s.slug, ref, test)

@@ -105,6 +105,7 @@ class _Rendering:
     images: Images
     notes: list[str] = field(default_factory=list)
     params_read: dict[str, list[str]] = field(default_factory=dict)  # pass -> params its impl looked up
+    png: bytes | None = None  # the display image as PNG (encoded where it rendered: a worker, in parallel)
 
 
 def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: bool) -> list[str]:
@@ -190,7 +191,8 @@ def _render(request: SweepRequest, plan: dict) -> _Rendering:
     timings = result.timings or {}
     pass_ms = {p["name"]: timings.get("passes", {}).get(p["name"]) for p in plan["passes"]}
     return _Rendering(plan, pass_ms, timings.get("total_ms"), [str(m) for m in result.messages],
-                      result.device_name, Images(ldr, hdr), notes, result.params_read)
+                      result.device_name, Images(ldr, hdr), notes, result.params_read,
+                      None if ldr is None else image_io.png_bytes(ldr))
 
 
 class _progress_bar:

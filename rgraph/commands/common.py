@@ -27,11 +27,19 @@ def parse_params(items: list[str] | None) -> dict[str, str]:
     return out
 
 
-def add_graph_arguments(parser: argparse.ArgumentParser, *, size_default: str = "1920x1080") -> None:
+def default_size_text() -> str:
+    """The one default output size of every command (``rgraph.compiler.pipeline.DEFAULT_SIZE``)."""
+    from rgraph.compiler.pipeline import DEFAULT_SIZE
+
+    return f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}"
+
+
+def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("graph", help="graph file, or the name of a bundled graph (rgraph graphs)")
     parser.add_argument("--scene", help="scene file (default: the graph's own 'scene:', else every feature present)")
     parser.add_argument("-p", "--param", action="append", metavar="NAME=VALUE", help="override a graph param")
-    parser.add_argument("--size", default=size_default, help=f"output size WxH (default {size_default})")
+    size = default_size_text()
+    parser.add_argument("--size", default=size, metavar="WxH", help=f"output size (default {size})")
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:

@@ -13,7 +13,7 @@ from rgraph.errors import RGraphError
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
-    add_graph_arguments(parser, size_default="640x360")
+    add_graph_arguments(parser)
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     for entry in plan.get("culled", []):
         print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
     if args.timings:
-        args.timings.write_text(json.dumps({"device": result.device_name, **result.timings}, indent=1,
+        args.timings.write_text(json.dumps({"device": result.device_name, "size": plan.get("size"), **result.timings}, indent=1,
                                            sort_keys=True) + "\n")
     status = 0
     for message in result.messages:

@@ -1,4 +1,4 @@
-"""The ``--timeline`` view: the plan's memory placement drawn as a PNG.
+"""The ``--timeline`` view: the plan's memory placement drawn as PNG, SVG or PDF (by suffix).
 
 Pass index runs across, offset up (a panel per memory class, its heaps stacked in id
 order); one rectangle per placed resource. ``rgraph.memory.timeline.draw_timeline`` can
@@ -211,4 +211,18 @@ def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
     axes[-1].set_xlabel("pass (executed order); hatched: not aliasable (persistent, imported, output)")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(str(path), format="png", metadata={"Software": None})
+    fmt = timeline_format(path)
+    fig.savefig(str(path), format=fmt, metadata={"Software": None} if fmt == "png" else None)
+
+
+TIMELINE_FORMATS = ("png", "svg", "pdf")
+
+
+def timeline_format(path: str | Path) -> str:
+    """The image format named by ``path``'s suffix (png when it has none); ValueError otherwise."""
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if not suffix:
+        return "png"
+    if suffix not in TIMELINE_FORMATS:
+        raise ValueError(f"cannot draw a timeline as .{suffix}: use {', '.join('.' + f for f in TIMELINE_FORMATS)}")
+    return suffix

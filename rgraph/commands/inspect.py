@@ -33,6 +33,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the pass graph as DOT (stdout; OUT.dot/.gv for text, OUT.svg/.pdf/.png rendered by graphviz)",
     )
     parser.add_argument("--html", metavar="OUT", help="write a self-contained HTML report")
+    parser.add_argument("--json", action="store_true",
+                        help="print the summary (and --barriers/--memory) as JSON (docs/cli-json.md)")
     parser.add_argument("--timings", metavar="T.json",
                         help="per-pass GPU times of a run that kept the culled passes (rgraph run --timings): "
                              "shows the milliseconds culling saved")
@@ -136,11 +138,19 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     timings = load_timings(args.timings) if args.timings else None
     if timings is not None:
         check_timings_size(plan, timings, args.timings)
-    if not (args.barriers or args.memory or dot_to_stdout):
+    if args.json:
+        if dot_to_stdout:
+            raise RGraphError.in_file(COMMAND_LINE, "--json and --dot to stdout both print; give --dot a file")
+        from rgraph.commands.jsonout import document, emit
+        from rgraph.report.json_view import inspect_document
+
+        emit(document("inspect", True, **inspect_document(plan, timings, barriers=args.barriers,
+                                                           memory=args.memory)), out)
+    elif not (args.barriers or args.memory or dot_to_stdout):
         text.print_summary(console, plan, timings)
-    if args.barriers:
+    if args.barriers and not args.json:
         text.print_barriers(console, plan)
-    if args.memory:
+    if args.memory and not args.json:
         if args.barriers:
             console.print()
         text.print_memory(console, plan, timings)

@@ -28,8 +28,8 @@ def parse_params(items: list[str] | None) -> dict[str, str]:
 
 
 def default_size_text() -> str:
-    """The one default output size of every command (``rgraph.compiler.pipeline.DEFAULT_SIZE``)."""
-    from rgraph.compiler.pipeline import DEFAULT_SIZE
+    """The one default output size of every command (``rgraph.defaults.DEFAULT_SIZE``)."""
+    from rgraph.defaults import DEFAULT_SIZE
 
     return f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}"
 

@@ -1,6 +1,7 @@
 """``rgraph validate G [--scene S]``: schema and semantic checks, nothing else.
 
-Beyond what compiling checks, ``impl`` names are looked up in the pass registry. Warnings
+Beyond what compiling checks, ``impl`` names are looked up in the pass registry and buffers
+that probe passes use as ``indirect`` must hold the probe's argument header. Warnings
 (e.g. every pass culled) go to stderr as ``FILE:LINE:COL: warning: ...`` and keep exit 0.
 """
 
@@ -40,6 +41,24 @@ def check_impls(source) -> None:
                 f"registered: {', '.join(known)} (omit impl to run the probe)")
 
 
+def check_probe_buffers(source, spec) -> None:
+    """An ``indirect`` buffer that a probe pass (no ``impl``) touches needs the probe's header."""
+    from rgraph.probe.values import HEADER_WORDS, INDIRECT_MIN_BYTES
+
+    passes, resources = spec.passes, spec.resources
+    indirect = {a.resource for p in passes for a in p.accesses if a.usage == "indirect"}
+    for name in sorted(indirect):
+        probe = next((p.name for p in passes if p.impl is None and any(a.resource == name for a in p.accesses)), None)
+        if probe is not None and resources[name].bytes < INDIRECT_MIN_BYTES:
+            raise RGraphError.at(
+                source.resources[name].loc("bytes"),
+                f"buffer '{name}' is used as indirect and pass '{probe}' runs the probe (no impl), which needs "
+                f"at least {INDIRECT_MIN_BYTES} bytes here ({4 * HEADER_WORDS}-byte header of draw, indexed-draw "
+                f"and dispatch arguments + one value word), got {resources[name].bytes}; "
+                "give the pass an impl or the buffer more bytes",
+            )
+
+
 def warnings(front, culling) -> list[tuple[Location, str]]:
     out = []
     if front.spec.passes and not culling.passes:
@@ -55,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
 
     front = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size))
     check_impls(front.source)
+    check_probe_buffers(front.source, front.spec)
     culling = cull(front.spec)
     found = warnings(front, culling)
     if args.json:

@@ -26,7 +26,7 @@ from rgraph.spec.pydantic_errors import did_you_mean
 from rgraph.spec.scene import ALL_PRESENT, Scene, load_scene
 from rgraph.spec.specialize import Spec, resolve_params, specialize
 
-DEFAULT_SIZE = (640, 360)  # the one default of the API and every command
+from rgraph.defaults import DEFAULT_SIZE  # noqa: E402  (re-exported: the one default everywhere)
 DEFAULT_POLICY = "aliased"
 DEFAULT_PROFILE = "lavapipe"
 

@@ -214,7 +214,6 @@ def specialize(
                 removed.append((name, "scene has no " + " and no ".join(missing)))
             passes.append(spec)
     _check_program_order(passes, resources)
-    _check_probe_buffers(source, passes, resources)
     return Spec(
         name=source.name,
         source=str(source.path),
@@ -466,23 +465,6 @@ def _check_program_order(passes: list[PassSpec], resources: dict[str, ResourceSp
         for a in p.accesses:
             if a.write:
                 written.setdefault(a.resource, set()).update(_cells(a))
-
-
-def _check_probe_buffers(source: GraphSource, passes: list[PassSpec], resources: dict[str, ResourceSpec]) -> None:
-    """An ``indirect`` buffer that a probe pass (no ``impl``) touches needs the probe's header."""
-    from rgraph.probe.values import HEADER_WORDS, INDIRECT_MIN_BYTES
-
-    indirect = {a.resource for p in passes for a in p.accesses if a.usage == "indirect"}
-    for name in sorted(indirect):
-        probe = next((p.name for p in passes if p.impl is None and any(a.resource == name for a in p.accesses)), None)
-        if probe is not None and resources[name].bytes < INDIRECT_MIN_BYTES:
-            raise RGraphError.at(
-                source.resources[name].loc("bytes"),
-                f"buffer '{name}' is used as indirect and pass '{probe}' runs the probe (no impl), which needs "
-                f"at least {INDIRECT_MIN_BYTES} bytes here ({4 * HEADER_WORDS}-byte header of draw, indexed-draw "
-                f"and dispatch arguments + one value word), got {resources[name].bytes}; "
-                "give the pass an impl or the buffer more bytes",
-            )
 
 
 def _cells(a: AccessSpec) -> set[tuple[int, int]]:

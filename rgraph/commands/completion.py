@@ -28,6 +28,7 @@ class Command:
     help: str
     options: tuple[Option, ...]
     graph_positional: bool
+    positional_choices: tuple[str, ...] = ()
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -68,8 +69,10 @@ def commands(parser: argparse.ArgumentParser) -> list[Command]:
             continue
         helps = {a.dest: a.help or "" for a in action._choices_actions}
         for name, sub in action.choices.items():
-            graph = any(not a.option_strings and a.dest in ("graph", "target") for a in sub._actions)
-            out.append(Command(name, helps.get(name, ""), _options(sub), graph))
+            positionals = [a for a in sub._actions if not a.option_strings]
+            graph = any(a.dest in ("graph", "target") for a in positionals)
+            choices = tuple(str(c) for a in positionals if a.choices for c in a.choices)
+            out.append(Command(name, helps.get(name, ""), _options(sub), graph, choices))
     return out
 
 
@@ -103,13 +106,13 @@ def _bash(cmds: list[Command]) -> str:
         f'        COMPREPLY=($(compgen -W "{names} --help --version" -- "$cur"))',
         "        return",
         "    fi",
-        '    local opts="" graph=0',
+        '    local opts="" graph=0 words=""',
         '    case "$cmd" in',
     ]
     for c in cmds:
         flags = " ".join(f for o in c.options for f in o.flags)
         lines.append(f"        {c.name})")
-        lines.append(f'            opts="{flags}"; graph={int(c.graph_positional)}')
+        lines.append(f'            opts="{flags}"; graph={int(c.graph_positional)}; words="{" ".join(c.positional_choices)}"')
         valued = [o for o in c.options if o.takes_value]
         if valued:
             lines.append('            case "$prev" in')
@@ -126,6 +129,8 @@ def _bash(cmds: list[Command]) -> str:
         "    esac",
         '    if [[ "$cur" == -* ]]; then',
         '        COMPREPLY=($(compgen -W "$opts" -- "$cur"))',
+        '    elif [[ -n "$words" ]]; then',
+        '        COMPREPLY=($(compgen -W "$words" -- "$cur"))',
         "    elif ((graph)); then",
         f'        COMPREPLY=($(compgen -W "{graphs}" -- "$cur") $(compgen -f -- "$cur"))',
         "    else",
@@ -152,6 +157,8 @@ def _fish(cmds: list[Command]) -> str:
         cond = f"'__fish_seen_subcommand_from {c.name}'"
         if c.graph_positional:
             lines.append(f"complete -c rgraph -n {cond} -F -a {_fish_quote(graphs)}")
+        if c.positional_choices:
+            lines.append(f"complete -c rgraph -n {cond} -a {_fish_quote(' '.join(c.positional_choices))}")
         for o in c.options:
             parts = [f"complete -c rgraph -n {cond}"]
             for flag in o.flags:

@@ -43,12 +43,21 @@ def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, blocks:SIZE, tlsf")
+    parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, optimal, tlsf, blocks:SIZE (docs/memory.md)")
     parser.add_argument("--profile", help="device profile (bundled name or JSON path) for sizes and alignments")
     add_sync_argument(parser)
 
 
+def add_schedule_argument(parser: argparse.ArgumentParser) -> None:
+    from rgraph.ir.schedule import SCHEDULES
+
+    parser.add_argument("--schedule", default="declaration", choices=SCHEDULES,
+                        help="pass order: declaration (default: declaration order minus culled passes) or "
+                             "async-early (compute/transfer-queue passes as early as dependencies allow)")
+
+
 def add_sync_argument(parser: argparse.ArgumentParser) -> None:
+    add_schedule_argument(parser)
     parser.add_argument("--sync", default="normal", choices=("normal", "naive"),
                         help="normal (default): the barrier generator's plan; naive: a full barrier before "
                              "every pass, all passes on the graphics queue, no semaphores (for comparison)")
@@ -65,4 +74,5 @@ def compile_from_args(args: argparse.Namespace) -> dict:
         policy=getattr(args, "policy", None),
         profile=getattr(args, "profile", None),
         sync=getattr(args, "sync", "normal"),
+        schedule=getattr(args, "schedule", "declaration"),
     )

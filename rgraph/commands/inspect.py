@@ -173,6 +173,6 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     if args.html:
         from rgraph.report.html import plan_html
 
-        _write(args.html, plan_html(plan))
+        _write(args.html, plan_html(plan, timings=timings))
         print(f"wrote {args.html}", file=err)
     return 0

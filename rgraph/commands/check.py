@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 from collections import Counter
 
-from rgraph.check import check_file
 from rgraph.commands.jsonout import document, emit
 
 
@@ -26,6 +25,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rgraph.check import check_file
+
     model, hazards = check_file(args.plan)
     barriers = sum(len(p.barriers) for p in model.passes)  # plan stats.barriers, as inspect shows
     releases = sum(len(p.releases) for p in model.passes)

@@ -49,7 +49,7 @@ def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_schedule_argument(parser: argparse.ArgumentParser) -> None:
-    from rgraph.ir.schedule import SCHEDULES
+    from rgraph.defaults import SCHEDULES
 
     parser.add_argument("--schedule", default="declaration", choices=SCHEDULES,
                         help="pass order: declaration (default: declaration order minus culled passes) or "

@@ -13,7 +13,6 @@ from typing import Any, TextIO
 
 from rgraph.commands.common import default_size_text, parse_params, parse_size
 from rgraph.errors import RGraphError
-from rgraph.report.plan_file import check_plan, load_plan
 
 COMMAND_LINE = "<command line>"
 
@@ -49,6 +48,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     """Load the plan file, or compile the graph with the given scene, params, size and policy."""
+    from rgraph.report.plan_file import check_plan, load_plan
+
     target: str = args.target
     compile_flags = [f for f in ("scene", "size", "policy", "profile") if getattr(args, f)] + (["-p"] if args.params else [])
     if target.endswith(".json"):

@@ -13,12 +13,12 @@ from collections.abc import Sequence
 
 import networkx as nx
 
+from rgraph.defaults import DEFAULT_SCHEDULE, SCHEDULES
 from rgraph.errors import RGraphError
 from rgraph.ir.graph import build_graph
 from rgraph.spec.specialize import PassSpec
 
-SCHEDULES = ("declaration", "async-early")
-DEFAULT_SCHEDULE = "declaration"
+__all__ = ["DEFAULT_SCHEDULE", "SCHEDULES", "schedule_passes"]
 
 
 def schedule_passes(passes: Sequence[PassSpec], mode: str = DEFAULT_SCHEDULE) -> list[PassSpec]:

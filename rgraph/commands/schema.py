@@ -6,7 +6,6 @@ import argparse
 import json
 
 
-
 def schema_text() -> str:
     from rgraph.spec.models import GraphFile
 

@@ -17,6 +17,7 @@ from typing import Any
 from rgraph.compiler import memory
 from rgraph.compiler.memory import MemoryRequirementsProvider
 from rgraph.compiler.sync import synchronize
+from rgraph.defaults import DEFAULT_SIZE  # re-exported: the one default everywhere
 from rgraph.errors import RGraphError
 from rgraph.ir.cull import cull
 from rgraph.ir.schedule import DEFAULT_SCHEDULE, schedule_passes
@@ -27,7 +28,6 @@ from rgraph.spec.pydantic_errors import did_you_mean
 from rgraph.spec.scene import ALL_PRESENT, Scene, load_scene
 from rgraph.spec.specialize import Spec, resolve_params, specialize
 
-from rgraph.defaults import DEFAULT_SIZE  # noqa: E402  (re-exported: the one default everywhere)
 DEFAULT_POLICY = "aliased"
 DEFAULT_PROFILE = "lavapipe"
 

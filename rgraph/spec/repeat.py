@@ -95,7 +95,7 @@ def instances(name: str, located: Located, env: Any) -> list[tuple[str, dict[str
     stop = env.integer(bounds[1], located, "for", var, 1)
     if stop - first > MAX_REPEAT:
         raise RGraphError.at(located.loc("for", var), f"'{var}' repeats {stop - first} times; the limit is {MAX_REPEAT}")
-    if f"${{" not in name:
+    if "${" not in name:
         raise RGraphError.at(located.key_loc(), f"repeated pass '{name}' needs '${{{var}}}' in its name, e.g. {name}_${{{var}}}")
     out = []
     for value in range(first, stop):

@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from locations import ROOT
+
 from rgraph import __version__
 from rgraph.cli import build_parser, main, subcommand_parser
 from rgraph.commands.completion import commands

@@ -6,8 +6,8 @@ import re
 import shutil
 
 import pytest
-
 from locations import ROOT
+
 from rgraph.cli import main
 
 DOC = ROOT / "docs" / "format.md"

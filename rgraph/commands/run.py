@@ -22,7 +22,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
     parser.add_argument("--out", type=Path, help="write the first output image as PNG")
-    parser.add_argument("--timings", type=Path, help="write per-pass GPU times (median ms) as JSON")
+    parser.add_argument("--timings", type=Path,
+                        help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
+    parser.add_argument("--trace", type=Path, metavar="OUT.json",
+                        help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
+                             "a track per queue, passes as slices, barriers, semaphore waits as flows")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.add_argument("--json", action="store_true",
                         help="print the result (timings, validation messages, data check) as JSON (docs/cli-json.md)")
@@ -107,6 +111,11 @@ def run(args: argparse.Namespace) -> int:
     if args.timings:
         args.timings.write_text(json.dumps({"device": result.device_name, "size": plan.get("size"),
                                             **result.timings}, indent=1, sort_keys=True) + "\n")
+    if args.trace:
+        from rgraph.report.trace import chrome_trace
+
+        trace = chrome_trace(plan, {"device": result.device_name, **result.timings})
+        args.trace.write_text(json.dumps(trace, indent=None, sort_keys=True) + "\n")
     if args.json:
         return _json(args, plan, result)
     if plan["passes"]:

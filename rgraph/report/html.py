@@ -118,11 +118,16 @@ def _gpu_section(plan: Plan, timings: dict | None) -> str:
     if timings:
         frames = timings.get("frames")
         total = timings.get("total_ms")
-        note = (f"Bar lengths are the per-pass GPU medians measured on {html.escape(str(timings.get('device') or '?'))}"
-                f"{f' over {frames} frames' if frames else ''}"
-                f"{f'; measured frame total {total:.3f} ms' if isinstance(total, (int, float)) else ''}. "
-                "Start times are derived: each pass starts after the previous pass on its queue and after "
-                "the semaphore signals it waits for (arrows); overlap between lanes is what async queues can hide.")
+        where = (f"measured on {html.escape(str(timings.get('device') or '?'))}"
+                 f"{f' over {frames} frames' if frames else ''}"
+                 f"{f'; measured frame total {total:.3f} ms' if isinstance(total, (int, float)) else ''}")
+        if timings.get("intervals"):
+            note = (f"Each pass's median start and end within the frame from GPU timestamps, {where}. Arrows are "
+                    "semaphore waits; overlap between lanes is async work running beside graphics.")
+        else:
+            note = (f"Bar lengths are the per-pass GPU medians {where}. This timings file has no timestamps "
+                    "per pass, so start times are derived: each pass starts after the previous pass on its "
+                    "queue and after the semaphore signals it waits for (arrows).")
     else:
         note = ("No timings given: each pass is drawn one slot long to show the queue structure. For measured "
                 "times: <code>rgraph run G --timings t.json</code>, then <code>rgraph inspect G --timings t.json "

@@ -145,13 +145,21 @@ def lifetimes_svg(plan: Plan) -> str:
 
 
 def gpu_layout(plan: Plan, timings: dict[str, Any] | None) -> list[dict[str, Any]]:
-    """Per executed pass: queue, start and end in ms, laid out from the measured per-pass medians.
+    """Per executed pass: queue, start and end in ms.
 
-    A pass starts when the previous pass on its queue has ended and every semaphore it waits
+    From the GPU timestamps of the timings file (``intervals``: median start/end of each pass
+    within the frame) when it has them for every pass. Otherwise laid out from the per-pass
+    medians: a pass starts when the previous pass on its queue has ended and every semaphore it waits
     for has been signalled (the signalling pass has ended). Without timings each pass is one
     unit long. The start times are derived; only the durations are measured.
     """
     measured = (timings or {}).get("passes") or {}
+    intervals = (timings or {}).get("intervals") or {}
+    if intervals and all(p["name"] in intervals for p in plan["passes"]):  # GPU timestamps (rgraph run)
+        return [{"name": p["name"], "index": p.get("index"), "queue": p.get("queue") or "graphics",
+                 "start": intervals[p["name"]]["start_ms"], "end": intervals[p["name"]]["end_ms"],
+                 "ms": measured.get(p["name"]), "waits": p.get("waits") or [], "timestamps": True}
+                for p in plan["passes"]]
     queue_end: dict[str, float] = {}
     signalled: dict[tuple[str, int], float] = {}
     rows = []
@@ -199,7 +207,8 @@ def gpu_svg(plan: Plan, timings: dict[str, Any] | None) -> str:
         x, w = LEFT + r["start"] * scale, max((r["end"] - r["start"]) * scale, 1.5)
         timing = f"{r['ms']:.3f} ms measured" if isinstance(r["ms"], (int, float)) else (
             "not in the timings file" if timings else "untimed")
-        tip = f"{r['index']} {r['name']} on {r['queue']}: {timing}; starts at {r['start']:.3f} {unit} (derived)"
+        how = "GPU timestamp" if r.get("timestamps") else "derived"
+        tip = f"{r['index']} {r['name']} on {r['queue']}: {timing}; starts at {r['start']:.3f} {unit} ({how})"
         out.append(_shape("rect", tip, x=f"{x:.1f}", y=f"{y:.1f}", width=f"{w:.1f}", height=lane_h - 12,
                           fill=QUEUE_COLOR.get(r["queue"], "#999999"), class_="pass", data_pass=r["name"]))
         out.append(_label(x + w / 2, y + (lane_h - 12) / 2, r["name"], w, lane_h - 12))

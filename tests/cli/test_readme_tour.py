@@ -86,7 +86,7 @@ def test_readme_tour_runs_from_a_clone(tmp_path):
         ran.append(line)
     assert len(ran) == len(commands)
     for name in ("plan.json", "dedicated.json", "early.json", "t.json", "naive.json", "out.png", "report.html",
-                 "graph.svg", "mem.svg", "rgraph.bash", "sweep/sweep.csv"):
+                 "graph.svg", "mem.svg", "rgraph.bash", "sweep/sweep.csv", "trace.json"):
         assert (clone / name).is_file(), name
     assert (clone / "mem.svg").read_text().lstrip().startswith("<?xml")
     assert "<svg" in (clone / "graph.svg").read_text()[:500]

@@ -6,38 +6,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from locations import TESTS
 
 from rgraph.check import check_plan
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.errors import RGraphError
 
-GRAPH = """\
-rgraph: 1
-name: sched
-resources:
-  depth: {kind: image, format: d32_sfloat, size: output}
-  gbuf:  {kind: image, format: r16g16b16a16_sfloat, size: output}
-  ao:    {kind: image, format: r32_sfloat, size: output}
-  color: {kind: image, format: r16g16b16a16_sfloat, size: output, lifetime: output}
-passes:
-  prepass:
-    kind: raster
-    writes: {depth: depth_attachment}
-  gbuffer:
-    kind: raster
-    reads: {depth: depth_read}
-    writes: {gbuf: color_attachment}
-  ao:
-    kind: compute
-    queue: compute
-    reads: {depth: sampled}
-    writes: {ao: storage_write}
-  light:
-    kind: compute
-    reads: {gbuf: sampled, ao: sampled}
-    writes: {color: storage_write}
-outputs: [color]
-"""
+GRAPH = (TESTS / "pass_graphs" / "async_compute.yaml").read_text()
 
 
 @pytest.fixture

@@ -44,6 +44,19 @@ def _unit(top: int) -> tuple[int, str]:
     return (MIB, "MiB") if top >= MIB else (1024, "KiB") if top >= 1024 else (1, "B")
 
 
+def _with_pass_axis(out: list[str], passes: list[dict], col: float, y: float, label: str) -> str:
+    """The chart ``out`` closed by pass names across at ``y`` (rotated so they never overlap,
+    each a link to its pass) in an ``<svg>`` tall enough for the longest name."""
+    for i, p in enumerate(passes):
+        x = LEFT + (i + 0.5) * col
+        out.append(f'<text transform="translate({x:.1f},{y:.1f}) rotate(-35)" text-anchor="end" class="axis">'
+                   f'<a href="#pass-{_attr(p["name"])}">{i} {escape(p["name"])}</a></text>')
+    longest = max((len(p["name"]) for p in passes), default=4) + 3
+    total_h = int(y + longest * CHAR_W * 0.6) + 30
+    return (f'<svg class="chart" viewBox="0 0 {WIDTH} {total_h}" width="{WIDTH}" height="{total_h}" role="img" '
+            f'aria-label="{label}">' + "".join(out) + "</svg>")
+
+
 def memory_svg(plan: Plan) -> str:
     """Offset (up) against pass index (across), one panel per memory class; hover for details."""
     passes = plan["passes"]
@@ -98,14 +111,7 @@ def memory_svg(plan: Plan) -> str:
         out.append(_shape("polyline", f"live bytes per pass; peak {human_bytes(max(live, default=0))}",
                           points=points, class_="live"))
         y0 += height + 40
-    for i, p in enumerate(passes):  # pass names across, rotated so they never overlap
-        x = LEFT + (i + 0.5) * col
-        out.append(f'<text transform="translate({x:.1f},{y0 - 20}) rotate(-35)" text-anchor="end" class="axis">'
-                   f'<a href="#pass-{_attr(p["name"])}">{i} {escape(p["name"])}</a></text>')
-    longest = max((len(p["name"]) for p in passes), default=4) + 3
-    total_h = y0 + int(longest * CHAR_W * 0.6) + 10
-    return (f'<svg class="chart" viewBox="0 0 {WIDTH} {total_h}" width="{WIDTH}" height="{total_h}" '
-            f'role="img" aria-label="memory timeline">' + "".join(out) + "</svg>")
+    return _with_pass_axis(out, passes, col, y0 - 20, "memory timeline")
 
 
 def lifetimes_svg(plan: Plan) -> str:
@@ -133,15 +139,7 @@ def lifetimes_svg(plan: Plan) -> str:
         out.append(_shape("rect", tip, x=f"{x:.1f}", y=f"{y + 2}", width=f"{w:.1f}", height=row_h - 4,
                           fill=PALETTE[heaps.index(b.heap) % len(PALETTE)], class_="res" + ("" if b.aliasable else " held"),
                           data_res=b.name))
-    height = top + row_h * len(blocks)
-    for i, p in enumerate(passes):
-        x = LEFT + (i + 0.5) * col
-        out.append(f'<text transform="translate({x:.1f},{height + 12}) rotate(-35)" text-anchor="end" class="axis">'
-                   f'{i} {escape(p["name"])}</text>')
-    longest = max((len(p["name"]) for p in passes), default=4) + 3
-    total_h = height + int(longest * CHAR_W * 0.6) + 16
-    return (f'<svg class="chart" viewBox="0 0 {WIDTH} {total_h}" width="{WIDTH}" height="{total_h}" role="img" '
-            f'aria-label="resource lifetimes">' + "".join(out) + "</svg>")
+    return _with_pass_axis(out, passes, col, top + row_h * len(blocks) + 12, "resource lifetimes")
 
 
 def gpu_layout(plan: Plan, timings: dict[str, Any] | None) -> list[dict[str, Any]]:

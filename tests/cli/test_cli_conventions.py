@@ -146,12 +146,39 @@ def test_indirect_minimum_is_checked_at_validate_time(tmp_path, capsys):
 
 
 def test_indirect_buffer_at_the_minimum_runs_clean(tmp_path):
-    """The minimum validate names is enough: the frame runs under validation with the data check."""
+    """The minimum validate names is enough: the frame runs under validation with the data
+    check (and ``run --json`` reports it as a document)."""
     path = tmp_path / "g.yaml"
     path.write_text(INDIRECT.replace("bytes: 16", "bytes: 68"))
-    run = cli("run", str(path), "--size", "16x16", "--validate")
+    run = cli("run", str(path), "--size", "16x16", "--validate", "--json")
     assert run.returncode == 0, run.stderr
-    assert "rgraph: 0 validation message(s)" in run.stderr and "data check ok" in run.stderr
+    doc = json.loads(run.stdout)
+    assert doc["format"] == "rgraph-run/1" and doc["ok"] is True and doc["size"] == [16, 16]
+    assert doc["validation"] == {"enabled": True, "messages": []}
+    assert doc["data_check"]["ok"] is True and doc["data_check"]["mismatches"] == []
+    assert set(doc["timings"]["passes"]) == {"gen", "draw"}
+
+
+def test_compile_and_inspect_json(tmp_path, capsys):
+    plan = tmp_path / "p.json"
+    assert main(["compile", "surgery", "--scene", "cct_no_sss", "--json", "-o", str(plan)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["format"] == "rgraph-compile/1" and doc["output"] == str(plan) and "plan" not in doc
+    assert [c["pass"] for c in doc["culled"]] == ["sss_blur_h", "sss_blur_v"]
+    assert doc["barriers"] == json.loads(plan.read_text())["stats"]["barriers"]
+    assert main(["inspect", str(plan), "--json", "--memory", "--barriers"]) == 0
+    view = json.loads(capsys.readouterr().out)
+    assert view["format"] == "rgraph-inspect/1" and view["scene"] == "cct_no_sss"
+    assert len(view["barriers"]) == sum(len(p[k]) for p in json.loads(plan.read_text())["passes"]
+                                        for k in ("waits", "barriers", "releases", "signals"))
+    assert {r["name"] for r in view["resources"]} >= {"depth", "color"} and view["heaps"]
+
+
+def test_scene_by_bundled_name(capsys):
+    assert main(["validate", "surgery", "--scene", "cct_no_sss"]) == 0
+    assert "with scene 'cct_no_sss'" in capsys.readouterr().out
+    assert main(["validate", "surgery", "--scene", "cct_nosss"]) == 2
+    assert "no such file or bundled scene (bundled: cct, " in capsys.readouterr().err
 
 
 def test_validate_json_errors_are_objects(tmp_path):

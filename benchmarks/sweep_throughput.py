@@ -65,6 +65,12 @@ def main(argv: list[str] | None = None) -> int:
         wall, renderings = wall + w, renderings + r
         print(f"one process: {group}: {r} renderings in {w:.1f} s", file=sys.stderr, flush=True)
     runs = [{"workers": 1, "how": "one process per group", "wall_s": round(wall, 2), "renderings": renderings}]
+
+    def save() -> None:  # after every run: a run cut short keeps what was measured
+        if args.json:
+            args.json.write_text(json.dumps({"size": args.size, "frames": args.frames, "runs": runs}, indent=1) + "\n")
+
+    save()
     for n in [int(x) for x in args.workers.split(",") if x]:
         out = args.out / f"workers{n}"
         w, r, _ = sweeps([*common, "--groups", ",".join(groups), "--workers", str(n), "-o", str(out)])
@@ -76,6 +82,7 @@ def main(argv: list[str] | None = None) -> int:
                 "time_change_median": round(statistics.median(changes), 4) if changes else None,
                 "time_change_max": round(max(changes), 4) if changes else None}
         runs.append(run)
+        save()
         print(f"--workers {n}: {r} renderings in {w:.1f} s", file=sys.stderr, flush=True)
     base = runs[0]["wall_s"] / max(runs[0]["renderings"], 1)
     print(f"{'run':<22} {'wall s':>8} {'renderings':>10} {'per min':>8} {'speedup':>8}  same outputs (but times); "
@@ -88,8 +95,7 @@ def main(argv: list[str] | None = None) -> int:
                          f"{v['time_change_median']} / {v['time_change_max']}" for g, v in run.get("groups", {}).items())
         print(f"{run['how']:<22} {run['wall_s']:>8.1f} {run['renderings']:>10} {run['per_minute']:>8} "
               f"{run['speedup']:>8}  {same or 'baseline'}")
-    if args.json:
-        args.json.write_text(json.dumps({"size": args.size, "frames": args.frames, "runs": runs}, indent=1) + "\n")
+    save()
     return 0 if all(not v["differences"] for run in runs[1:] for v in run["groups"].values()) else 1
 
 

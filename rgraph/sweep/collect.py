@@ -51,12 +51,19 @@ class Collector:
         else:
             self.pending.append(key)
 
+    def reference_images(self) -> Images | None:
+        """The reference's images once it rendered (kept to the end), else None."""
+        reference = self.renderings.get(self.reference_key)
+        return reference.images if reference is not None else None
+
     def _finish(self, key: tuple) -> None:
         rendering = self.renderings.get(key)
         if rendering is None:
             return
         reference = self.renderings.get(self.reference_key)
-        if reference is None:
+        if rendering.compared is not None:  # its worker had the reference
+            self.compared[key] = rendering.compared
+        elif reference is None:
             self.compared[key] = (dict.fromkeys(METRICS), [])
         else:
             self.compared[key] = compare(reference.images, rendering.images)

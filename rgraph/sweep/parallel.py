@@ -77,16 +77,29 @@ class Executor:
 
     def run(self, fn: Callable[[Any], Any], items: Iterable[tuple[Hashable, Any]]) -> Iterator[Outcome]:
         """``fn(arg)`` for every ``(key, arg)``, each in a fresh worker process; yields as
-        tasks finish. ``fn`` must be importable (module level). Closing the iterator early
-        cancels the tasks still running."""
-        queue: deque[tuple[Hashable, Any, int, list[str]]] = deque((k, a, 1, []) for k, a in items)
+        tasks finish. ``items`` is read only when a slot is free (all at once without a slot
+        limit). ``fn`` must be importable (module level). Closing the iterator early cancels
+        the tasks still running."""
+        source = iter(items)  # taken lazily: an item may depend on results that came back
+        queue: deque[tuple[Hashable, Any, int, list[str]]] = deque()  # retries, first
         running: dict[Hashable, tuple[Hashable, Any, int, list[str]]] = {}
         slots = self.backend.slots
+        exhausted = False
         try:
-            while queue or running:
-                while queue and (slots is None or len(running) < slots):
+            while True:
+                while slots is None or len(running) < slots:
+                    if not queue and not exhausted:
+                        item = next(source, None)
+                        if item is None:
+                            exhausted = True
+                        else:
+                            queue.append((item[0], item[1], 1, []))
+                    if not queue:
+                        break
                     task = queue.popleft()
                     running[self.backend.start(fn, task[1])] = task
+                if not running:
+                    break
                 for handle, status, value in self.backend.wait(list(running)):
                     key, arg, attempt, errors = running.pop(handle)
                     if status == "ok":

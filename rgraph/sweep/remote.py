@@ -3,7 +3,8 @@
 The parent sends a :class:`RenderJob` per distinct setting; the worker compiles the setting
 with its own device's memory requirements and renders it exactly as the one-process sweep
 does (``runner._compile_all``, ``runner._render``),
-then hands the rendering (plan, times, messages, images) back.
+then hands the rendering (plan, times, messages, images) back; a job made after the
+reference rendered carries the reference's images, and its worker computes the metrics too.
 
 A worker is a fresh interpreter: the job carries the parent's ``sys.path`` and the modules
 that registered the graph's pass implementations there (a user's passes, a test fixture),
@@ -18,7 +19,7 @@ import importlib.util
 import os
 import signal
 import sys
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -38,6 +39,7 @@ class RenderJob:
     sys_path: tuple[str, ...]
     modules: tuple[tuple[str, str | None], ...]  # (name, file) of modules registering the graph's impls
     fault: str | None = None
+    reference: Any = None  # the reference's Images once rendered: the worker compares with it
 
 
 def implementation_modules(impls: set[str]) -> tuple[tuple[str, str | None], ...]:
@@ -62,16 +64,19 @@ def _graph_impls(request: Any) -> set[str]:
     return {p.model.impl for p in source.passes.values() if getattr(p.model, "impl", None)}
 
 
-def jobs(request: Any, settings: Mapping[Any, Setting], env: Mapping[str, str] | None = None
-         ) -> Iterator[tuple[Any, RenderJob]]:
-    """(params key, job) per distinct setting, in the given order (the reference first)."""
+def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
+         env: Mapping[str, str] | None = None) -> Iterator[tuple[Any, RenderJob]]:
+    """(params key, job) per distinct setting, in the given order (the reference first).
+    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
+    so its worker computes the metrics too."""
     env = os.environ if env is None else env
     fault = env.get(KILL_ENV) or None
     request = dataclasses.replace(request, graph=_absolute(request.graph), scene=_absolute(request.scene))
     sys_path = tuple(p for p in sys.path if p)
     modules = implementation_modules(_graph_impls(request))
     for key, setting in settings.items():
-        yield key, RenderJob(request, setting, sys_path, modules, fault)
+        images = reference() if reference is not None and setting.label != "reference" else None
+        yield key, RenderJob(request, setting, sys_path, modules, fault, images)
 
 
 def _absolute(path: str | None) -> str | None:
@@ -147,4 +152,9 @@ def render_job(job: RenderJob) -> Any:
         request = dataclasses.replace(request, device=index)
     plans = _compile_all(request, [job.setting])
     (plan,) = plans.values()
-    return _render(request, plan)
+    rendering = _render(request, plan)
+    if job.reference is not None:
+        from rgraph.sweep.compare import compare
+
+        rendering.compared = compare(job.reference, rendering.images)
+    return rendering

@@ -90,3 +90,15 @@ def test_a_ray_gpu_is_the_vulkan_gpu_of_that_ordinal():
                PhysicalDeviceInfo(1, None, "H200 a", "discrete", (1, 4, 0)),
                PhysicalDeviceInfo(2, None, "H200 b", "discrete", (1, 4, 0))]
     assert [gpu_device_index(devices, g) for g in (0, 1, 2)] == [1, 2, None]
+
+
+def test_items_are_read_when_a_slot_frees():
+    backend, seen = Scripted(1, {}), []
+
+    def items():
+        for k in "abc":
+            seen.append((k, [h[0] for h in backend.started]))  # what had started when k was made
+            yield k, k
+
+    assert [o.key for o in Executor(backend).run(str, items())] == ["a", "b", "c"]
+    assert seen == [("a", []), ("b", ["a"]), ("c", ["a", "b"])]

@@ -104,3 +104,20 @@ def test_ray_missing_is_one_line(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "ray", None)  # as if Ray were not installed
     assert sweep([*ARGS, "--ray", "-o", str(tmp_path / "x")]) == 2
     assert "rgraph: error: --ray needs Ray: pip install 'rgraph[ray]'" in capsys.readouterr().err
+
+
+def test_workers_started_after_the_reference_compare_with_it(one_process, tmp_path, monkeypatch, capsys):
+    """With one worker the reference renders first, so every later job carries its images
+    and its worker computes the metrics: the parent compares only the reference with itself."""
+    from rgraph.sweep import collect
+
+    real = collect.compare
+
+    def parent_compare(reference, test):
+        assert reference is test, "a worker that had the reference should have compared"
+        return real(reference, test)
+
+    monkeypatch.setattr(collect, "compare", parent_compare)
+    out = tmp_path / "w1"
+    assert sweep([*ARGS, "--workers", "1", "-o", str(out)]) == 0, capsys.readouterr().err
+    assert differences(one_process, out) == []

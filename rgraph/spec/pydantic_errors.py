@@ -80,7 +80,8 @@ def _model_fields(model: type[BaseModel], path: Sequence[str | int]) -> list[str
 
 
 _FIELD_WORDS = {"requires": "scene feature", "stages": "shader stage", "kind": "pass kind", "usage": "usage"}
-_BRANCHES = ("int", "str", "float", "bool", "list[union[int,str]]", "literal['output']", "ScaleSize")
+_BRANCHES = ("int", "str", "float", "bool", "list[union[int,str]]", "literal['output']", "ScaleSize", "light",
+             "generator")
 
 
 def _siblings(exc: ValidationError, loc: tuple[Any, ...]) -> list[Any]:

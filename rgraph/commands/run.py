@@ -23,6 +23,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
     parser.add_argument("--out", type=Path, help="write the first output image as PNG")
     parser.add_argument("--timings", type=Path, help="write per-pass GPU times (median ms) as JSON")
+    parser.add_argument("--heatmap", type=Path,
+                        help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.set_defaults(func=run)
 
@@ -64,17 +66,34 @@ def _print_table(plan: dict, timings: dict) -> None:
     Console(stderr=True).print(table)
 
 
+def _report_clusters(args: argparse.Namespace, outputs: dict) -> None:
+    """Light-list statistics and the heatmap of a clustered graph (rgraph.passes.cluster_report)."""
+    if "cluster_stats" not in outputs and not args.heatmap:
+        return
+    from rgraph.passes import cluster_report
+
+    if "cluster_stats" in outputs:
+        print(cluster_report.stats_line(cluster_report.stats_of(outputs["cluster_stats"])), file=sys.stderr)
+    if args.heatmap:
+        print(cluster_report.write_heatmap(args.heatmap, outputs["light_heat"][..., 0]), file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
     from rgraph.vk.executor import execute_plan
 
     try:
         plan = _load_plan(args)
+        outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
+        if args.heatmap and "light_heat" not in outputs:
+            raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' (see graphs/clustered.yaml)")
         result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
-                              check_data=args.check_data, out_png=args.out, verbose=True)
+                              check_data=args.check_data, out_png=args.out, verbose=True,
+                              read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
+    _report_clusters(args, result.outputs)
     if plan["passes"]:
         _print_table(plan, result.timings)
     else:

@@ -1,0 +1,199 @@
+"""Clustered forward lighting on lavapipe under validation + synchronization validation.
+
+- froxel bounds and light lists against passes/clustered_ref.py (float64): every list holds
+  each light the reference accepts with spheres and froxels shrunk by ASSIGN_MARGIN and none it
+  rejects with them grown (tight), in ascending order (points, spots, a directional light);
+- the all-lights hdr against the float64 shading of the floor (window, cone, GGX);
+- hard cases, each clustered against all_lights within one 8-bit sRGB code after tonemapping:
+  0 and 1 lights, 65,536 lights with an overflowing list (reported in cluster_stats), a light
+  behind the camera reaching the frustum, radius 0 and 1e4, a light on a froxel corner, the camera
+  inside a light, near plane 1e-4, objects at 1e5 m.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from clustered_helpers import graph_with_outputs, render, scene_file, srgb_codes, stats
+
+from rgraph.passes import clustered_ref as ref
+from rgraph.scene.build import load_scene_data
+
+SIZE = (64, 48)
+MIXED = """  - {type: directional, direction: [-0.3, -1, -0.2], intensity: 0.3}
+  - {generate: point, count: 300, seed: 5, bounds: [[-8, 0.2, -8], [8, 3, 8]], radius: [0.3, 2.5], intensity: [0.5, 2]}
+  - {type: spot, position: [-2, 3, 2], direction: [0.3, -1, -0.1], cone: [15, 25], radius: 8, intensity: 30}
+  - {type: spot, position: [3, 2, 4], direction: [-1, -0.5, -1], cone: [5, 40], radius: 12, intensity: 30}
+"""
+
+
+def _lists(outputs: dict, grid: ref.Grid) -> list[list[np.ndarray]]:
+    cells = outputs["light_grid"]  # (slices, gy, gx, 4) uint32 as floats of the decoded values
+    idx = outputs["light_indices"].view(np.uint32)
+    gx, gy = grid.tiles
+    out = []
+    for k in range(grid.slices):
+        row = []
+        for y in range(gy):
+            for x in range(gx):
+                off, cnt = int(cells[k, y, x, 0]), int(cells[k, y, x, 1])
+                row.append(idx[off:off + cnt])
+        out.append(row)
+    return out
+
+
+@pytest.mark.vulkan
+def test_froxel_bounds_and_lists_match_the_reference(tmp_path):
+    scene = scene_file(tmp_path, MIXED)
+    graph = graph_with_outputs(tmp_path, ("froxel_bounds", "light_grid", "light_indices"))
+    plan, out = render(scene, size=SIZE, graph=graph)
+    data = load_scene_data(scene, SIZE)
+    grid = ref.grid_for(data, 16, 8)
+    lo, hi = ref.froxel_bounds(grid)
+    plo, phi = ref.padded(lo, hi)
+    fb = out["froxel_bounds"].astype(np.float64)  # (2 * slices, gy, gx, 4)
+    got_lo = np.moveaxis(fb[0::2, ..., :3], 0, 2)
+    got_hi = np.moveaxis(fb[1::2, ..., :3], 0, 2)
+    finite = np.abs(phi) < 1e29
+    scale = np.maximum(np.abs(plo), np.abs(phi)).max(axis=-1, keepdims=True)
+    assert np.all(np.abs(got_lo - plo)[finite] <= 1e-5 * np.broadcast_to(scale, plo.shape)[finite] + 1e-6)
+    assert np.all(np.abs(got_hi - phi)[finite] <= 1e-5 * np.broadcast_to(scale, phi.shape)[finite] + 1e-6)
+    lights = ref.light_table(data)
+    must = ref.touches(lights, lo, hi, -ref.ASSIGN_MARGIN)  # (gy, gx, s, n)
+    may = ref.touches(lights, lo, hi, ref.ASSIGN_MARGIN)
+    lists = _lists(out, grid)
+    gx, gy = grid.tiles
+    total = 0
+    for k in range(grid.slices):
+        for y in range(gy):
+            for x in range(gx):
+                got = lists[k][y * gx + x]
+                assert np.all(np.diff(got.astype(np.int64)) > 0)  # ascending, no repeats
+                have = np.zeros(len(data.lights), bool)
+                have[got] = True
+                assert not np.any(must[y, x, k] & ~have), f"froxel {(x, y, k)} misses lights"
+                assert not np.any(have & ~may[y, x, k]), f"froxel {(x, y, k)} lists lights it cannot reach"
+                total += len(got)
+    s = stats(out)
+    assert s["references"] == total and s["overflowed_froxels"] == 0 and s["capacity"] == 4194304
+    assert must[..., 0].all()  # the directional light is everywhere
+    spots = [i for i, li in enumerate(data.lights) if li.type == ref.LIGHT_SPOT]
+    sphere_only = ref.touches({**lights, "type": np.where(lights["type"] == ref.LIGHT_SPOT, 1, lights["type"])},
+                              lo, hi, ref.ASSIGN_MARGIN)
+    assert np.any(sphere_only[..., spots] & ~may[..., spots])  # the cone test culls froxels the sphere meets
+    assert total < 0.5 * grid.froxels * len(data.lights)  # the lists are far shorter than every light
+
+
+@pytest.mark.vulkan
+def test_all_lights_hdr_matches_the_float64_shading(tmp_path):
+    floor = """materials:
+  floor: {base_color: [0.6, 0.5, 0.4], roughness: 0.5, metallic: 0}
+meshes:
+  - {shape: plane, params: {size: [60, 60], subdivisions: 1}, material: floor}
+"""
+    lights = """  - {type: point, position: [1, 0.8, 3], radius: 3, intensity: 8, color: [1, 0.8, 0.6]}
+  - {type: spot, position: [-2, 2, 2], direction: [0.2, -1, 0], cone: [10, 30], radius: 6, intensity: 40}
+  - {type: directional, direction: [0, -1, -1], intensity: 0.2}
+"""
+    scene = scene_file(tmp_path, lights, meshes=floor)
+    graph = graph_with_outputs(tmp_path, ("hdr", "depth"))
+    plan, out = render(scene, size=SIZE, graph=graph, mode="all_lights")
+    data = load_scene_data(scene, SIZE)
+    cam = data.camera(0)
+    depth = out["depth"][..., 0].astype(np.float64)
+    w, h = SIZE
+    px, py = np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
+    ndc = np.stack([px * 2 - 1, py * 2 - 1, depth, np.ones_like(depth)], axis=-1)
+    floor_px = depth > 0
+    ndc[~floor_px, 2] = 1.0  # background: any finite point (masked out below)
+    world = ndc @ cam.inv_view_proj.T
+    world = world[..., :3] / world[..., 3:4]
+    from rgraph.scene.packing import AMBIENT
+
+    want = ref.shade(ref.light_table(data), world, np.broadcast_to([0.0, 1.0, 0.0], world.shape), [0.6, 0.5, 0.4],
+                     0.5, 0.0, AMBIENT)
+    got = out["hdr"][..., :3].astype(np.float64)
+    assert floor_px.mean() > 0.3
+    err = np.abs(got - want) - (0.01 * np.abs(want) + 0.002)
+    assert err[floor_px].max() <= 0, f"worst excess {err[floor_px].max()}"
+    spot_lit = want[..., 2] > 0.1 + want[..., 2].min()
+    assert spot_lit[floor_px].mean() > 0.02 and (~spot_lit[floor_px]).mean() > 0.2  # the cone edge is in view
+
+
+def _boundary_light(tmp_path) -> str:
+    """A light exactly on a froxel corner: tile boundary x = 0 and y = 1/3 in NDC, at a slice start."""
+    data = load_scene_data(scene_file(tmp_path, "", name="probe"), SIZE)
+    cam = data.camera(0)
+    grid = ref.grid_for(data, 16, 8)
+    starts = ref.slice_starts(grid)
+    ray = np.array([0.0, (1 / 3) / cam.proj[1, 1], -1.0])  # view-space direction per unit distance
+    world_ray = cam.inv_view[:3, :3] @ ray
+    hit = -cam.position[1] / world_ray[1]  # distance where the ray meets the floor
+    d = starts[starts < hit].max()
+    p = cam.position + d * world_ray
+    return f"  - {{type: point, position: [{float(p[0])!r}, {float(p[1])!r}, {float(p[2])!r}], radius: 1.5, intensity: 6}}"
+
+
+FAR_MESHES = """materials:
+  box: {base_color: [0.7, 0.7, 0.72], roughness: 0.4, metallic: 0}
+meshes:
+  - {shape: box, params: {size: [20000, 20000, 20000]}, material: box, position: [0, 0, -100000]}
+"""
+CASES = {
+    "zero_lights": ("", {}, {}),
+    "one_light": ("  - {type: point, position: [0, 1, 2], radius: 4, intensity: 10}", {}, {}),
+    "behind_camera": ("  - {type: point, position: [0, 3.87, 12.87], radius: 9, intensity: 800}", {}, {}),
+    "radius_0": ("  - {type: point, position: [0, 0.5, 1.5], radius: 0, intensity: 10}\n"
+                 "  - {type: spot, position: [0, 2, 0], radius: 0, intensity: 10}", {}, {}),
+    "radius_1e4": ("  - {type: point, position: [0, 5, 0], radius: 10000, intensity: 50}", {}, {}),
+    "froxel_boundary": (None, {}, {}),
+    "camera_inside": ("  - {type: point, position: [0.2, 3.1, 9.8], radius: 20, intensity: 60}", {}, {}),
+    "near_1e-4": ("  - {type: point, position: [0, 1, 2], radius: 4, intensity: 10}",
+                  {"camera": "camera: {position: [0, 3, 10], look_at: [0, 0, 0], fov_y: 60, near: 0.0001}\n"}, {}),
+    "far_1e5": ("  - {type: point, position: [0, 12000, -88000], radius: 30000, intensity: 1e9}",
+                {"camera": "camera: {position: [0, 3, 10], look_at: [0, 0, -100000], fov_y: 60, near: 0.1}\n",
+                 "meshes": FAR_MESHES}, {}),
+}
+
+
+@pytest.mark.vulkan
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_clustered_equals_all_lights(tmp_path, case):
+    lights, scene_kw, params = CASES[case]
+    if lights is None:
+        lights = _boundary_light(tmp_path)
+    scene = scene_file(tmp_path, lights, **scene_kw)
+    _, clustered = render(scene, size=SIZE, params=params)
+    _, every = render(scene, size=SIZE, params=params, mode="all_lights")
+    a, b = srgb_codes(clustered), srgb_codes(every)
+    assert np.abs(a - b).max() <= 1, f"{np.count_nonzero(a != b)} pixels differ, worst {np.abs(a - b).max()}"
+    heat = clustered["light_heat"][..., 0]
+    s = stats(clustered)
+    assert s["overflowed_froxels"] == 0
+    if case == "zero_lights":
+        assert heat.max() == 0 and s["references"] == 0
+    else:
+        assert heat.max() >= 1 and s["references"] >= 1
+    if case not in ("zero_lights", "radius_0"):
+        assert a.max() >= 120, "the light should visibly light the geometry"
+    if case == "behind_camera":
+        cam = load_scene_data(scene, SIZE).camera(0)
+        assert (cam.view @ np.append(np.array([0, 3.87, 12.87]) - cam.position, 1))[2] > 0  # behind: +z in view
+
+
+@pytest.mark.vulkan
+def test_65536_lights_overflow_is_reported_and_the_image_stays_right(tmp_path):
+    lights = ("  - {generate: point, count: 65536, seed: 9, bounds: [[-6, 0.1, -6], [6, 2, 6]], radius: [0.2, 0.8],"
+              " intensity: [0.02, 0.1]}")
+    scene = scene_file(tmp_path, lights)
+    size, params = (32, 24), {"clusters.max_indices": "4096"}
+    _, clustered = render(scene, size=size, params=params)
+    s = stats(clustered)
+    assert s["capacity"] == 4096 and s["overflowed_froxels"] > 0 and s["references"] > 4096
+    from rgraph.passes.cluster_report import stats_line
+
+    assert "OVERFLOW" in stats_line(s) and "clusters.max_indices" in stats_line(s)
+    assert clustered["light_heat"][..., 0].max() == 65536  # overflowed froxels shade every light
+    _, every = render(scene, size=size, params=params, mode="all_lights")
+    a, b = srgb_codes(clustered), srgb_codes(every)
+    assert np.abs(a - b).max() <= 1 and a.max() >= 120

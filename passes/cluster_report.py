@@ -1,6 +1,7 @@
 """What ``rgraph run`` says about a clustered frame: the light-list statistics and the heatmap.
 
-``cluster_stats`` (uint32[4], written by ``light_assign``): light references asked for,
+``cluster_stats`` (uint32[4], written by ``light_assign``): list entries asked for (light
+indices, or bitmask words with ``clusters.list=bitmask``),
 overflowed froxels (shaded with every light: the image stays right, the frame slower),
 longest list, list capacity. ``light_heat`` (r32_sfloat): lights shaded per pixel.
 """
@@ -22,8 +23,8 @@ def stats_of(raw: np.ndarray | bytes) -> dict[str, int]:
 
 
 def stats_line(stats: dict[str, int]) -> str:
-    line = (f"rgraph: light lists: {stats['references']} light references (capacity {stats['capacity']}), "
-            f"longest list {stats['longest_list']}")
+    line = (f"rgraph: light lists: {stats['references']} entries (capacity {stats['capacity']}), "
+            f"longest list {stats['longest_list']} lights")
     if stats["overflowed_froxels"]:
         line += (f"; OVERFLOW: {stats['overflowed_froxels']} froxel(s) did not fit and were shaded with every "
                  f"light (raise clusters.max_indices to at least {stats['references']})")

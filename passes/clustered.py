@@ -34,6 +34,7 @@ from rgraph.vk.passkit import Binding, PassSetup, pack
 from .scene_passes import SCENE_FRONT_FACE
 
 MODES = ("clustered", "all_lights")
+LISTS = ("indices", "bitmask")
 LIGHT_BYTES = 64
 
 
@@ -67,11 +68,18 @@ def lighting_mode(setup: PassSetup) -> str:
     return mode
 
 
+def list_kind(setup: PassSetup) -> str:
+    kind = str(setup.param("clusters.list", "indices"))
+    if kind not in LISTS:
+        raise ExecutionError(f"pass {setup.name!r}: clusters.list must be one of {', '.join(LISTS)}, got {kind!r}")
+    return kind
+
+
 def cluster_defines(setup: PassSetup) -> dict[str, object]:
     g = grid_of(setup)
     return {"GRID_X": g.tiles[0], "GRID_Y": g.tiles[1], "SLICES": g.slices, "TILE_X": g.tile_px[0],
             "TILE_Y": g.tile_px[1], "CLUSTER_FAR": repr(float(g.far)),
-            "ALL_LIGHTS": int(lighting_mode(setup) == "all_lights")}
+            "ALL_LIGHTS": int(lighting_mode(setup) == "all_lights"), "LIST_BITMASK": int(list_kind(setup) == "bitmask")}
 
 
 def light_push(setup: PassSetup) -> bytes:

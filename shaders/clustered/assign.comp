@@ -70,12 +70,49 @@ uint sweep(bool write, vec3 lo, vec3 hi, uint n) {
     return total;
 }
 
+#if LIST_BITMASK
+// LIST_BITMASK: the froxel's list is a bitmask of ceil(n / 32) words at froxel_index * words
+// (light i = bit i % 32 of word i / 32); light_grid = (offset, lights set). One sweep, no atomics
+// for the offset; the froxels past the capacity overflow.
+void bitmask_main(ivec3 c, vec3 lo, vec3 hi, uint n) {
+    uint tid = gl_LocalInvocationID.x;
+    uint words = (n + 31u) / 32u;
+    uint froxel = uint((c.z * GRID_Y + c.y) * GRID_X + c.x);
+    bool over = words > 0u && (froxel >= pc.capacity / words);
+    uint offset = froxel * words;
+    uint total = 0u;
+    for (uint base = 0u; base < n; base += GROUP) {
+        if (tid < 2u) s_mask[tid] = 0u;
+        barrier();
+        uint i = base + tid;
+        bool hit = i < n && touches(i, lo, hi);
+        if (hit) atomicOr(s_mask[tid >> 5], 1u << (tid & 31u));
+        barrier();
+        uint w = base / 32u + tid;
+        if (!over && tid < 2u && w < words) indices[offset + w] = s_mask[tid];
+        total += uint(bitCount(s_mask[0]) + bitCount(s_mask[1]));
+        barrier();
+    }
+    if (tid == 0u) {
+        atomicAdd(stats[0], words);
+        atomicMax(stats[2], total);
+        if (c == ivec3(0)) stats[3] = pc.capacity;
+        if (over) atomicAdd(stats[1], 1u);
+        imageStore(light_grid, c, uvec4(over ? 0u : offset, over ? CLUSTER_OVERFLOW : total, 0u, 0u));
+    }
+}
+#endif
+
 void main() {
     ivec3 c = ivec3(gl_WorkGroupID);
     uint tid = gl_LocalInvocationID.x;
     vec3 lo = imageLoad(froxel_bounds, ivec3(c.xy, 2 * c.z)).xyz;
     vec3 hi = imageLoad(froxel_bounds, ivec3(c.xy, 2 * c.z + 1)).xyz;
     uint n = pc.light_count;
+#if LIST_BITMASK
+    bitmask_main(c, lo, hi, n);
+    return;
+#endif
     uint count = sweep(false, lo, hi, n);
     if (tid == 0u) {
         uint offset = atomicAdd(stats[0], count);

@@ -36,7 +36,19 @@ void main() {
     if (cell.y == CLUSTER_OVERFLOW) {
         for (uint i = 0u; i < n; ++i) shade_light(i, s, in_world, diffuse, specular);
     } else {
+#if LIST_BITMASK
+        uint words = cell.y == 0u ? 0u : (n + 31u) / 32u;
+        for (uint w = 0u; w < words; ++w) {
+            uint bits = indices[cell.x + w];
+            while (bits != 0u) {
+                uint b = uint(findLSB(bits));
+                bits &= bits - 1u;
+                shade_light(w * 32u + b, s, in_world, diffuse, specular);
+            }
+        }
+#else
         for (uint j = 0u; j < cell.y; ++j) shade_light(indices[cell.x + j], s, in_world, diffuse, specular);
+#endif
     }
 #endif
     vec3 c = diffuse + specular + s.diffuse_color * frame.ambient.rgb + m.emissive.rgb;

@@ -27,26 +27,34 @@ MIXED = """  - {type: directional, direction: [-0.3, -1, -0.2], intensity: 0.3}
 """
 
 
-def _lists(outputs: dict, grid: ref.Grid) -> list[list[np.ndarray]]:
-    cells = outputs["light_grid"]  # (slices, gy, gx, 4) uint32 as floats of the decoded values
+def _lists(outputs: dict, grid: ref.Grid, kind: str, lights: int) -> list[list[np.ndarray]]:
+    """Per slice, per tile (row-major): the light indices of the GPU's list (either encoding)."""
+    cells = outputs["light_grid"]  # (slices, gy, gx, 4)
     idx = outputs["light_indices"].view(np.uint32)
     gx, gy = grid.tiles
+    words = -(-lights // 32)
     out = []
     for k in range(grid.slices):
         row = []
         for y in range(gy):
             for x in range(gx):
                 off, cnt = int(cells[k, y, x, 0]), int(cells[k, y, x, 1])
-                row.append(idx[off:off + cnt])
+                if kind == "indices":
+                    row.append(idx[off:off + cnt])
+                else:
+                    bits = np.unpackbits(idx[off:off + words].view(np.uint8), bitorder="little")[:lights]
+                    row.append(np.nonzero(bits)[0])
+                    assert len(row[-1]) == cnt
         out.append(row)
     return out
 
 
 @pytest.mark.vulkan
-def test_froxel_bounds_and_lists_match_the_reference(tmp_path):
+@pytest.mark.parametrize("kind", ["indices", "bitmask"])
+def test_froxel_bounds_and_lists_match_the_reference(tmp_path, kind):
     scene = scene_file(tmp_path, MIXED)
     graph = graph_with_outputs(tmp_path, ("froxel_bounds", "light_grid", "light_indices"))
-    plan, out = render(scene, size=SIZE, graph=graph)
+    plan, out = render(scene, size=SIZE, graph=graph, params={"clusters.list": kind})
     data = load_scene_data(scene, SIZE)
     grid = ref.grid_for(data, 16, 8)
     lo, hi = ref.froxel_bounds(grid)
@@ -61,7 +69,7 @@ def test_froxel_bounds_and_lists_match_the_reference(tmp_path):
     lights = ref.light_table(data)
     must = ref.touches(lights, lo, hi, -ref.ASSIGN_MARGIN)  # (gy, gx, s, n)
     may = ref.touches(lights, lo, hi, ref.ASSIGN_MARGIN)
-    lists = _lists(out, grid)
+    lists = _lists(out, grid, kind, len(data.lights))
     gx, gy = grid.tiles
     total = 0
     for k in range(grid.slices):
@@ -75,7 +83,8 @@ def test_froxel_bounds_and_lists_match_the_reference(tmp_path):
                 assert not np.any(have & ~may[y, x, k]), f"froxel {(x, y, k)} lists lights it cannot reach"
                 total += len(got)
     s = stats(out)
-    assert s["references"] == total and s["overflowed_froxels"] == 0 and s["capacity"] == 4194304
+    entries = total if kind == "indices" else grid.froxels * -(-len(data.lights) // 32)
+    assert s["references"] == entries and s["overflowed_froxels"] == 0 and s["capacity"] == 4194304
     assert must[..., 0].all()  # the directional light is everywhere
     spots = [i for i, li in enumerate(data.lights) if li.type == ref.LIGHT_SPOT]
     sphere_only = ref.touches({**lights, "type": np.where(lights["type"] == ref.LIGHT_SPOT, 1, lights["type"])},
@@ -197,3 +206,7 @@ def test_65536_lights_overflow_is_reported_and_the_image_stays_right(tmp_path):
     _, every = render(scene, size=size, params=params, mode="all_lights")
     a, b = srgb_codes(clustered), srgb_codes(every)
     assert np.abs(a - b).max() <= 1 and a.max() >= 120
+    _, bitmask = render(scene, size=size, params={**params, "clusters.list": "bitmask"})
+    s = stats(bitmask)
+    assert s["overflowed_froxels"] == 16 - 2 and s["references"] == 16 * 2048  # 2 froxels of 2,048 words fit
+    assert np.abs(srgb_codes(bitmask) - b).max() <= 1

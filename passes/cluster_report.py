@@ -23,6 +23,8 @@ def stats_of(raw: np.ndarray | bytes) -> dict[str, int]:
 
 
 def stats_line(stats: dict[str, int]) -> str:
+    if stats["capacity"] == 0:
+        return "rgraph: light lists: not built (lighting.mode=all_lights shades every light)"
     line = (f"rgraph: light lists: {stats['references']} entries (capacity {stats['capacity']}), "
             f"longest list {stats['longest_list']} lights")
     if stats["overflowed_froxels"]:

@@ -7,8 +7,9 @@ lists) and ``lights.glsl`` (the bounded point/spot light terms), with the BRDF o
 Tolerances used by the tests:
 - froxel bounds: 1e-5 relative to the largest coordinate of the froxel (float32 exp2/log2);
 - assignment: the GPU list of a froxel holds every light the float64 test accepts with the
-  sphere (and the froxel) shrunk by ``ASSIGN_MARGIN`` relative, and none that it rejects with
-  them grown by ``ASSIGN_MARGIN`` (the GPU pads the froxel by 1e-4 and the radius by 1e-4);
+  sphere and the froxel shrunk by ``ASSIGN_MARGIN`` (of the radius; of the froxel's largest
+  finite coordinate), and none that it rejects with them grown by as much (the GPU pads the
+  froxel by 1e-4 of its slice's far distance and the radius by 1e-4);
 - shading: |gpu - ref| <= 0.01 |ref| + 0.002 per channel of the hdr output (float16 storage,
   float32 arithmetic), and clustered == all_lights within one 8-bit code after tonemapping.
 """
@@ -97,9 +98,19 @@ def froxel_bounds(g: Grid) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def padded(lo: np.ndarray, hi: np.ndarray, rel: float = PAD, abs_: float = PAD_ABS) -> tuple[np.ndarray, np.ndarray]:
-    pad = rel * np.maximum(np.abs(lo), np.abs(hi)) + abs_
+def padded(g: Grid, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """build.comp's padding: PAD x the slice's far distance (near for the last slice) + PAD_ABS."""
+    d = slice_starts(g)
+    scale = np.where(np.arange(g.slices) + 1 < g.slices, d[1:], d[:-1])
+    pad = (PAD * scale + PAD_ABS)[None, None, :, None]
     return lo - pad, hi + pad
+
+
+def _grown(lo: np.ndarray, hi: np.ndarray, fraction: float) -> tuple[np.ndarray, np.ndarray]:
+    """The box grown (fraction > 0) or shrunk by ``fraction`` of its largest finite coordinate."""
+    mag = np.where(np.abs(lo) < 1e29, np.abs(lo), 0).max(axis=-1, keepdims=True)
+    mag = np.maximum(mag, np.where(np.abs(hi) < 1e29, np.abs(hi), 0).max(axis=-1, keepdims=True))
+    return lo - fraction * mag, hi + fraction * mag
 
 
 def light_table(scene, frame: int = 0) -> dict[str, np.ndarray]:
@@ -124,7 +135,7 @@ def light_table(scene, frame: int = 0) -> dict[str, np.ndarray]:
 def touches(lights: dict[str, np.ndarray], lo: np.ndarray, hi: np.ndarray, margin: float = 0.0) -> np.ndarray:
     """(froxels..., lights) bool: assign.comp's test; ``margin`` > 0 grows spheres, cones and
     froxels by that fraction, < 0 shrinks them."""
-    lo, hi = padded(lo, hi, margin, 0.0) if margin else (lo, hi)  # a negative fraction shrinks
+    lo, hi = _grown(lo, hi, margin) if margin else (lo, hi)  # a negative fraction shrinks
     c = lights["centre"]
     r = lights["radius"] * (1 + margin)
     q = np.clip(c, lo[..., None, :], hi[..., None, :]) - c

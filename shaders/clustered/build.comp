@@ -17,7 +17,7 @@ void main() {
     if (any(greaterThanEqual(c, ivec3(GRID_X, GRID_Y, SLICES)))) return;
     vec3 lo, hi;
     cluster_bounds(c, lo, hi);
-    vec3 pad = CLUSTER_PAD * max(abs(lo), abs(hi)) + CLUSTER_PAD_ABS;
+    vec3 pad = vec3(cluster_pad(c.z));
     imageStore(froxel_bounds, ivec3(c.xy, 2 * c.z), vec4(lo - pad, 0.0));
     imageStore(froxel_bounds, ivec3(c.xy, 2 * c.z + 1), vec4(hi + pad, 0.0));
 }

@@ -7,9 +7,10 @@
 // - Slices are exponential in view distance d = -z_view: slice k covers
 //   [near * (far / near)^(k / SLICES), near * (far / near)^((k + 1) / SLICES)); the last slice
 //   extends to infinity, so every visible point has a froxel.
-// - A froxel's bounds are the view-space AABB of its frustum cell (8 corners), padded by
-//   CLUSTER_PAD relative (+ CLUSTER_PAD_ABS m): assignment is conservative against float rounding of
-//   the fragment's own slice and tile, so clustered shading equals shading every light.
+// - A froxel's bounds are the view-space AABB of its frustum cell (8 corners), padded on every side
+//   by CLUSTER_PAD times the slice's far distance (its near distance for the last, unbounded slice)
+//   + CLUSTER_PAD_ABS m: assignment is conservative against float rounding of the fragment's own
+//   position, slice and tile, so clustered shading equals shading every light.
 #ifndef CLUSTERED_CLUSTERS_GLSL
 #define CLUSTERED_CLUSTERS_GLSL
 
@@ -44,6 +45,12 @@ int cluster_slice_of(float d) {
 ivec3 cluster_of(vec2 frag_coord, float view_distance) {
     ivec2 t = min(ivec2(frag_coord) / ivec2(TILE_X, TILE_Y), ivec2(GRID_X - 1, GRID_Y - 1));
     return ivec3(t, cluster_slice_of(view_distance));
+}
+
+// The padding of slice k's froxels (metres, every side).
+float cluster_pad(int k) {
+    float d = k + 1 < SLICES ? cluster_slice_start(k + 1) : cluster_slice_start(k);
+    return CLUSTER_PAD * d + CLUSTER_PAD_ABS;
 }
 
 // Unpadded view-space AABB of froxel c: (min, max).

@@ -49,6 +49,8 @@ def test_generator_is_seeded_bounded_and_counted(tmp_path):
     ("{generate: point, count: -1, bounds: [[0, 0, 0], [1, 1, 1]]}", "count"),
     ("{generate: spot, count: 4, bounds: [[0, 0, 0], [1, 1, 1]]}", "generate"),
     ("{type: spot, cone: [50, 40]}", "cone must be"),
+    ("{generate: point, cont: 4, bounds: [[0, 0, 0], [1, 1, 1]]}", "unknown key 'cont'"),
+    ("{type: point, radiuss: 4}", "did you mean 'radius'"),
 ])
 def test_bad_generators_are_located_errors(tmp_path, item, message):
     path = write(tmp_path, f"  - {item}\n")

@@ -151,7 +151,7 @@ class ForwardClustered(PassImpl):
                                        Binding(2, "storage_buffer", "light_indices")])
         cull = str(setup.param("depth_prepass.cull", "back")).upper()
         self.pipeline = setup.graphics_pipeline(
-            "clustered/forward.vert", "clustered/forward.frag", [scene.set_layout, self.sets.layout],
+            "forward/forward.vert", "clustered/forward.frag", [scene.set_layout, self.sets.layout],
             defines=cluster_defines(setup), push_constant_bytes=8, vertex_input=scene.vertex_input, cull=cull,
             front_face=SCENE_FRONT_FACE, depth_test=True, depth_write=False, depth_compare="GREATER_OR_EQUAL")
 

@@ -38,19 +38,9 @@ layout(set = 1, binding = 3) uniform sampler2D ao_map;
 layout(set = 1, binding = 4) uniform sampler2DArray shadow_maps;
 #endif
 
-// Point-light falloff: inverse square, windowed to reach 0 at the radius (Karis 2013);
-// inv_r2 = 1 / radius^2 (Light.view.w); distance^2 floored at 1 mm^2.
-float point_falloff(float dist2, float inv_r2) {
-    float x = dist2 * inv_r2;
-    float window = clamp(1.0 - x * x, 0.0, 1.0);
-    return window * window / max(dist2, 1e-6);
-}
-
-// Spot cone: full inside the inner half-angle, 0 outside the outer (cosines in SceneLights, scene.glsl).
-float spot_cone(float cos_angle, float cos_inner, float cos_outer) {
-    float t = clamp((cos_angle - cos_outer) / max(cos_inner - cos_outer, 1e-4), 0.0, 1.0);
-    return t * t;
-}
+// Point and spot falloff (light_window: inverse square windowed to 0 at the radius, Karis 2013;
+// inv_r2 = Light.view.w) and spot cones (spot_factor): clustered/lights.glsl.
+#include "clustered/lights.glsl"
 
 // Adds light i's reflected radiance at this fragment.
 void add_light(int i, Surface s, inout vec3 diffuse, inout vec3 specular) {
@@ -70,9 +60,9 @@ void add_light(int i, Surface s, inout vec3 diffuse, inout vec3 specular) {
         vec3 d = light.position.xyz - in_world;
         float dist2 = dot(d, d);
         l = safe_normalize(d, s.n);
-        radiance *= point_falloff(dist2, light.view.w);
+        radiance *= light_window(dist2, light.view.w);
         if (type == LIGHT_SPOT) {
-            radiance *= spot_cone(dot(l, light.to_light.xyz), scene_lights[i].direction.w, scene_lights[i].radiance.w);
+            radiance *= spot_factor(dot(l, light.to_light.xyz), scene_lights[i].direction.w, scene_lights[i].radiance.w);
         }
     }
     eval_light(s, l, radiance, diffuse, specular);

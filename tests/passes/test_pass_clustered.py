@@ -211,3 +211,36 @@ def test_65536_lights_overflow_is_reported_and_the_image_stays_right(tmp_path):
     s = stats(bitmask)
     assert s["overflowed_froxels"] == 16 - 2 and s["references"] == 16 * 2048  # 2 froxels of 2,048 words fit
     assert np.abs(srgb_codes(bitmask) - b).max() <= 1
+
+
+@pytest.mark.vulkan
+def test_run_heatmap_timings_and_list_report(tmp_path, capsys):
+    """rgraph run clustered --heatmap: a PNG of lights per pixel, the per-stage GPU times and the
+    list statistics line; --heatmap on a graph without light_heat is one located error."""
+    import json
+
+    from rgraph.cli import main
+
+    heat, timings = tmp_path / "heat.png", tmp_path / "t.json"
+    args = ["run", "clustered", "--size", "64x36", "-p", "clusters.tile=16", "-p", "clusters.slices=8", "--validate"]
+    assert main([*args, "--heatmap", str(heat), "--timings", str(timings)]) == 0
+    err = capsys.readouterr().err
+    assert "rgraph: 0 validation message(s)" in err and "rgraph: light lists:" in err and "OVERFLOW" not in err
+    assert f"wrote heatmap {heat}" in err
+    passes = json.loads(timings.read_text())["passes"]
+    assert {"cluster_build", "light_assign", "forward", "heatmap"} <= set(passes)
+    png = heat.read_bytes()
+    assert png.startswith(b"\x89PNG") and len(png) > 100
+    assert main(["run", "surgery", "--size", "32x32", "--heatmap", str(tmp_path / "x.png")]) == 2
+    assert "--heatmap needs an output image 'light_heat'" in capsys.readouterr().err
+
+
+def test_heat_ramp_and_stats_line():
+    from rgraph.passes.cluster_report import RAMP, heat_rgba, stats_line
+
+    rgba, top = heat_rgba(np.array([[0.0, 1.0], [5.0, 10.0]]))
+    assert top == 10 and rgba[0, 0, :3].tolist() == [0, 0, 0] and rgba[1, 1, :3].tolist() == RAMP[-1].tolist()
+    assert np.all(rgba[..., 3] == 255) and rgba[1, 0, :3].tolist() == RAMP[2].tolist()
+    assert "not built" in stats_line({"references": 0, "overflowed_froxels": 0, "longest_list": 0, "capacity": 0})
+    line = stats_line({"references": 900, "overflowed_froxels": 3, "longest_list": 40, "capacity": 500})
+    assert "OVERFLOW: 3 froxel(s)" in line and "at least 900" in line

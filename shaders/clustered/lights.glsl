@@ -1,5 +1,5 @@
 // Physically bounded lights of the clustered passes (NumPy twin: passes/clustered_ref.py).
-// Needs scene/scene.glsl and forward/brdf.glsl first.
+// Needs scene/scene.glsl, forward/brdf.glsl and the `lights` array (Light[]) declared first.
 //
 // Point and spot lights: inverse square windowed to reach exactly zero at the radius (Karis 2013),
 //   falloff = clamp(1 - (d^2 / r^2)^2, 0, 1)^2 / max(d^2, 1e-6),  r = max(radius, 1e-6);

@@ -57,3 +57,15 @@ def test_bad_generators_are_located_errors(tmp_path, item, message):
     with pytest.raises(RGraphError) as err:
         load_scene(path)
     assert f"{path}:4:" in str(err.value) and message in str(err.value)
+
+
+def test_bundled_lighting_scenes():
+    from locations import ROOT
+
+    scenes = ROOT / "graphs" / "scenes"
+    test, many = load_scene_data(scenes / "lighting_test.yaml"), load_scene_data(scenes / "many_lights.yaml")
+    assert len(test.lights) == 25 and len(many.lights) == 4096
+    for data in (test, many):
+        boxes = next(m for m in data.meshes if m.name.endswith(":box"))
+        assert boxes.instances == 968 and data.draw_count == 969  # one instanced draw of 968 boxes + the floor
+        assert all(li.type == 1 and li.radius > 0 for li in data.lights)

@@ -29,6 +29,9 @@ from typing import Any
 
 import numpy as np
 
+from rgraph.resources import builtin_passes
+
+builtin_passes()  # rgraph.passes also from a plain checkout on PYTHONPATH (the GPU machines)
 ROOT = Path(__file__).resolve().parent.parent
 GRAPH = ROOT / "graphs" / "clustered.yaml"
 SCENES = ROOT / "graphs" / "scenes"

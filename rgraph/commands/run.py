@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
@@ -70,7 +71,9 @@ def _report_clusters(args: argparse.Namespace, outputs: dict) -> None:
     """Light-list statistics and the heatmap of a clustered graph (rgraph.passes.cluster_report)."""
     if "cluster_stats" not in outputs and not args.heatmap:
         return
-    from rgraph.passes import cluster_report
+    from rgraph.resources import builtin_passes
+
+    cluster_report = importlib.import_module(f"{builtin_passes().__name__}.cluster_report")
 
     if "cluster_stats" in outputs:
         print(cluster_report.stats_line(cluster_report.stats_of(outputs["cluster_stats"])), file=sys.stderr)

@@ -16,8 +16,11 @@ import numpy as np
 import pytest
 from clustered_helpers import graph_with_outputs, render, scene_file, srgb_codes, stats
 
-from rgraph.passes import clustered_ref as ref
-from rgraph.scene.build import load_scene_data
+from rgraph.resources import builtin_passes
+
+builtin_passes()  # rgraph.passes from a plain checkout too (the GPU machines)
+from rgraph.passes import clustered_ref as ref  # noqa: E402
+from rgraph.scene.build import load_scene_data  # noqa: E402
 
 SIZE = (64, 48)
 MIXED = """  - {type: directional, direction: [-0.3, -1, -0.2], intensity: 0.3}

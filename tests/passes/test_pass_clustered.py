@@ -7,7 +7,8 @@
 - hard cases, each clustered against all_lights within one 8-bit sRGB code after tonemapping:
   0 and 1 lights, 65,536 lights with an overflowing list (reported in cluster_stats), a light
   behind the camera reaching the frustum, radius 0 and 1e4, a light on a froxel corner, the camera
-  inside a light, near plane 1e-4, objects at 1e5 m.
+  inside a light, near plane 1e-4, objects at 1e5 m, spot lights (narrow, zero-width and
+  hemispherical cones).
 """
 
 from __future__ import annotations
@@ -163,6 +164,10 @@ CASES = {
     "camera_inside": ("  - {type: point, position: [0.2, 3.1, 9.8], radius: 20, intensity: 60}", {}, {}),
     "near_1e-4": ("  - {type: point, position: [0, 1, 2], radius: 4, intensity: 10}",
                   {"camera": "camera: {position: [0, 3, 10], look_at: [0, 0, 0], fov_y: 60, near: 0.0001}\n"}, {}),
+    "spots": ("  - {type: spot, position: [-2, 3, 2], direction: [0.3, -1, -0.1], cone: [10, 30], radius: 8, intensity: 300}\n"
+              "  - {type: spot, position: [2, 1, 6], direction: [-0.2, -0.3, -1], cone: [0, 5], radius: 15, intensity: 200}\n"
+              "  - {type: spot, position: [0, 0.3, 3], direction: [0, 1, 0], cone: [80, 90], radius: 5, intensity: 20}", {},
+              {"clusters.tile": "4", "clusters.slices": "16"}),  # froxels small against the cones
     "far_1e5": ("  - {type: point, position: [0, 12000, -88000], radius: 30000, intensity: 1e9}",
                 {"camera": "camera: {position: [0, 3, 10], look_at: [0, 0, -100000], fov_y: 60, near: 0.1}\n",
                  "meshes": FAR_MESHES}, {}),

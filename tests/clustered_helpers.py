@@ -48,7 +48,7 @@ def render(scene: Path, *, size=(64, 48), mode: str = "clustered", params: dict 
     from rgraph.vk.executor import execute_plan
 
     plan = compile_graph(graph, scene_path=scene, size=size,
-                         params={"lighting.mode": mode, "clusters.tile": "16", "clusters.slices": "8",
+                         params={"lighting.mode": mode, "clusters.tile": "8", "clusters.slices": "12",
                                  **(params or {})})
     result = execute_plan(plan, validate=True, frames=frames, read_outputs=True)
     assert [m.text for m in result.messages] == []

@@ -58,7 +58,8 @@ def _lists(outputs: dict, grid: ref.Grid, kind: str, lights: int) -> list[list[n
 def test_froxel_bounds_and_lists_match_the_reference(tmp_path, kind):
     scene = scene_file(tmp_path, MIXED)
     graph = graph_with_outputs(tmp_path, ("froxel_bounds", "light_grid", "light_indices"))
-    plan, out = render(scene, size=SIZE, graph=graph, params={"clusters.list": kind})
+    plan, out = render(scene, size=SIZE, graph=graph, params={"clusters.list": kind, "clusters.tile": "16",
+                                                             "clusters.slices": "8"})
     data = load_scene_data(scene, SIZE)
     grid = ref.grid_for(data, 16, 8)
     lo, hi = ref.froxel_bounds(grid)
@@ -135,10 +136,11 @@ meshes:
 
 
 def _boundary_light(tmp_path) -> str:
-    """A light exactly on a froxel corner: tile boundary x = 0 and y = 1/3 in NDC, at a slice start."""
+    """A light exactly on a froxel corner: tile boundaries x = 0 and y = 1/3 in NDC (8-pixel tiles of
+    64 x 48), at a slice start."""
     data = load_scene_data(scene_file(tmp_path, "", name="probe"), SIZE)
     cam = data.camera(0)
-    grid = ref.grid_for(data, 16, 8)
+    grid = ref.grid_for(data, 8, 12)  # clustered_helpers.render's grid
     starts = ref.slice_starts(grid)
     ray = np.array([0.0, (1 / 3) / cam.proj[1, 1], -1.0])  # view-space direction per unit distance
     world_ray = cam.inv_view[:3, :3] @ ray
@@ -155,7 +157,7 @@ meshes:
 """
 CASES = {
     "zero_lights": ("", {}, {}),
-    "one_light": ("  - {type: point, position: [0, 1, 2], radius: 4, intensity: 10}", {}, {}),
+    "one_light": ("  - {type: point, position: [0, 1, 2], radius: 4, intensity: 60}", {}, {}),
     "behind_camera": ("  - {type: point, position: [0, 3.87, 12.87], radius: 9, intensity: 800}", {}, {}),
     "radius_0": ("  - {type: point, position: [0, 0.5, 1.5], radius: 0, intensity: 10}\n"
                  "  - {type: spot, position: [0, 2, 0], radius: 0, intensity: 10}", {}, {}),
@@ -204,7 +206,7 @@ def test_65536_lights_overflow_is_reported_and_the_image_stays_right(tmp_path):
     lights = ("  - {generate: point, count: 65536, seed: 9, bounds: [[-6, 0.1, -6], [6, 2, 6]], radius: [0.2, 0.8],"
               " intensity: [0.02, 0.1]}")
     scene = scene_file(tmp_path, lights)
-    size, params = (32, 24), {"clusters.max_indices": "4096"}
+    size, params = (32, 24), {"clusters.max_indices": "4096", "clusters.tile": "16", "clusters.slices": "8"}
     _, clustered = render(scene, size=size, params=params)
     s = stats(clustered)
     assert s["capacity"] == 4096 and s["overflowed_froxels"] > 0 and s["references"] > 4096

@@ -57,6 +57,7 @@ def scene_with_lights(count: int, folder: Path) -> Path:
 def run_once(scene: Path, size: tuple[int, int], params: dict[str, str], frames: int) -> dict[str, Any]:
     from rgraph.passes.cluster_report import stats_of
     from rgraph.passes.tonemap_ref import srgb_codes
+
     from rgraph.vk.executor import execute_plan
     from rgraph.vk.memreq import compile_for_device
 

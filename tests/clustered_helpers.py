@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from ruamel.yaml import YAML
 from locations import ROOT
+from ruamel.yaml import YAML
 
 GRAPH = ROOT / "graphs" / "clustered.yaml"
 BASE_MESHES = """materials:

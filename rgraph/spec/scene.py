@@ -43,7 +43,7 @@ class Light(_Strict):
     cone: list[float] = Field(default_factory=lambda: [30.0, 45.0], min_length=2, max_length=2)  # spot: inner, outer (deg)
 
     @model_validator(mode="after")
-    def _cone_order(self) -> "Light":
+    def _cone_order(self) -> Light:
         inner, outer = self.cone
         if not 0 <= inner <= outer <= 90:
             raise ValueError(f"cone must be [inner, outer] degrees with 0 <= inner <= outer <= 90, got {self.cone}")
@@ -62,7 +62,7 @@ class LightGenerator(_Strict):
     color: Vec3 | None = Field(None, min_length=3, max_length=3)  # omitted: seeded random colours
 
     @model_validator(mode="after")
-    def _ranges(self) -> "LightGenerator":
+    def _ranges(self) -> LightGenerator:
         for name in ("radius", "intensity"):
             lo, hi = getattr(self, name)
             if not 0 <= lo <= hi:

@@ -21,6 +21,7 @@ from rgraph.resources import builtin_passes
 
 builtin_passes()  # rgraph.passes from a plain checkout too (the GPU machines)
 from rgraph.passes import clustered_ref as ref  # noqa: E402
+
 from rgraph.scene.build import load_scene_data  # noqa: E402
 
 SIZE = (64, 48)

@@ -20,6 +20,7 @@ EXTRA = """  - {generate: point, count: 200, seed: 11, bounds: [[-0.15, -0.1, 0.
 
 def _run(graph: str, scene, params: dict[str, str]):
     from rgraph.passes.tonemap_ref import srgb_codes
+
     from rgraph.vk.executor import execute_plan
 
     plan = compile_graph(graph, scene_path=scene, size=SIZE, params={"shadow.size": "256", **params})

@@ -187,7 +187,32 @@ class ProfileMemoryRequirements:
             size = predict_image(rule, entry["block_bytes"], entry["block_extent"], ext, mips, layers, samples)
         return size, int(entry["alignment"]), int(entry["memory_type_bits"])
 
+    def _accel_section(self) -> dict[str, Any]:
+        section = self.profile.get("accel")
+        if section is None:
+            raise self._error(f"device profile {self.name!r} has no acceleration-structure sizes (capture it with "
+                              "`rgraph device-profile` on a device with VK_KHR_acceleration_structure)")
+        return section
+
+    def accel_sizes(self, level: str, count: int, max_vertex: int, update: bool) -> tuple[int, int, int]:
+        from rgraph.accel_profile import predict
+
+        try:
+            return predict(self._accel_section(), level, count, max_vertex, update, self.name)
+        except RGraphError as err:
+            raise self._error(err.first.message) from None
+
+    def accel_scratch_alignment(self) -> int:
+        return int(self._accel_section()["scratch_alignment"])
+
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
+        accel = [u for u in usage_names if u.startswith("accel_")]
+        if accel:
+            rules = self._accel_section()["buffer"]
+            picked = [rules[u] for u in sorted(set(accel))]
+            align = max(r["alignment"] for r in picked)
+            return (align_up(max(int(size), 1), max(r["size_align"] for r in picked)), align,
+                    int(picked[0]["memory_type_bits"]))
         rule = self.profile["buffer"]
         usage_names = sorted({"storage_rw" if u.startswith("storage_") else u for u in usage_names})
         unknown = sorted(set(usage_names) - set(rule["alignment_by_usage"]))

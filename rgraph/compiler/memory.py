@@ -40,7 +40,8 @@ class ResourceMemory:
 
 
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
-_SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw"}
+_SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw",
+                     "accel_build": "accel_storage", "accel_read": "accel_storage"}
 
 
 def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:

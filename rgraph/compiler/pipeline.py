@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from rgraph.compiler import memory
+from rgraph.compiler.accel import size_accels
 from rgraph.compiler.memory import MemoryRequirementsProvider
 from rgraph.compiler.sync import synchronize
 from rgraph.errors import RGraphError
@@ -93,6 +94,7 @@ def _compile_spec(spec, policy, memory_provider, profile_name) -> dict[str, Any]
 
         memory_provider = ProfileMemoryRequirements.named(DEFAULT_PROFILE)
         profile_name = profile_name or DEFAULT_PROFILE
+    passes = size_accels(spec, passes, memory_provider)
     used = memory.usages_by_resource(passes)
     spans = memory.lifetimes(passes)
     reqs = memory.requirements(spec.resources, used, spec.outputs, memory_provider)

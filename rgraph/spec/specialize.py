@@ -17,7 +17,7 @@ from rgraph import formats
 from rgraph.errors import Location, RGraphError
 from rgraph.spec.expr import ExprError, parse_value
 from rgraph.spec.loader import GraphSource, Located
-from rgraph.spec.models import ImageResource, ScaleSize
+from rgraph.spec.models import AccelResource, ImageResource, ScaleSize
 from rgraph.spec.pydantic_errors import describe, did_you_mean
 from rgraph.spec.vocabulary import (
     QUEUE_PASS_KINDS,
@@ -54,6 +54,9 @@ class ResourceSpec:
     samples: int = 1
     bytes: int = 0
     loc: Location = field(default_factory=lambda: Location("?"))
+    geometry: str | None = None  # accels: "scene" | "probe"
+    accel: Any = None  # accels: rgraph.compiler.accel.AccelLayout once sized
+    scratch_of: str | None = None  # an accel's build scratch buffer: the accel
 
     @property
     def is_image(self) -> bool:
@@ -72,6 +75,7 @@ class AccessSpec:
     stages: tuple[str, ...] | None  # explicit shader stages, else derived from the pass kind
     optional: bool
     loc: Location
+    refit: bool = False  # accel_build of a persistent accel refitted each frame (reads it too)
 
 
 @dataclass(frozen=True)
@@ -223,6 +227,8 @@ def _outputs(source: GraphSource, resources: dict[str, ResourceSpec]) -> list[st
 
 def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits) -> ResourceSpec:
     model = loc.model
+    if isinstance(model, AccelResource):
+        return ResourceSpec(loc.name, "accel", model.lifetime, loc=loc.key_loc(), geometry=model.geometry)
     if not isinstance(model, ImageResource):
         nbytes = env.integer(model.bytes, loc, "bytes")
         if nbytes <= 0 or nbytes > limits.max_buffer_bytes:

@@ -25,7 +25,15 @@ _BUFFER_USAGE = {
     "uniform": "UNIFORM_BUFFER", "vertex": "VERTEX_BUFFER", "index": "INDEX_BUFFER",
     "indirect": "INDIRECT_BUFFER", "storage_read": "STORAGE_BUFFER", "storage_write": "STORAGE_BUFFER",
     "storage_rw": "STORAGE_BUFFER", "transfer_src": "TRANSFER_SRC", "transfer_dst": "TRANSFER_DST",
+    "accel_storage": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
+    "accel_build": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
+    "accel_read": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
+    "accel_scratch": "STORAGE_BUFFER|0x20000",
 }
+SHADER_DEVICE_ADDRESS = 0x20000  # VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT (core 1.2)
+MEMORY_ALLOCATE_DEVICE_ADDRESS = 0x2  # VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
+#: Buffer usages whose memory must be allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT.
+DEVICE_ADDRESS_USAGES = frozenset({"accel_storage", "accel_build", "accel_read", "accel_scratch"})
 
 
 def _const(name: str) -> int:
@@ -92,7 +100,11 @@ def buffer_usage(usages: Iterable[str]) -> int:
     for u in set(usages) | set(RUNTIME_USAGES):
         if u not in _BUFFER_USAGE:
             raise ExecutionError(f"usage {u!r} does not apply to buffers")
-        out |= _const(f"VK_BUFFER_USAGE_{_BUFFER_USAGE[u]}_BIT")
+        for bit in _BUFFER_USAGE[u].split("|"):
+            if bit.startswith("0x"):  # the binding lacks VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT
+                out |= int(bit, 16)
+            else:
+                out |= _const(f"VK_BUFFER_USAGE_{bit}" if bit.endswith("_KHR") else f"VK_BUFFER_USAGE_{bit}_BIT")
     return out
 
 

@@ -85,7 +85,8 @@ def layout_of(res: ResourceSpec, geometry: str, blas_counts, instances: int, upd
         offset = align_up(offset + size, AS_OFFSET_ALIGNMENT)
         blas_scratch += align_up(max(build, upd if update else 0), scratch_align)
     tlas_size, tlas_build, tlas_upd = provider.accel_sizes("top", instances, 0, update)
-    scratch = max(blas_scratch, align_up(max(tlas_build, tlas_upd if update else 0), scratch_align))
+    # + one alignment: the runtime rounds the scratch buffer's address up to it
+    scratch = max(blas_scratch, align_up(max(tlas_build, tlas_upd if update else 0), scratch_align)) + scratch_align
     per_frame = res.lifetime != "persistent" or update
     return AccelLayout(geometry, tuple(blas), instances, tlas_size, offset, offset + tlas_size,
                        scratch if per_frame else 0, update, scratch_align)

@@ -161,7 +161,7 @@ def _query_features(handle: Any) -> tuple[Any, Any, Any, Any]:
 
 
 def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True,
-                  ray_tracing: bool = False) -> Device:
+                  ray_tracing: bool = False, rt_pipelines: bool = False) -> Device:
     """Choose a physical device, check required features, create the queues. ``ray_tracing``
     enables acceleration structures, ray tracing pipelines and buffer device addresses
     (``rgraph.vk.rt_device``)."""
@@ -197,7 +197,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
     if ray_tracing:
         from rgraph.vk import rt_device
 
-        head, extensions = rt_device.chain(physical.handle, physical.name, e12)
+        head, extensions = rt_device.chain(physical.handle, physical.name, e12, bind2=rt_pipelines)
     enabled = v.VkPhysicalDeviceFeatures2(pNext=head, features=core_features)
     info = v.VkDeviceCreateInfo(
         pNext=enabled, queueCreateInfoCount=len(queue_infos), pQueueCreateInfos=queue_infos,
@@ -217,6 +217,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},
         capabilities={q: _capabilities(families[f].queueFlags) for q, f in plan_families.items()},
     )
+    device.__dict__["extensions"] = tuple(extensions)
     return device
 
 

@@ -43,18 +43,26 @@ def _const(name: str) -> int:
         raise ExecutionError(f"unknown Vulkan name {name}") from None
 
 
+def _bit_name(prefix: str, name: str) -> str:
+    """``RAY_TRACING_SHADER_KHR`` -> ``..._RAY_TRACING_SHADER_BIT_KHR`` (vendor suffix after BIT)."""
+    for suffix in ("_KHR", "_EXT", "_NV"):
+        if name.endswith(suffix):
+            return f"{prefix}{name[:-len(suffix)]}_BIT{suffix}"
+    return f"{prefix}{name}_BIT"
+
+
 @cache
 def stage(name: str) -> int:
     if name == "NONE":
         return 0
-    return _const(f"VK_PIPELINE_STAGE_2_{name}_BIT")
+    return _const(_bit_name("VK_PIPELINE_STAGE_2_", name))
 
 
 @cache
 def access(name: str) -> int:
     if name == "NONE":
         return 0
-    return _const(f"VK_ACCESS_2_{name}_BIT")
+    return _const(_bit_name("VK_ACCESS_2_", name))
 
 
 @cache

@@ -568,7 +568,7 @@ class Executor:
         s = (frames - 1) % FRAMES_IN_FLIGHT
         out: dict[tuple, bytes] = {}
         wanted = [r for r in self.plan["resources"] if r["lifetime"] in ("output", "persistent", "imported")
-                  and r.get("first") is not None]
+                  and r.get("first") is not None and r["kind"] != "accel"]  # accels: checked through traces
         by_queue: dict[str, list[dict]] = {}
         for res in wanted:
             by_queue.setdefault(res["final"]["queue"], []).append(res)

@@ -163,6 +163,7 @@ class Executor:
             if p.get("impl"):
                 self.passes.append(ImplPass(dev, self.plan, p, self.resources, sets=FRAMES_IN_FLIGHT,
                                             scene=self._scene, samplers=self.samplers))
+                self.passes[-1].setup.accels = self.accels  # rgraph.vk.accel.AccelSet (impl accel_build)
             else:
                 self.passes.append(probe_pass(dev, self.plan, p, self.resources, self.sampler, self.accels))
         self.updaters = [p for p in self.passes if isinstance(p, ImplPass) and _overrides_update(p)]

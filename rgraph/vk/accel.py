@@ -111,14 +111,17 @@ class AccelSet:
         self.buffers: list[AddressBuffer] = []
         self.built: dict[tuple[str, int], BuiltAccel] = {}
         self.layouts: dict[str, dict] = {}
+        self.compacted: dict[str, list[int]] = {}  # persistent accels: each BLAS's compacted bytes
         self.inputs: dict[str, tuple[Geometry, list[tuple[int, int]]]] = {}
         for res in plan["resources"]:
             if res["kind"] != "accel":
                 continue
             self.layouts[res["name"]] = res["accel"]
             self._create(res)
-            if res["lifetime"] in SHARED:
+            if res["lifetime"] in SHARED and res["accel"]["refit"]:
                 one_time("compute", lambda cb, name=res["name"]: self._initial_build(cb, name))
+            elif res["lifetime"] in SHARED:
+                self._compacted_build(res["name"], one_time)
 
     # ------------------------------------------------------------------ setup
     def geometry(self, res: dict) -> Geometry:
@@ -178,6 +181,104 @@ class AccelSet:
     def tlas(self, name: str, set_index: int) -> Any:
         return self.built[(name, set_index)].tlas
 
+    def _compacted_build(self, name: str, one_time) -> None:
+        """Build-once accels: BLAS built with ALLOW_COMPACTION in a temporary buffer, compacted
+        into the plan's buffer at the plan's offsets (compacted <= built size), then the TLAS."""
+        v = vk()
+        layout = self.layouts[name]
+        built = self.built[(name, 0)]
+        geo, addresses = self.inputs[name]
+        align = int(layout["scratch_alignment"])
+        sizes = [query(self.device, "bottom", b["triangles"], b["max_vertex"], compact=True) for b in layout["blas"]]
+        offsets, total = [], 0
+        for size, _, _ in sizes:
+            offsets.append(total)
+            total = -(-(total + size) // 256) * 256
+        temp = AddressBuffer.create(self.device, total, 0x100000)  # ACCELERATION_STRUCTURE_STORAGE
+        scratch_bytes = sum(-(-s[1] // align) * align for s in sizes)
+        tlas_scratch = query(self.device, "top", layout["tlas"]["instances"], 0)[1]
+        scratch = AddressBuffer.create(self.device, max(scratch_bytes, tlas_scratch) + align, 0x20)
+        self.buffers += [temp, scratch]
+        scratch_address = -(-scratch.address // align) * align
+        create = proc(self.device, "vkCreateAccelerationStructureKHR")
+        destroy = proc(self.device, "vkDestroyAccelerationStructureKHR")
+        temps = [create(self.device.handle, v.VkAccelerationStructureCreateInfoKHR(
+            buffer=temp.host.handle, offset=o, size=s[0], type=v.VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR), None)
+            for o, s in zip(offsets, sizes, strict=True)]
+        pool = v.vkCreateQueryPool(self.device.handle, v.VkQueryPoolCreateInfo(
+            queryType=v.VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, queryCount=len(temps)), None)
+        v.vkResetQueryPool(self.device.handle, pool, 0, len(temps))
+        fn = proc(self.device, "vkCmdBuildAccelerationStructuresKHR")
+
+        def build(cb: Any) -> None:
+            infos, keep, offset = [], [], 0
+            for i, ((positions, _), (va, ia)) in enumerate(zip(geo.meshes, addresses, strict=True)):
+                geometry = v.ffi.new("VkAccelerationStructureGeometryKHR[1]",
+                                     [triangles_geometry(va, ia, len(positions) - 1)])
+                keep.append(geometry)
+                infos.append(v.VkAccelerationStructureBuildGeometryInfoKHR(
+                    type=v.VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, flags=build_flags(False, True),
+                    mode=v.VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR, dstAccelerationStructure=temps[i],
+                    geometryCount=1, pGeometries=geometry,
+                    scratchData=v.VkDeviceOrHostAddressKHR(deviceAddress=scratch_address + offset)))
+                offset += -(-sizes[i][1] // align) * align
+            self._build(fn, cb, infos, [len(m[1]) for m in geo.meshes], keep)
+            self._build_barrier(cb)
+            handles = v.ffi.new("VkAccelerationStructureKHR[]", temps)
+            proc(self.device, "vkCmdWriteAccelerationStructuresPropertiesKHR")(
+                cb, len(temps), handles, v.VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, pool, 0)
+
+        one_time("compute", build)
+        results = v.ffi.new("uint64_t[]", len(temps))
+        v.vkGetQueryPoolResults(self.device.handle, pool, 0, len(temps), 8 * len(temps), results, 8,
+                                v.VK_QUERY_RESULT_64_BIT | v.VK_QUERY_RESULT_WAIT_BIT)
+        v.vkDestroyQueryPool(self.device.handle, pool, None)
+        compacted = [int(results[i]) for i in range(len(temps))]
+        res_buf = self.resources.get(name, 0)
+        for i, b in enumerate(layout["blas"]):  # the plan's BLAS objects, now of their compacted size
+            if compacted[i] > b["bytes"]:
+                raise ExecutionError(f"accel {name!r}: compacted BLAS {i} ({compacted[i]} bytes) exceeds its "
+                                     f"plan size {b['bytes']}")
+            destroy(self.device.handle, built.blas[i], None)
+            built.blas[i] = create(self.device.handle, v.VkAccelerationStructureCreateInfoKHR(
+                buffer=res_buf.handle, offset=b["offset"], size=compacted[i],
+                type=v.VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR), None)
+        built.instances.host.write(pack_instances(geo.instances, [self._address(h) for h in built.blas]))
+        self.compacted[name] = compacted
+
+        def compact(cb: Any) -> None:
+            copy = proc(self.device, "vkCmdCopyAccelerationStructureKHR")
+            infos = [v.VkCopyAccelerationStructureInfoKHR(src=t, dst=d, mode=v.VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR)
+                     for t, d in zip(temps, built.blas, strict=True)]
+            for info in infos:
+                copy(cb, info)
+            self._build_barrier(cb)
+            geometry = v.ffi.new("VkAccelerationStructureGeometryKHR[1]", [instances_geometry(built.instances.address)])
+            tlas = v.VkAccelerationStructureBuildGeometryInfoKHR(
+                type=v.VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, flags=build_flags(False, False),
+                mode=v.VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR, dstAccelerationStructure=built.tlas,
+                geometryCount=1, pGeometries=geometry,
+                scratchData=v.VkDeviceOrHostAddressKHR(deviceAddress=scratch_address))
+            self._build(fn, cb, [tlas], [len(geo.instances)], [geometry, infos])
+
+        one_time("compute", compact)
+        for t in temps:
+            destroy(self.device.handle, t, None)
+
+    def _build_barrier(self, cb: Any) -> None:
+        """Inside a build: structures written -> read by the next build/copy, scratch reused."""
+        v = vk()
+        barrier = v.VkMemoryBarrier2(
+            srcStageMask=(v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR
+                          | v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_COPY_BIT_KHR),
+            srcAccessMask=v.VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+            dstStageMask=(v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR
+                          | v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_COPY_BIT_KHR),
+            dstAccessMask=(v.VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR
+                           | v.VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR))
+        dependency = v.VkDependencyInfo(memoryBarrierCount=1, pMemoryBarriers=[barrier])
+        v.vkCmdPipelineBarrier2(cb, dependency)
+
     # ------------------------------------------------------------------ record
     def _initial_build(self, cb: Any, name: str) -> None:
         layout = self.layouts[name]
@@ -213,21 +314,14 @@ class AccelSet:
             offset += -(-(sizes[2] if update else sizes[1]) // align) * align
             ranges.append(len(indices))
         self._build(fn, cb, infos, ranges, keep)
-        barrier = v.VkMemoryBarrier2(
-            srcStageMask=v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-            srcAccessMask=v.VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
-            dstStageMask=v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-            dstAccessMask=(v.VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR
-                           | v.VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR))
-        dependency = v.VkDependencyInfo(memoryBarrierCount=1, pMemoryBarriers=[barrier])
-        v.vkCmdPipelineBarrier2(cb, dependency)  # inside the build: BLAS -> TLAS, scratch reuse
+        self._build_barrier(cb)  # inside the build: BLAS -> TLAS, scratch reuse
         geometry = v.ffi.new("VkAccelerationStructureGeometryKHR[1]", [instances_geometry(built.instances.address)])
         tlas_info = v.VkAccelerationStructureBuildGeometryInfoKHR(
             type=v.VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, flags=build_flags(refit, False), mode=mode,
             srcAccelerationStructure=built.tlas if update else None, dstAccelerationStructure=built.tlas,
             geometryCount=1, pGeometries=geometry,
             scratchData=v.VkDeviceOrHostAddressKHR(deviceAddress=scratch_address))
-        self._build(fn, cb, [tlas_info], [len(geo.instances)], [geometry, barrier, dependency])
+        self._build(fn, cb, [tlas_info], [len(geo.instances)], [geometry])
 
     @staticmethod
     def _build(fn: Any, cb: Any, infos: list[Any], counts: list[int], keep: list[Any]) -> None:

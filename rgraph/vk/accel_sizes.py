@@ -46,7 +46,7 @@ def build_flags(update: bool, compact: bool) -> int:
     return flags
 
 
-def query(device: Any, level: str, count: int, max_vertex: int = 0, update: bool = False,
+def query(device: Any, level: str, count: int, max_vertex: int = 0, update: bool = False, *,
           compact: bool = False) -> tuple[int, int, int]:
     """(accelerationStructureSize, buildScratchSize, updateScratchSize) of one BLAS of ``count``
     triangles over ``max_vertex + 1`` vertices, or of a TLAS of ``count`` instances."""

@@ -25,12 +25,25 @@ def _run(plan, **kw):
         pytest.skip(str(exc))
 
 
-@pytest.mark.parametrize("name", ["rt_probe", "rt_refit", "rt_rebuild"])
+@pytest.mark.parametrize("name", ["rt_probe", "rt_refit", "rt_rebuild", "rt_static"])
 def test_probe_traces_match_the_simulation(name, memory):
     plan = compile_graph(RT / f"{name}.yaml", size=(32, 32), memory=memory)
     result = _run(plan, frames=3, check_data=True)
     assert result.data_ok, [str(m) for m in result.mismatches]
     assert not result.unchecked
+
+
+def test_build_once_accels_are_compacted(memory):
+    from rgraph.vk.executor import Executor
+
+    plan = compile_graph(RT / "rt_static.yaml", size=(32, 32), memory=memory)
+    executor = Executor(plan, validate=False, device_index=None, verbose=False)
+    try:
+        compacted = executor.accels.compacted["scene_as"]
+    finally:
+        executor.close()
+    blas = next(r for r in plan["resources"] if r["name"] == "scene_as")["accel"]["blas"]
+    assert len(compacted) == len(blas) and all(0 < c <= b["bytes"] for c, b in zip(compacted, blas, strict=True))
 
 
 def test_a_wrong_ray_fails_the_data_check(memory, monkeypatch):

@@ -61,7 +61,8 @@ def pack_tables(data) -> dict[str, bytes]:
 def frame_constants(data, size: tuple[int, int], max_depth: int) -> bytes:
     _cam, basis, tan_half = camera_basis(data)
     right, up, fwd = basis
-    return struct.pack("<12f4I", *right, tan_half, *up, size[0] / size[1], *fwd, 0.0, size[0], size[1], max_depth,
+    near = float(data.model.camera.near)
+    return struct.pack("<12f4I", *right, tan_half, *up, size[0] / size[1], *fwd, near, size[0], size[1], max_depth,
                        min(len(data.lights), MAX_LIGHTS))
 
 

@@ -115,13 +115,12 @@ class Tables:
 
 
 def camera_basis(data: SceneData) -> tuple[np.ndarray, np.ndarray, float]:
+    """Camera world position, (right, up, forward) rows as the raster camera's view matrix."""
+    from rgraph.scene.camera import orthonormal_basis
+
     c = data.model.camera
     pos = np.asarray(c.position, dtype=np.float64)
-    fwd = np.asarray(c.look_at, dtype=np.float64) - pos
-    fwd /= np.linalg.norm(fwd)
-    right = np.cross(fwd, np.asarray(c.up, dtype=np.float64))
-    right /= np.linalg.norm(right)
-    up = np.cross(right, fwd)
+    right, up, fwd = orthonormal_basis(np.asarray(c.look_at, dtype=np.float64) - pos, c.up)
     return pos, np.stack([right, up, fwd]), float(np.tan(np.radians(c.fov_y) / 2.0))
 
 

@@ -49,6 +49,8 @@ def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
     for p in passes:
         for a in p.accesses:
             out.setdefault(a.resource, set()).add(a.usage)
+            if a.usage == "indirect" and p.kind == "raytrace":  # vkCmdTraceRaysIndirectKHR: a device address
+                out[a.resource].add("trace_indirect")
     return out
 
 

@@ -45,6 +45,6 @@ def capture_accel(device: Device) -> dict[str, Any]:
         levels[level] = {"samples": samples, "rules": fit_level(samples)}
     return {
         "scratch_alignment": properties(device.physical.handle).min_scratch_offset_alignment,
-        "buffer": {u: _buffer_rule(req, u) for u in ("accel_storage", "accel_scratch")},
+        "buffer": {u: _buffer_rule(req, u) for u in ("accel_storage", "accel_scratch", "trace_indirect")},
         **levels,
     }

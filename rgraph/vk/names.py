@@ -29,11 +29,12 @@ _BUFFER_USAGE = {
     "accel_build": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
     "accel_read": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
     "accel_scratch": "STORAGE_BUFFER|0x20000",
+    "trace_indirect": "INDIRECT_BUFFER|0x20000",
 }
 SHADER_DEVICE_ADDRESS = 0x20000  # VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT (core 1.2)
 MEMORY_ALLOCATE_DEVICE_ADDRESS = 0x2  # VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
 #: Buffer usages whose memory must be allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT.
-DEVICE_ADDRESS_USAGES = frozenset({"accel_storage", "accel_build", "accel_read", "accel_scratch"})
+DEVICE_ADDRESS_USAGES = frozenset({"accel_storage", "accel_build", "accel_read", "accel_scratch", "trace_indirect"})
 
 
 def _const(name: str) -> int:

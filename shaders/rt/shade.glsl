@@ -1,5 +1,10 @@
-// The ray tree (needs payloads `hit` at location 0 and `visible` at location 1).
+// The ray tree (needs payloads `hit` at location 0 and `visible` at location 1), walked depth
+// first with an explicit stack: passes/rt_ref.py trace_pixel, line for line.
 const uint MAX_STACK = 17u;
+
+struct Ray { vec3 o; vec3 d; vec3 w; uint depth; };
+Ray stack[MAX_STACK];
+uint top = 0u;
 
 Hit trace_closest(vec3 o, vec3 d) {
     hit.t = -1.0;
@@ -34,14 +39,30 @@ vec3 shade_local(vec3 p, vec3 ng, vec3 ns, vec3 d, uint m) {
     return c;
 }
 
-struct Ray { vec3 o; vec3 d; vec3 w; uint depth; };
+// Push the reflection/refraction rays of a surface hit by `r` (facing normals ngf/nsf).
+void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m) {
+    if (r.depth + 1u >= frame.counts.z || top + 2u > MAX_STACK) return;
+    vec4 k = mat[2u * m + 1u];  // kr kt ior n
+    vec3 reflect_w = r.w * k.x;
+    if (k.y > 0.0) {
+        float eta = entering ? 1.0 / k.z : k.z;
+        float cos_i = -dot(r.d, nsf);
+        float kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        if (kk < 0.0) reflect_w += r.w * k.y;  // total internal reflection
+        else {
+            vec3 t = eta * r.d + (eta * cos_i - sqrt(kk)) * nsf;
+            stack[top++] = Ray(offset_ray(p, -ngf), safe_normalize(t, r.d), r.w * k.y * mat[2u * m].rgb, r.depth + 1u);
+        }
+    }
+    if (max(reflect_w.x, max(reflect_w.y, reflect_w.z)) > 0.0) {
+        vec3 refl = r.d - 2.0 * dot(r.d, nsf) * nsf;
+        stack[top++] = Ray(offset_ray(p, ngf), safe_normalize(refl, ngf), reflect_w, r.depth + 1u);
+    }
+}
 
-vec3 trace_tree(vec3 o0, vec3 d0, vec3 w0, uint depth0) {
-    Ray stack[MAX_STACK];
-    uint top = 0u;
-    stack[top++] = Ray(o0, d0, w0, depth0);
+// Radiance of every ray on the stack and of their descendants.
+vec3 walk() {
     vec3 color = vec3(0.0);
-    uint max_depth = frame.counts.z;
     while (top > 0u) {
         Ray r = stack[--top];
         Hit h = trace_closest(r.o, r.d);
@@ -51,25 +72,16 @@ vec3 trace_tree(vec3 o0, vec3 d0, vec3 w0, uint depth0) {
         surface(h, r.d, ng, ns, m);
         bool entering = dot(r.d, ng) < 0.0;
         vec3 ngf = entering ? ng : -ng, nsf = entering ? ns : -ns;
-        vec4 k = mat[2u * m + 1u];  // kr kt ior n
+        vec4 k = mat[2u * m + 1u];
         float opaque = 1.0 - k.x - k.y;
         if (opaque > 0.0) color += r.w * opaque * shade_local(p, ngf, nsf, r.d, m);
-        if (r.depth + 1u >= max_depth || top + 2u > MAX_STACK) continue;
-        vec3 reflect_w = r.w * k.x;
-        if (k.y > 0.0) {
-            float eta = entering ? 1.0 / k.z : k.z;
-            float cos_i = -dot(r.d, nsf);
-            float kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-            if (kk < 0.0) reflect_w += r.w * k.y;  // total internal reflection
-            else {
-                vec3 t = eta * r.d + (eta * cos_i - sqrt(kk)) * nsf;
-                stack[top++] = Ray(offset_ray(p, -ngf), safe_normalize(t, r.d), r.w * k.y * mat[2u * m].rgb, r.depth + 1u);
-            }
-        }
-        if (max(reflect_w.x, max(reflect_w.y, reflect_w.z)) > 0.0) {
-            vec3 refl = r.d - 2.0 * dot(r.d, nsf) * nsf;
-            stack[top++] = Ray(offset_ray(p, ngf), safe_normalize(refl, ngf), reflect_w, r.depth + 1u);
-        }
+        push_children(r, p, ngf, nsf, entering, m);
     }
     return color;
+}
+
+vec3 camera_ray(uvec2 px) {
+    float sx = (2.0 * (float(px.x) + 0.5) / float(frame.counts.x) - 1.0) * frame.right.w * frame.up.w;
+    float sy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(frame.counts.y)) * frame.right.w;
+    return normalize(frame.forward.xyz + sx * frame.right.xyz + sy * frame.up.xyz);
 }

@@ -73,7 +73,7 @@ class Classify(PassImpl):
         super().__init__(setup)
         from rgraph.scene.build import load_scene_data
 
-        data = load_scene_data(setup.plan["scene_source"], setup.size)
+        data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
         mask = needs_secondary_rays(data.materials).tobytes()
         flags = setup.host_buffer(len(mask), "storage")
         flags.write(mask)

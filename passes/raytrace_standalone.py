@@ -99,7 +99,7 @@ class RayTracingImpl(PassImpl):
 
         if not setup.plan.get("scene_source"):
             raise ValueError(f"pass {setup.name!r}: ray tracing needs a scene (--scene)")
-        self.data = load_scene_data(setup.plan["scene_source"], setup.size)
+        self.data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
         tables = pack_tables(self.data)
         bindings = []
         for i, name in enumerate(TABLES):

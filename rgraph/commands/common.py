@@ -32,6 +32,7 @@ def add_graph_arguments(parser: argparse.ArgumentParser, *, size_default: str = 
     parser.add_argument("--scene", help="scene file (default: the graph's own 'scene:', else every feature present)")
     parser.add_argument("-p", "--param", action="append", metavar="NAME=VALUE", help="override a graph param")
     parser.add_argument("--size", default=size_default, help=f"output size WxH (default {size_default})")
+    parser.add_argument("--camera", type=int, default=0, help="camera preset N of the scene's 'cameras' (default 0)")
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
@@ -57,4 +58,5 @@ def compile_from_args(args: argparse.Namespace) -> dict:
         policy=getattr(args, "policy", None),
         profile=getattr(args, "profile", None),
         sync=getattr(args, "sync", "normal"),
+        camera=getattr(args, "camera", 0),
     )

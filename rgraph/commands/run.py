@@ -43,7 +43,8 @@ def _load_plan(args: argparse.Namespace) -> dict:
     from rgraph.vk.memreq import compile_for_device
 
     return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
-                              size=parse_size(args.size), policy=args.policy, sync=args.sync)
+                              size=parse_size(args.size), policy=args.policy, sync=args.sync,
+                              camera=args.camera)
 
 
 def _print_table(plan: dict, timings: dict) -> None:

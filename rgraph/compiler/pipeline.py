@@ -138,6 +138,7 @@ def compile_graph(
     profile: str | None = None,
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
+    camera: int = 0,
 ) -> dict[str, Any]:
     """Compile a graph file (or bundled graph name) into a plan dict.
 
@@ -157,7 +158,22 @@ def compile_graph(
         profile_name = provider.name
     chosen = policy or front.source.memory_policy or DEFAULT_POLICY
     plan = compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name)
+    if camera:
+        plan["camera"] = check_camera(front.scene, camera)
     return apply_sync_mode(plan, sync)
+
+
+def check_camera(scene: Scene | None, camera: int) -> int:
+    """``--camera N`` against the scene's presets (FORMAT.md 7); the plan records it."""
+    from rgraph.scene.build import pick_camera
+
+    if scene is None:
+        raise RGraphError.in_file("<command line>", f"--camera {camera}: the graph has no scene")
+    try:
+        pick_camera(scene.model, camera)
+    except ValueError as exc:
+        raise RGraphError.in_file("<command line>", f"--camera: {exc}") from None
+    return camera
 
 
 SYNC_MODES = ("normal", "naive")

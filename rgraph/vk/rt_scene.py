@@ -18,7 +18,7 @@ def scene_geometry(plan: dict):
     source = plan.get("scene_source")
     if not source:
         raise ExecutionError("an accel over the scene needs a scene (--scene)")
-    data = load_scene_data(source, tuple(plan.get("size") or (64, 64)))
+    data = load_scene_data(source, tuple(plan.get("size") or (64, 64)), int(plan.get("camera", 0)))
     cam = np.asarray(data.camera(0).position, dtype=np.float64)
     meshes = [(m.data.positions.astype(np.float32), m.data.indices.astype(np.uint32)) for m in data.meshes]
     instances = []

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rgraph.scene.build import AMBIENT, SceneData
+from rgraph.scene.build import SceneData
 from rgraph.scene.camera import model_matrix
 
 SKY_ZENITH = np.array([0.20, 0.40, 0.90])

@@ -19,6 +19,7 @@ from rgraph.probe.simulate import simulate
 from rgraph.probe.values import codec, initial_value, modulus
 from rgraph.stages import CAPABILITIES, fit_to_queue
 from rgraph.vk import names
+from rgraph.vk.accel import AccelSet
 from rgraph.vk.after_reads import src_additions
 from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
@@ -27,7 +28,6 @@ from rgraph.vk.instance import Instance, ValidationMessage, create_instance
 from rgraph.vk.layer_races import avoid_layer_races, touched_resources
 from rgraph.vk.loader import vk
 from rgraph.vk.packed_ranges import partial_handoffs
-from rgraph.vk.accel import AccelSet
 from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
 from rgraph.vk.probe_rt import needs_ray_tracing, probe_pass, refuse_layer_for_ray_tracing
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png

@@ -86,10 +86,8 @@ class DeviceMemoryRequirements:
 def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceMemoryRequirements, Device]]:
     """The memory-requirements provider of the live device that ``execute_plan(...,
     device_index=device_index)`` will use, and that device; both destroyed on exit."""
-    from rgraph.vk.device import create_device
+    from rgraph.vk.device import choose_physical_device, create_device, list_physical_devices
     from rgraph.vk.instance import create_instance
-
-    from rgraph.vk.device import choose_physical_device, list_physical_devices
     from rgraph.vk.rt_device import supported
 
     instance = create_instance(validate=False)

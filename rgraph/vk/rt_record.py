@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from rgraph.vk.loader import vk
 from rgraph.vk.rt_device import proc
 
 

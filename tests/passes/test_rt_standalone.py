@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from ruamel.yaml import YAML
 from locations import ROOT
+from ruamel.yaml import YAML
 
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.resources import builtin_passes

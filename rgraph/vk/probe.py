@@ -109,8 +109,12 @@ class ProbePass:
         if plan_pass["kind"] == "transfer":
             self._prepare_transfer()
         else:
-            self.shaders = generate(plan_pass, self.res_plan, self.plan_size)
-            self._prepare_pipeline()
+            self._prepare_shaders()
+
+    def _prepare_shaders(self) -> None:
+        """Shaders and pipeline of a compute or raster pass (ray tracing: ``rgraph.vk.probe_rt``)."""
+        self.shaders = generate(self.p, self.res_plan, self.plan_size)
+        self._prepare_pipeline()
 
     # ------------------------------------------------------------------ setup
     def _own(self, destroy: str, handle: Any) -> Any:

@@ -75,21 +75,13 @@ class AccelBuildProbePass(ProbePass):
 
 class RayTraceProbePass(ProbePass):
     def __init__(self, device, plan, plan_pass, resources, sampler, accels: AccelSet | None) -> None:
-        self.device = device
-        self.plan = plan
-        self.p = plan_pass
-        self.resources = resources
-        self.sampler = sampler
         self.accels = accels
-        self.res_plan = {r["name"]: r for r in plan["resources"]}
-        self.plan_size = tuple(plan.get("size") or (64, 64))
-        self.objects: list[tuple[str, Any]] = []
-        self.host_buffers = []
-        self.sets: list[Any] = []
-        self.framebuffers: list[list[Any]] = []
-        self.rt = generate_rt(plan_pass, self.res_plan, self.plan_size)
-        if self.rt.accel_bindings and accels is None:
-            raise ExecutionError(f"pass {plan_pass['name']!r}: reads an accel the plan does not build")
+        super().__init__(device, plan, plan_pass, resources, sampler)
+
+    def _prepare_shaders(self) -> None:
+        self.rt = generate_rt(self.p, self.res_plan, self.plan_size)
+        if self.rt.accel_bindings and self.accels is None:
+            raise ExecutionError(f"pass {self.p['name']!r}: reads an accel the plan does not build")
         self.shaders = self.rt.base
         self._prepare_rt()
 

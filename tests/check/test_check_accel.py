@@ -60,3 +60,19 @@ def test_every_accel_barrier_mutant_is_caught_by_check(name):
     assert accel
     for m in accel:
         assert check_plan(m.plan), f"mutant {m.name} not caught"
+
+
+@pytest.mark.vulkan
+def test_rgraph_mutate_on_a_ray_tracing_graph_catches_every_mutant(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    out = tmp_path / "m.json"
+    run = subprocess.run([sys.executable, "-m", "rgraph", "mutate", str(RT / "rt_rebuild.yaml"), "--size", "16x16",
+                          "-q", "--json", str(out)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    report = json.loads(out.read_text())
+    assert report["baseline"]["caught_by"] == []
+    assert report["baseline"]["data_ok"] is True and report["oracles"] == ["check", "data"]
+    assert report["mutants"] and all(m["caught_by"] for m in report["mutants"])

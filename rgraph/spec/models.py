@@ -87,6 +87,8 @@ class Pass(_Strict):
     impl: str | None = Field(None, description="A registered implementation; omitted -> the probe.")
     queue: QueueName = "graphics"
     requires: list[SceneFeature] = Field(default_factory=list)
+    requires_any: list[SceneFeature] = Field(
+        default_factory=list, description="The pass is removed when the scene has none of these features.")
     side_effects: bool = False
     reads: dict[str, UsageValue] = Field(default_factory=dict)
     writes: dict[str, UsageValue] = Field(default_factory=dict)

@@ -120,8 +120,6 @@ def features_of(scene: SceneFile) -> dict[str, int]:
         "transparent_materials": sum(1 for m in mats if m.opacity < 1),
         "deformable_meshes": sum(1 for m in scene.meshes if m.deformable),
         "large_world": int(far > LARGE_WORLD_METERS),
-        # materials that spawn reflection or refraction rays (ray tracing: reflective or refractive)
-        "secondary_rays": sum(1 for m in mats if m.reflective > 0 or m.refractive > 0),
     }
     assert set(feats) == set(SCENE_FEATURES)
     return feats

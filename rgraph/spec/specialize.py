@@ -90,6 +90,7 @@ class PassSpec:
     accesses: tuple[AccessSpec, ...]
     params: Mapping[str, Any]
     loc: Location
+    requires_any: tuple[str, ...] = ()  # removed when the scene has none of these
 
 
 @dataclass
@@ -196,6 +197,8 @@ def specialize(
         missing = [f for f in spec.requires if not features.get(f)]
         if missing:
             removed.append((name, "scene has no " + " and no ".join(missing)))
+        elif spec.requires_any and not any(features.get(f) for f in spec.requires_any):
+            removed.append((name, "scene has none of " + ", ".join(spec.requires_any)))
         passes.append(spec)
     _check_program_order(passes, resources)
     return Spec(
@@ -333,6 +336,7 @@ def _pass(name: str, order: int, located: Located, resources: dict[str, Resource
         queue=model.queue,
         impl=model.impl,
         requires=tuple(model.requires),
+        requires_any=tuple(model.requires_any),
         side_effects=model.side_effects,
         accesses=tuple(accesses),
         params=dict(model.params),

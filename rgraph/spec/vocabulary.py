@@ -32,7 +32,7 @@ ShaderStage = Literal[
 ]
 SceneFeature = Literal[
     "lights", "point_lights", "shadow_lights", "sss_materials", "decals", "reflective_materials",
-    "refractive_materials", "transparent_materials", "deformable_meshes", "large_world", "secondary_rays",
+    "refractive_materials", "transparent_materials", "deformable_meshes", "large_world",
 ]
 
 USAGES: tuple[str, ...] = get_args(UsageName)

@@ -131,8 +131,14 @@ class RayTraceProbePass(ProbePass):
 
     def record(self, ctx: RecordContext, set_index: int) -> None:
         ctx.bind(self.pipeline, [self.sets[set_index]] if self.sets else [])
-        w, h = self.shaders.domain
-        ctx.trace_rays(self.pipeline, w, h)
+        indirect = [self._resource(i, set_index) for i in self.shaders.indirect_accesses]
+        if len(indirect) > 1:
+            raise ExecutionError(f"pass {self.p['name']!r}: the probe traces through one indirect buffer")
+        if indirect:  # the header's dispatch words (gx, gy, 1): the raygen loop covers the domain
+            ctx.trace_rays_indirect(self.pipeline, ctx.buffer_address(indirect[0].handle) + 4 * 12)
+        else:
+            w, h = self.shaders.domain
+            ctx.trace_rays(self.pipeline, w, h)
 
     def destroy(self) -> None:
         self.pipeline.destroy()

@@ -15,7 +15,7 @@ from rgraph.compiler.pipeline import compile_graph
 from rgraph.mutate import mutants
 
 RT = TESTS / "data" / "rt"
-GRAPHS = ("rt_probe", "rt_refit", "rt_rebuild")
+GRAPHS = ("rt_probe", "rt_refit", "rt_rebuild", "rt_indirect")
 
 
 def _plan(name: str) -> dict:

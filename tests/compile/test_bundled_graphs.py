@@ -28,9 +28,8 @@ def test_every_bundled_graph_has_small_run_params():
 @pytest.mark.vulkan
 @pytest.mark.parametrize("name", sorted(SMALL))
 def test_bundled_graph_runs_clean(name):
-    from rgraph.vk.executor import execute_plan
-
     from rgraph.vk.errors import ExecutionError
+    from rgraph.vk.executor import execute_plan
     from rgraph.vk.probe_rt import refuse_layer_for_ray_tracing
 
     plan = compile_graph(name, params=SMALL[name], size=(64, 36))

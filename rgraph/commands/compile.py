@@ -14,16 +14,37 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_graph_arguments(parser)
     add_compile_arguments(parser)
     parser.add_argument("-o", "--output", help="plan file to write (default: stdout)")
+    parser.add_argument("--json", action="store_true",
+                        help="print a JSON summary (docs/cli-json.md); the plan goes to -o or into its 'plan' key")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from rgraph.plan import dumps
 
-    text = dumps(compile_from_args(args))
+    plan = compile_from_args(args)
+    text = dumps(plan)
+    if args.json:
+        return _json(args, plan, text)
     if args.output:
         Path(args.output).write_text(text)
         print(f"wrote {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(text)
+    return 0
+
+
+def _json(args: argparse.Namespace, plan: dict, text: str) -> int:
+    from rgraph.commands.jsonout import document, emit
+    from rgraph.report.summary import counted_barriers
+
+    if args.output:
+        Path(args.output).write_text(text)
+    barriers, releases = counted_barriers(plan)
+    body = {"file": plan.get("source"), "graph": plan.get("graph"), "output": args.output,
+            "passes": [p["name"] for p in plan["passes"]], "culled": plan.get("culled") or [],
+            "barriers": barriers, "releases": releases, "stats": plan.get("stats") or {}}
+    if not args.output:
+        body["plan"] = plan
+    emit(document("compile", True, **body))
     return 0

@@ -100,17 +100,9 @@ class RayTraceProbePass(ProbePass):
         self.set_layout = self._own("vkDestroyDescriptorSetLayout", v.vkCreateDescriptorSetLayout(
             dev, v.VkDescriptorSetLayoutCreateInfo(bindingCount=len(layout_bindings),
                                                    pBindings=layout_bindings or None), None))
-        sets = self.resources.sets
         if bindings:
-            counts: dict[int, int] = {}
-            for _, t in bindings:
-                counts[t] = counts.get(t, 0) + sets
-            sizes = [v.VkDescriptorPoolSize(type=t, descriptorCount=n) for t, n in counts.items()]
-            self.pool = self._own("vkDestroyDescriptorPool", v.vkCreateDescriptorPool(
-                dev, v.VkDescriptorPoolCreateInfo(maxSets=sets, poolSizeCount=len(sizes), pPoolSizes=sizes), None))
-            self.sets = v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
-                descriptorPool=self.pool, descriptorSetCount=sets, pSetLayouts=[self.set_layout] * sets))
-            for s in range(sets):
+            self._allocate_sets([t for _, t in bindings])
+            for s in range(self.resources.sets):
                 self._write_descriptors(s, kinds)
                 self._write_accels(s)
         spirv = {"raygen": [compile_glsl(self.rt.raygen, "rgen")], "miss": [compile_glsl(self.rt.miss, "rmiss")],

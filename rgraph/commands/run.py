@@ -53,7 +53,7 @@ def _load_plan(args: argparse.Namespace) -> dict:
 
     return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
                               size=parse_size(args.size), policy=args.policy, sync=args.sync,
-                              schedule=args.schedule)
+                              schedule=args.schedule, camera=args.camera)
 
 
 def _print_table(plan: dict, timings: dict) -> None:

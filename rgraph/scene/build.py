@@ -171,8 +171,23 @@ def _instance_positions(mesh) -> np.ndarray:
     return base + np.asarray(offs, dtype=np.float64).reshape(-1, 3)
 
 
-def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str | None = None) -> SceneData:
-    """Geometry and tables of a scene file for an output of ``extent`` (w, h)."""
+def pick_camera(model: SceneFile, camera: int) -> SceneFile:
+    """``model`` seen from its camera preset ``camera`` (FORMAT.md 7: index into ``cameras``;
+    0 is ``camera`` when there is no list)."""
+    if not model.cameras:
+        if camera != 0:
+            raise ValueError(f"camera {camera}: the scene has no 'cameras' list (only camera 0)")
+        return model
+    if not 0 <= camera < len(model.cameras):
+        raise ValueError(f"camera {camera} out of range: the scene has {len(model.cameras)} cameras")
+    return model.model_copy(update={"camera": model.cameras[camera]})
+
+
+def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str | None = None,
+                camera: int = 0) -> SceneData:
+    """Geometry and tables of a scene file for an output of ``extent`` (w, h), seen from camera
+    preset ``camera``."""
+    model = pick_camera(model, camera)
     material_names = list(model.materials)
     materials = [model.materials[n] for n in material_names]
     meshes, draw = [], 0
@@ -209,6 +224,6 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
                      decals, corners)
 
 
-def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64)) -> SceneData:
+def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64), camera: int = 0) -> SceneData:
     scene = load_scene(path)
-    return build_scene(scene.model, extent, scene.name)
+    return build_scene(scene.model, extent, scene.name, camera)

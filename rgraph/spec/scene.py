@@ -123,6 +123,7 @@ class SceneFile(_Strict):
     scene: int
     name: str | None = None
     camera: Camera = Field(default_factory=Camera)
+    cameras: list[Camera] = Field(default_factory=list, description="camera presets; --camera N picks one")
     lights: list[LightItem] = Field(default_factory=list)
     materials: dict[str, Material] = Field(default_factory=dict)
     meshes: list[Mesh] = Field(default_factory=list)
@@ -145,6 +146,7 @@ def features_of(scene: SceneFile) -> dict[str, int]:
     mats = [mat for name, mat in sorted(scene.materials.items()) if name in used]
     far = max(
         [math.dist(scene.camera.position, (0, 0, 0))]
+        + [math.dist(c.position, (0, 0, 0)) for c in scene.cameras]
         + [math.dist(m.position, (0, 0, 0)) for m in scene.meshes],
     )
     authored = [light for light in scene.lights if isinstance(light, Light)]

@@ -40,6 +40,7 @@ def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-p", "--param", action="append", metavar="NAME=VALUE", help="override a graph param")
     size = default_size_text()
     parser.add_argument("--size", default=size, metavar="WxH", help=f"output size (default {size})")
+    parser.add_argument("--camera", type=int, default=0, help="camera preset N of the scene's 'cameras' (default 0)")
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
@@ -75,4 +76,5 @@ def compile_from_args(args: argparse.Namespace) -> dict:
         profile=getattr(args, "profile", None),
         sync=getattr(args, "sync", "normal"),
         schedule=getattr(args, "schedule", "declaration"),
+        camera=getattr(args, "camera", 0),
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
@@ -27,6 +28,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--trace", type=Path, metavar="OUT.json",
                         help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
                              "a track per queue, passes as slices, barriers, semaphore waits as flows")
+    parser.add_argument("--heatmap", type=Path,
+                        help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.add_argument("--json", action="store_true",
                         help="print the result (timings, validation messages, data check) as JSON (docs/cli-json.md)")
@@ -50,7 +53,7 @@ def _load_plan(args: argparse.Namespace) -> dict:
 
     return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
                               size=parse_size(args.size), policy=args.policy, sync=args.sync,
-                              schedule=args.schedule)
+                              schedule=args.schedule, camera=args.camera)
 
 
 def _print_table(plan: dict, timings: dict) -> None:
@@ -91,14 +94,32 @@ def _json(args: argparse.Namespace, plan: dict, result) -> int:
     return status
 
 
+def _report_clusters(args: argparse.Namespace, outputs: dict) -> None:
+    """Light-list statistics and the heatmap of a clustered graph (rgraph.passes.cluster_report)."""
+    if "cluster_stats" not in outputs and not args.heatmap:
+        return
+    from rgraph.resources import builtin_passes
+
+    cluster_report = importlib.import_module(f"{builtin_passes().__name__}.cluster_report")
+
+    if "cluster_stats" in outputs:
+        print(cluster_report.stats_line(cluster_report.stats_of(outputs["cluster_stats"])), file=sys.stderr)
+    if args.heatmap:
+        print(cluster_report.write_heatmap(args.heatmap, outputs["light_heat"][..., 0]), file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
     from rgraph.vk.executor import execute_plan
 
     try:
         plan = _load_plan(args)
+        outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
+        if args.heatmap and "light_heat" not in outputs:
+            raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' (see graphs/clustered.yaml)")
         result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
-                              check_data=args.check_data, out_png=args.out, verbose=True)
+                              check_data=args.check_data, out_png=args.out, verbose=True,
+                              read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
     except (VulkanUnavailable, ExecutionError) as exc:
         if args.json:
             from rgraph.commands.jsonout import diagnostic, document, emit
@@ -108,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
             return 2
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
+    _report_clusters(args, result.outputs)
     if args.timings:
         args.timings.write_text(json.dumps({"device": result.device_name, "size": plan.get("size"),
                                             **result.timings}, indent=1, sort_keys=True) + "\n")

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from rgraph.compiler import memory
+from rgraph.compiler.accel import size_accels
 from rgraph.compiler.memory import MemoryRequirementsProvider
 from rgraph.compiler.sync import synchronize
 from rgraph.defaults import DEFAULT_SIZE  # re-exported: the one default everywhere
@@ -95,6 +96,7 @@ def _compile_spec(spec, policy, memory_provider, profile_name, schedule=DEFAULT_
 
         memory_provider = ProfileMemoryRequirements.named(DEFAULT_PROFILE)
         profile_name = profile_name or DEFAULT_PROFILE
+    passes = size_accels(spec, passes, memory_provider)
     used = memory.usages_by_resource(passes)
     spans = memory.lifetimes(passes)
     reqs = memory.requirements(spec.resources, used, spec.outputs, memory_provider)
@@ -142,6 +144,7 @@ def compile_graph(
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
     schedule: str = DEFAULT_SCHEDULE,
+    camera: int = 0,
 ) -> dict[str, Any]:
     """Compile a graph file (or bundled graph name) into a plan dict.
 
@@ -162,7 +165,22 @@ def compile_graph(
     chosen = policy or front.source.memory_policy or DEFAULT_POLICY
     plan = compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name,
                         schedule=schedule)
+    if camera:
+        plan["camera"] = check_camera(front.scene, camera)
     return apply_sync_mode(plan, sync)
+
+
+def check_camera(scene: Scene | None, camera: int) -> int:
+    """``--camera N`` against the scene's presets (FORMAT.md 7); the plan records it."""
+    from rgraph.scene.build import pick_camera
+
+    if scene is None:
+        raise RGraphError.in_file("<command line>", f"--camera {camera}: the graph has no scene")
+    try:
+        pick_camera(scene.model, camera)
+    except ValueError as exc:
+        raise RGraphError.in_file("<command line>", f"--camera: {exc}") from None
+    return camera
 
 
 SYNC_MODES = ("normal", "naive")

@@ -121,6 +121,7 @@ def access_syncs(p: PassSpec, resources: Mapping[str, ResourceSpec]) -> list[Syn
                 is_image=res.is_image,
                 depth_format=bool(fmt and fmt.has_depth),
                 stencil_format=bool(fmt and fmt.has_stencil),
+                refit=a.refit,
             )
         )
     return out

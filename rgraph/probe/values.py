@@ -147,5 +147,9 @@ def header_words(plan_size: tuple[int, int]) -> list[int]:
 def modulus(resource: dict) -> int | None:
     if resource["kind"] == "buffer":
         return BUFFER_MODULUS
+    if resource["kind"] == "accel":
+        from rgraph.probe.semantics import ACCEL_MODULUS
+
+        return ACCEL_MODULUS
     c = codec(resource["format"])
     return c.modulus if c else None

@@ -17,7 +17,7 @@ from rgraph import formats
 from rgraph.errors import Location, RGraphError
 from rgraph.spec.expr import ExprError, parse_value
 from rgraph.spec.loader import GraphSource, Located
-from rgraph.spec.models import ImageResource, ScaleSize
+from rgraph.spec.models import AccelResource, ImageResource, ScaleSize
 from rgraph.spec.pydantic_errors import describe, did_you_mean
 from rgraph.spec.repeat import instances, substitute
 from rgraph.spec.vocabulary import (
@@ -55,6 +55,9 @@ class ResourceSpec:
     samples: int = 1
     bytes: int = 0
     loc: Location = field(default_factory=lambda: Location("?"))
+    geometry: str | None = None  # accels: "scene" | "probe"
+    accel: Any = None  # accels: rgraph.compiler.accel.AccelLayout once sized
+    scratch_of: str | None = None  # an accel's build scratch buffer: the accel
 
     @property
     def is_image(self) -> bool:
@@ -73,6 +76,7 @@ class AccessSpec:
     stages: tuple[str, ...] | None  # explicit shader stages, else derived from the pass kind
     optional: bool
     loc: Location
+    refit: bool = False  # accel_build of a persistent accel refitted each frame (reads it too)
 
 
 @dataclass(frozen=True)
@@ -87,6 +91,7 @@ class PassSpec:
     accesses: tuple[AccessSpec, ...]
     params: Mapping[str, Any]
     loc: Location
+    requires_any: tuple[str, ...] = ()  # removed when the scene has none of these
 
 
 @dataclass
@@ -212,6 +217,8 @@ def specialize(
             missing = [f for f in spec.requires if not features.get(f)]
             if missing:
                 removed.append((name, "scene has no " + " and no ".join(missing)))
+            elif spec.requires_any and not any(features.get(f) for f in spec.requires_any):
+                removed.append((name, "scene has none of " + ", ".join(spec.requires_any)))
             passes.append(spec)
     _check_program_order(passes, resources)
     return Spec(
@@ -243,6 +250,8 @@ def _outputs(source: GraphSource, resources: dict[str, ResourceSpec]) -> list[st
 
 def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits) -> ResourceSpec:
     model = loc.model
+    if isinstance(model, AccelResource):
+        return ResourceSpec(loc.name, "accel", model.lifetime, loc=loc.key_loc(), geometry=model.geometry)
     if not isinstance(model, ImageResource):
         nbytes = env.integer(model.bytes, loc, "bytes")
         if nbytes <= 0 or nbytes > limits.max_buffer_bytes:
@@ -352,6 +361,7 @@ def _pass(name: str, order: int, located: Located, resources: dict[str, Resource
         queue=model.queue,
         impl=model.impl,
         requires=tuple(model.requires),
+        requires_any=tuple(model.requires_any),
         side_effects=model.side_effects,
         accesses=tuple(accesses),
         params=dict(model.params),

@@ -111,7 +111,7 @@ class ResourceSet:
             info = image_create_info(res["format"], res["extent"], res["mips"], res["layers"], res["samples"],
                                      res["usages"], alias=alias)
             return v.vkCreateImage(self.device.handle, info, None)
-        if res["kind"] == "buffer":
+        if res["kind"] in ("buffer", "accel"):  # an accel: the buffer its structures live in
             info = buffer_create_info(res["size_bytes"] or res["bytes"], res["usages"])
             return v.vkCreateBuffer(self.device.handle, info, None)
         raise ExecutionError(f"resource {res['name']!r}: kind {res['kind']!r} is not supported by the runtime")
@@ -159,7 +159,9 @@ class ResourceSet:
                 if bits == 0:
                     raise ExecutionError(f"heap {heap_id}: its resources share no memory type")
                 index = memory_type(self.device, bits, v.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)
-                memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(allocationSize=int(heap["bytes"]),
+                flags = (v.VkMemoryAllocateFlagsInfo(flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
+                         if any(set(r["usages"]) & names.DEVICE_ADDRESS_USAGES for r in residents) else None)
+                memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(pNext=flags, allocationSize=int(heap["bytes"]),
                                                                         memoryTypeIndex=index), None)
                 self.memories.append(memory)
                 name_object(self.device, memory, v.VK_OBJECT_TYPE_DEVICE_MEMORY,

@@ -137,7 +137,7 @@ def gpu_run(mode: int, distance: float, *, size: tuple[int, int], frames: int, i
             validate: bool = False, device_index: int | None = None) -> dict[str, Any]:
     """Median GPU ms of the transform pass, the image, and validation messages."""
     from rgraph.vk.executor import execute_plan
-    from rgraph.vk.memreq import compile_for_device
+    from rgraph.api import compile_for_device
 
     plan = compile_for_device(GPU_GRAPH, device_index, size=size, params={"lw.mode": str(mode), "lw.distance": repr(float(distance)),
                                                        "lw.instances": str(instances), "lw.triangles": str(triangles)})

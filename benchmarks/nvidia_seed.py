@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 
 from rgraph.random_graph import random_graph, to_yaml
-from rgraph.vk.memreq import compile_for_device
+from rgraph.api import compile_for_device
 
 
 def main() -> None:

@@ -49,7 +49,7 @@ def _compile(args: argparse.Namespace, need_device: bool) -> dict:
                   policy=args.policy)
     if not need_device:
         return compile_graph(args.graph, **kwargs)
-    from rgraph.vk.memreq import compile_for_device
+    from rgraph.api import compile_for_device
 
     return compile_for_device(args.graph, args.device, **kwargs)
 

@@ -40,7 +40,7 @@ def _load_plan(args: argparse.Namespace) -> dict:
 
             plan = apply_sync_mode(plan, "naive")
         return plan
-    from rgraph.vk.memreq import compile_for_device
+    from rgraph.api import compile_for_device
 
     return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
                               size=parse_size(args.size), policy=args.policy, sync=args.sync)

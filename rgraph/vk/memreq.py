@@ -67,7 +67,8 @@ class DeviceMemoryRequirements:
 @contextmanager
 def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceMemoryRequirements, Device]]:
     """The memory-requirements provider of the live device that ``execute_plan(...,
-    device_index=device_index)`` will use, and that device; both destroyed on exit."""
+    device_index=device_index)`` will use, and that device; both destroyed on exit
+    (``rgraph.open_device`` keeps one device for compiling and running instead)."""
     from rgraph.vk.device import create_device
     from rgraph.vk.instance import create_instance
 
@@ -81,12 +82,3 @@ def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceM
     finally:
         instance.destroy()
 
-
-def compile_for_device(graph: Any, device_index: int | None = None, **options: Any) -> dict:
-    """``compile_graph(graph, **options)`` with sizes and alignments from the live device that
-    ``execute_plan(..., device_index=device_index)`` will use (a plan compiled for another
-    device's profile is refused by the runtime's requirements cross-check)."""
-    from rgraph.compiler.pipeline import compile_graph
-
-    with live_requirements(device_index) as (memory, _device):
-        return compile_graph(graph, memory=memory, **options)

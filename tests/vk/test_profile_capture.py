@@ -65,7 +65,7 @@ def test_captured_profile_compiles_the_plan_the_live_device_gets(tmp_path: Path)
     """End to end: capture the default device's profile with the CLI, then compile a bundled
     graph offline with it; the plan's memory layout equals the one compiled against the device."""
     from rgraph.compiler.pipeline import compile_graph
-    from rgraph.vk.memreq import compile_for_device
+    from rgraph.api import compile_for_device
 
     out = tmp_path / "device.json"
     formats = "R8G8B8A8_UNORM,R16G16B16A16_SFLOAT,R32_SFLOAT,D32_SFLOAT,B10G11R11_UFLOAT_PACK32"

@@ -18,9 +18,9 @@ import pytest
 
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.random_graph import random_graph, to_yaml
-from rgraph.vk.executor import make_batches
-from rgraph.vk.layer_races import avoid_layer_races, racing_batches, touched_resources
-from rgraph.vk.semaphore_edges import (
+from rgraph.vk.lower.batches import make_batches
+from rgraph.vk.lower.workarounds.layer_races import avoid_layer_races, racing_batches, touched_resources
+from rgraph.vk.lower.semaphores import (
     BatchSync,
     batch_semaphores,
     semaphore_count,

@@ -33,7 +33,7 @@ from rgraph.check.hazards import (
     WAW,
     Hazard,
 )
-from rgraph.check.jsonloc import locate
+from rgraph.jsonloc import locate
 from rgraph.check.plan import Plan, PlanShapeError, read_plan
 from rgraph.check.replay import Replay
 from rgraph.errors import RGraphError

@@ -18,9 +18,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.plan import dumps
+    from rgraph.plan import dump
 
-    text = dumps(compile_from_args(args))
+    text = dump(compile_from_args(args))
     if args.output:
         Path(args.output).write_text(text)
         print(f"wrote {args.output}", file=sys.stderr)

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from rgraph.check.jsonloc import locate
+from rgraph.jsonloc import locate
 from rgraph.errors import RGraphError
 
 PLAN_FORMAT = "rgraph-plan/1"

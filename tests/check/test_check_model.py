@@ -12,7 +12,7 @@ from rgraph.check import RAW, SEMAPHORE, WAR, WAW, check_plan
 from rgraph.check.aliasing import analyse
 from rgraph.check.cells import CellMap, merge_rects
 from rgraph.check.chains import ChainRegistry
-from rgraph.check.jsonloc import locate
+from rgraph.jsonloc import locate
 from rgraph.check.plan import read_plan
 from rgraph.check.vocab import ALL_STAGES, STAGE_BIT, access_mask, stage_mask
 

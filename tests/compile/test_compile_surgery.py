@@ -11,7 +11,7 @@ import pytest
 
 from rgraph.cli import main
 from rgraph.compiler.pipeline import compile_graph
-from rgraph.plan import dumps
+from rgraph.plan import dumps_json as dumps
 from rgraph.resources import graphs_dir
 
 GOLDEN = TESTS / "golden"

@@ -1,6 +1,6 @@
 """Find where a value sits in JSON text, given its path (keys and list indices).
 
-Used only when a plan is malformed, to turn a path like ``passes[3].barriers[0].src``
+Used when a plan is malformed (rgraph.plan.load, rgraph check), to turn a path like ``passes[3].barriers[0].src``
 into the 1-based line and column an editor shows.
 """
 

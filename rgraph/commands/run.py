@@ -1,4 +1,11 @@
-"""``rgraph run G-or-PLAN``: compile (sizes from the live device) and execute on Vulkan."""
+"""``rgraph run G-or-PLAN``: compile (sizes from the live device) and execute on Vulkan.
+
+One instance and one device (``rgraph.open_device``) serve both: the compiler sizes resources
+with the device's memory requirements, then the same device runs the plan. A plan file is
+loaded through the typed loader (``rgraph.plan.load``) and replayed by the independent
+checker (``rgraph.check``) first; a malformed plan or one with hazards is refused (exit 2)
+unless ``--unchecked``.
+"""
 
 from __future__ import annotations
 
@@ -10,10 +17,14 @@ from pathlib import Path
 from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
 from rgraph.errors import RGraphError
 
+DEFAULT_SIZE = "640x360"
+COMMAND_LINE = "<command line>"
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
-    add_graph_arguments(parser, size_default="640x360")
+    add_graph_arguments(parser, size_default=DEFAULT_SIZE)
+    parser.set_defaults(size=None)  # None: not given (a plan file has its own size)
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
@@ -24,26 +35,59 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", type=Path, help="write the first output image as PNG")
     parser.add_argument("--timings", type=Path, help="write per-pass GPU times (median ms) as JSON")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.add_argument("--unchecked", action="store_true",
+                        help="run a plan file even if rgraph check finds hazards in it")
+    parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
+                        help="record the plan without the validation-layer 1.3.239 workarounds "
+                             "(rgraph/vk/lower/workarounds; validation messages are then reported, not avoided)")
     parser.set_defaults(func=run)
 
 
-def _load_plan(args: argparse.Namespace) -> dict:
-    path = Path(args.graph)
-    if path.suffix == ".json" and path.is_file():
-        from rgraph.check import load_plan_file
+def is_plan_file(target: str) -> bool:
+    path = Path(target)
+    return path.suffix == ".json" and path.is_file()
 
-        plan, _ = load_plan_file(path)
-        if plan.get("format") != "rgraph-plan/1":
-            raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
-        if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
-            from rgraph.compiler.pipeline import apply_sync_mode
 
-            plan = apply_sync_mode(plan, "naive")
-        return plan
-    from rgraph.api import compile_for_device
+def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
+    """A plan file through the typed loader (malformed: ``RGraphError``, one located line),
+    then replayed by ``rgraph.check``: hazards are refused (``RGraphError``) unless ``unchecked``."""
+    from rgraph.plan import load, to_json_dict
 
-    return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
-                              size=parse_size(args.size), policy=args.policy, sync=args.sync)
+    model = load(path)
+    if model.format != "rgraph-plan/1":
+        raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
+    if not unchecked:
+        from rgraph.check import check_file
+
+        _checked, hazards = check_file(path)
+        if hazards:
+            first = hazards[0].message.splitlines()[0]
+            raise RGraphError.in_file(
+                path, f"rgraph check finds {len(hazards)} hazard{'s' if len(hazards) != 1 else ''} in this plan "
+                      f"(first: {first}); see 'rgraph check {path}', or pass --unchecked to run it anyway")
+    return to_json_dict(model)
+
+
+def _plan_from_file(args: argparse.Namespace) -> dict:
+    given = [flag for flag, value in (("--size", args.size), ("--scene", args.scene), ("-p", args.param),
+                                      ("--policy", args.policy)) if value]
+    if given:
+        raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only apply when compiling a graph, not to "
+                                                f"a plan file (its size is {_plan_size(args.graph)})")
+    plan = load_checked_plan(Path(args.graph), unchecked=args.unchecked)
+    if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
+        from rgraph.compiler.pipeline import apply_sync_mode
+
+        plan = apply_sync_mode(plan, "naive")
+    return plan
+
+
+def _plan_size(path: str) -> str:
+    try:
+        size = json.loads(Path(path).read_text()).get("size")
+        return f"{size[0]}x{size[1]}"
+    except Exception:  # noqa: BLE001 -- only for the message
+        return "fixed"
 
 
 def _print_table(plan: dict, timings: dict) -> None:
@@ -65,13 +109,25 @@ def _print_table(plan: dict, timings: dict) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rgraph.api import open_device
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
-    from rgraph.vk.executor import execute_plan
+    from rgraph.vk.lower import LAYER_WORKAROUNDS
 
+    if args.frames < 1:
+        print("rgraph: error: --frames must be at least 1", file=sys.stderr)
+        return 2
+    plan = _plan_from_file(args) if is_plan_file(args.graph) else None
     try:
-        plan = _load_plan(args)
-        result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
-                              check_data=args.check_data, out_png=args.out, verbose=True)
+        with open_device(validate=args.validate, device=args.device) as gpu:
+            if plan is None:
+                from rgraph.compiler.pipeline import compile_graph
+
+                plan = compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
+                                     size=parse_size(args.size or DEFAULT_SIZE), policy=args.policy,
+                                     sync=args.sync, memory=gpu.memory_requirements())
+            exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else ())
+            result = exe.run_checked(args.frames, check_data=args.validate if args.check_data is None
+                                     else args.check_data, out_png=args.out)
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
@@ -87,6 +143,8 @@ def run(args: argparse.Namespace) -> int:
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)
+    if not args.layer_workarounds:
+        print("rgraph: recorded without the validation-layer workarounds", file=sys.stderr)
     if args.validate:
         print(f"rgraph: {len(result.messages)} validation message(s)", file=sys.stderr)
         if result.messages:

@@ -33,6 +33,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the pass graph as DOT (stdout; OUT.dot for text, OUT.svg renders with graphviz)",
     )
     parser.add_argument("--html", metavar="OUT", help="write a self-contained HTML report")
+    parser.add_argument("--lowered", action="store_true",
+                        help="what the runtime will record (rgraph/vk/lower): barrier calls per pass, batches, "
+                             "semaphore edges, submit order; no device needed")
+    parser.add_argument("--queues", choices=("single", "separate"), default="single",
+                        help="queue-family layout for --lowered: single (default: one graphics+compute+transfer "
+                             "family, as on lavapipe) or separate (graphics, compute and transfer families, as on "
+                             "NVIDIA)")
+    parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
+                        help="--lowered without the validation-layer 1.3.239 workarounds")
     parser.add_argument("--timings", metavar="T.json",
                         help="per-pass GPU times of a run that kept the culled passes (rgraph run --timings): "
                              "shows the milliseconds culling saved")
@@ -110,6 +119,19 @@ def emit_dot(plan: dict[str, Any], dest: str, out: TextIO) -> None:
         _write(dest, text)
 
 
+def lowered_text(plan: dict[str, Any], queues: str, workarounds: bool = True) -> str:
+    """``--lowered``: the recording of ``plan`` on the ``queues`` model, as text."""
+    from rgraph.vk.lower import LAYER_WORKAROUNDS, LoweringError, lower
+    from rgraph.vk.lower.queues import MODELS
+    from rgraph.vk.lower.text import format_recording
+
+    try:
+        recording = lower(plan, MODELS[queues](), workarounds=LAYER_WORKAROUNDS if workarounds else ())
+    except LoweringError as exc:
+        raise RGraphError.in_file(COMMAND_LINE, f"--lowered: {exc}") from None
+    return format_recording(recording)
+
+
 def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None = None) -> int:
     from rgraph.report import text
     from rgraph.report.table import make_console
@@ -120,7 +142,9 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     console = make_console(out)
     dot_to_stdout = args.dot == "-"
     timings = load_timings(args.timings) if args.timings else None
-    if not (args.barriers or args.memory or dot_to_stdout):
+    if args.lowered:
+        out.write(lowered_text(plan, args.queues, args.layer_workarounds))
+    if not (args.barriers or args.memory or dot_to_stdout or args.lowered):
         text.print_summary(console, plan, timings)
     if args.barriers:
         text.print_barriers(console, plan)

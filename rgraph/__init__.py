@@ -10,9 +10,18 @@ __version__ = "0.1.0"
 #: Public names, imported on first use (``import rgraph`` stays cheap and Vulkan-free):
 #: name -> "module:attribute".
 _LAZY = {
+_LAZY = {
+    "load": "rgraph.compiled:load",
+    "compile": "rgraph.compiled:compile",
+    "Compiled": "rgraph.compiled:Compiled",
+    "MemoryAnalysis": "rgraph.compiled:MemoryAnalysis",
+    "Plan": "rgraph.plan.model:Plan",
+    "load_plan": "rgraph.plan.read:load",
+    "RGraphError": "rgraph.errors:RGraphError",
     "open_device": "rgraph.api:open_device",
     "Gpu": "rgraph.api:Gpu",
     "Executable": "rgraph.api:Executable",
+}
 }
 
 

@@ -147,7 +147,7 @@ def compile_graph_plan(
 
         provider = ProfileMemoryRequirements.named(profile)
         profile_name = provider.name
-    chosen = policy or front.source.memory_policy or DEFAULT_POLICY
+    chosen = policy or spec.memory_policy or DEFAULT_POLICY
     plan = compile_plan(spec, policy=chosen, memory_provider=provider, profile_name=profile_name)
     return apply_sync_mode(plan, sync)
 

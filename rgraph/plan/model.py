@@ -228,3 +228,9 @@ class Plan:
     @property
     def barrier_count(self) -> int:
         return sum(len(p.barriers) for p in self.passes)
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The decoded JSON document (fresh, mutable): for code that still reads plan dicts."""
+        from rgraph.plan.dump import to_json_dict
+
+        return to_json_dict(self)

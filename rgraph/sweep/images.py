@@ -6,18 +6,21 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rgraph.sweep.metrics import linear_to_srgb
 
+if TYPE_CHECKING:
+    from rgraph.plan import Plan, PlanResource
 
-def output_image_resources(plan: dict) -> list[dict]:
+
+def output_image_resources(plan: Plan) -> list[PlanResource]:
     """The plan's output images, in the plan's ``outputs`` order."""
-    by_name = {r["name"]: r for r in plan["resources"]}
-    names = plan.get("outputs") or [r["name"] for r in plan["resources"] if r["lifetime"] == "output"]
-    return [by_name[n] for n in names if n in by_name and by_name[n]["kind"] == "image"]
+    by_name = plan.resource_by_name
+    names = plan.outputs or [r.name for r in plan.resources if r.lifetime == "output"]
+    return [by_name[n] for n in names if n in by_name and by_name[n].is_image]
 
 
 def output_arrays(result: Any) -> dict[str, np.ndarray]:

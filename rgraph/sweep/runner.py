@@ -10,13 +10,16 @@ from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgraph.resources import resolve_graph
 from rgraph.spec.loader import load_graph
 from rgraph.sweep import images as image_io
 from rgraph.sweep.compare import Images, compare
 from rgraph.sweep.settings import Knob, Setting, expand, numeric_key, params_key, resolved
+
+if TYPE_CHECKING:
+    from rgraph.plan import Plan
 
 
 @dataclass
@@ -90,7 +93,7 @@ class SweepResult:
 
 @dataclass
 class _Rendering:
-    plan: dict
+    plan: Plan
     pass_ms: dict[str, float | None]
     total_ms: float | None
     messages: list[str]
@@ -166,44 +169,44 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
     first_plan = plans[reference_key]
     pass_names: list[str] = []
     for plan in plans.values():
-        pass_names += [p["name"] for p in plan["passes"] if p["name"] not in pass_names]
-    order = {p["name"]: i for i, p in enumerate(first_plan["passes"])}
+        pass_names += [p.name for p in plan.passes if p.name not in pass_names]
+    order = {p.name: i for i, p in enumerate(first_plan.passes)}
     pass_names.sort(key=lambda n: order.get(n, len(order)))
     outputs = image_io.output_image_resources(first_plan)
     return SweepResult(
-        request=request, graph_name=first_plan["graph"], scene=first_plan.get("scene"),
+        request=request, graph_name=first_plan.graph, scene=first_plan.scene,
         device=next(iter(renderings.values())).device, defaults=resolved_params["default"], rows=rows,
         pass_names=pass_names, notes=notes, error_maps=error_maps,
-        output_name=outputs[0]["name"] if outputs else None, reference_params=resolved_params["reference"],
+        output_name=outputs[0].name if outputs else None, reference_params=resolved_params["reference"],
     )
 
 
-def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, dict]:
+def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, Plan]:
     """Plans by params key, compiled with the live device's memory requirements."""
-    from rgraph.compiler.pipeline import compile_graph
+    from rgraph.compiler.pipeline import compile_graph_plan
     from rgraph.vk.memreq import live_requirements
 
     source = load_graph(resolve_graph(request.graph))
-    plans: dict[tuple, dict] = {}
+    plans: dict[tuple, Plan] = {}
     with live_requirements(request.device) as (memory, _device):
         for s in settings:
-            plans[params_key(resolved(source, s.overrides))] = compile_graph(
+            plans[params_key(resolved(source, s.overrides))] = compile_graph_plan(
                 request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
                 policy=request.policy, memory=memory,
                 extra_outputs=[request.hdr] if request.hdr else [])
     return plans
 
 
-def _render(request: SweepRequest, plan: dict, notes: list[str]) -> _Rendering:
+def _render(request: SweepRequest, plan: Plan, notes: list[str]) -> _Rendering:
     from rgraph.vk.executor import execute_plan
 
-    result = execute_plan(plan, validate=request.validate, frames=request.frames, device_index=request.device,
+    result = execute_plan(plan.to_json_dict(), validate=request.validate, frames=request.frames, device_index=request.device,
                           check_data=False, read_outputs=True)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None
-    if outputs and outputs[0]["name"] in arrays:
-        ldr = image_io.display(arrays[outputs[0]["name"]], outputs[0]["format"])
+    if outputs and outputs[0].name in arrays:
+        ldr = image_io.display(arrays[outputs[0].name], outputs[0].format)
     if request.hdr and request.hdr in arrays:
         hdr = image_io.rgb(arrays[request.hdr])
     elif request.hdr:
@@ -211,7 +214,7 @@ def _render(request: SweepRequest, plan: dict, notes: list[str]) -> _Rendering:
         if note not in notes:
             notes.append(note)
     timings = result.timings or {}
-    pass_ms = {p["name"]: timings.get("passes", {}).get(p["name"]) for p in plan["passes"]}
+    pass_ms = {p.name: timings.get("passes", {}).get(p.name) for p in plan.passes}
     return _Rendering(plan, pass_ms, timings.get("total_ms"), [str(m) for m in result.messages],
                       result.device_name, Images(ldr, hdr))
 

@@ -10,7 +10,6 @@ __version__ = "0.1.0"
 #: Public names, imported on first use (``import rgraph`` stays cheap and Vulkan-free):
 #: name -> "module:attribute".
 _LAZY = {
-_LAZY = {
     "load": "rgraph.compiled:load",
     "compile": "rgraph.compiled:compile",
     "Compiled": "rgraph.compiled:Compiled",
@@ -21,7 +20,6 @@ _LAZY = {
     "open_device": "rgraph.api:open_device",
     "Gpu": "rgraph.api:Gpu",
     "Executable": "rgraph.api:Executable",
-}
 }
 
 

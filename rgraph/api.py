@@ -7,7 +7,7 @@
         result = exe.run(frames=3)                         # timings, validation messages
         images = exe.read_outputs()                        # name -> numpy array
 
-``gpu.load`` accepts a plan dict or a compiled object carrying one; ``gpu.memory_requirements()``
+``gpu.load`` accepts a ``Compiled``, a typed ``Plan``, a plan dict or a plan file; ``gpu.memory_requirements()``
 is the provider the compiler sizes resources with (``compile_graph(..., memory=...)``).
 Everything a device needs is closed when the ``with`` block ends; executables close first.
 """
@@ -37,25 +37,22 @@ class RunSummary:
 
 
 def plan_of(obj: Any) -> dict:
-    """The plan dict of a plan dict, a compiled object (``.plan`` or ``.as_dict()``), or a
-    typed plan (``rgraph.plan.dump``)."""
+    """The plan document of a plan dict, a ``Compiled`` (``rgraph.compile``), a typed
+    ``rgraph.plan.Plan``, or a plan file path (loaded through the typed loader)."""
+    from rgraph.compiled import Compiled
+    from rgraph.plan.model import Plan
+
     if isinstance(obj, dict):
         return obj
-    for attr in ("plan_dict", "as_dict", "to_dict"):
-        fn = getattr(obj, attr, None)
-        if callable(fn):
-            return fn()
-    inner = getattr(obj, "plan", None)
-    if isinstance(inner, dict):
-        return inner
-    if inner is not None:
-        return plan_of(inner)
-    try:
-        from rgraph.plan import dump  # type: ignore[attr-defined]
+    if isinstance(obj, Compiled):
+        return obj.as_dict()
+    if isinstance(obj, Plan):
+        return obj.to_json_dict()
+    if isinstance(obj, (str, Path)):
+        from rgraph.plan import load
 
-        return dump(obj)
-    except (ImportError, TypeError, AttributeError):
-        raise TypeError(f"not a plan: {type(obj).__name__}") from None
+        return load(obj).to_json_dict()
+    raise TypeError(f"not a plan: {type(obj).__name__} (give a plan dict, a Compiled, a Plan or a plan file)")
 
 
 class Gpu:

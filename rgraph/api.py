@@ -179,29 +179,34 @@ class Executable:
 
         return decode_outputs(self.plan, self.read_back())
 
-    def run_checked(self, frames: int, *, check_data: bool, out_png: Path | None = None,
-                    read_outputs: bool = False) -> Any:
+    def run_and_check(self, frames: int, *, check_data: bool, out_png: Path | None = None,
+                      read_outputs: bool = False) -> Any:
         """Run, read back when needed, check the probe's data (``rgraph.probe.check``), write
-        the PNG, close the whole device; an ``rgraph.vk.executor.RunResult`` with every message."""
+        the PNG and close this executable (the device stays open): an
+        ``rgraph.vk.executor.RunResult`` with the messages logged from load to close."""
         from rgraph.png import first_output_image, write_output_png
         from rgraph.probe.check import check_outputs
         from rgraph.vk.errors import ExecutionError
         from rgraph.vk.executor import RunResult
         from rgraph.vk.runtime.readback import decode_outputs
 
-        if out_png is not None and first_output_image(self.plan) is None:
-            raise ExecutionError("--out: the plan has no output image")
-        summary = self.run(frames)
-        result = RunResult([], summary.timings, None, self.gpu.name)
-        if check_data or read_outputs or out_png is not None:
-            data = self.read_back()
-            result.outputs = decode_outputs(self.plan, data)
-            if check_data:
-                verdict = check_outputs(self.plan, data, self.executor.frames_done)
-                result.data_ok, result.mismatches, result.unchecked = verdict.ok, verdict.mismatches, verdict.unchecked
-            if out_png is not None:
-                write_output_png(self.plan, data, out_png)
-        result.messages = self.gpu.close()
+        try:
+            if out_png is not None and first_output_image(self.plan) is None:
+                raise ExecutionError("--out: the plan has no output image")
+            summary = self.run(frames)
+            result = RunResult([], summary.timings, None, self.gpu.name)
+            if check_data or read_outputs or out_png is not None:
+                data = self.read_back()
+                result.outputs = decode_outputs(self.plan, data)
+                if check_data:
+                    verdict = check_outputs(self.plan, data, self.executor.frames_done)
+                    result.data_ok, result.mismatches, result.unchecked = (verdict.ok, verdict.mismatches,
+                                                                           verdict.unchecked)
+                if out_png is not None:
+                    write_output_png(self.plan, data, out_png)
+        finally:
+            messages = self.close()
+        result.messages = list(messages)
         return result
 
     def close(self) -> list[Any]:

@@ -126,8 +126,9 @@ def run(args: argparse.Namespace) -> int:
                                      size=parse_size(args.size or DEFAULT_SIZE), policy=args.policy,
                                      sync=args.sync, memory=gpu.memory_requirements())
             exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else ())
-            result = exe.run_checked(args.frames, check_data=args.validate if args.check_data is None
-                                     else args.check_data, out_png=args.out)
+            result = exe.run_and_check(args.frames, check_data=args.validate if args.check_data is None
+                                       else args.check_data, out_png=args.out)
+            result.messages = gpu.close()  # the device's teardown included
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2

@@ -143,5 +143,7 @@ def execute_plan(plan: dict, *, validate: bool = False, frames: int = 1, device_
         raise ExecutionError("--frames must be at least 1")
     with open_device(validate=validate, device=device_index, verbose=verbose) as gpu:
         exe = gpu.load(plan, inputs=inputs, workarounds=workarounds)
-        return exe.run_checked(frames, check_data=validate if check_data is None else check_data,
-                               out_png=out_png, read_outputs=read_outputs)
+        result = exe.run_and_check(frames, check_data=validate if check_data is None else check_data,
+                                   out_png=out_png, read_outputs=read_outputs)
+        result.messages = gpu.close()  # every message of the instance, its teardown included
+    return result

@@ -36,24 +36,25 @@ def case(seed: int, max_passes: int) -> tuple[int, int, str]:
 
 
 def _open_worker() -> None:
-    """Open the worker's device for memory requirements; a failure is kept and reported with
-    every case (an initializer that raises makes the pool respawn workers forever)."""
-    from rgraph.vk.memreq import live_requirements
+    """Open the worker's device (validation on) once: memory requirements and every case's run;
+    a failure is kept and reported with every case (an initializer that raises makes the pool
+    respawn workers forever)."""
+    import rgraph
 
     stack = ExitStack()
     try:
-        memory, _device = stack.enter_context(live_requirements())
+        gpu = stack.enter_context(rgraph.open_device(validate=True, verbose=False))
+        memory = gpu.memory_requirements()
     except Exception as exc:  # noqa: BLE001 - reported per case by run_case
         _worker.update(error=f"worker could not open the device: {type(exc).__name__}: {exc}")
         return
-    _worker.update(stack=stack, memory=memory, tmp=Path(tempfile.mkdtemp(prefix="rgraph-fuzz-")))
+    _worker.update(stack=stack, gpu=gpu, memory=memory, tmp=Path(tempfile.mkdtemp(prefix="rgraph-fuzz-")))
 
 
 def run_case(entry: tuple[int, int, str]) -> dict[str, Any]:
     """Compile and run one graph; its messages, data check and any exception."""
     from rgraph.compiler.pipeline import compile_spec, frontend
     from rgraph.random_graph import random_graph, to_yaml
-    from rgraph.vk.executor import execute_plan
 
     seed, passes, policy = entry
     record: dict[str, Any] = {"seed": seed, "passes": passes, "policy": policy}
@@ -64,7 +65,7 @@ def run_case(entry: tuple[int, int, str]) -> dict[str, Any]:
         path = _worker["tmp"] / f"g_{seed}_{passes}.yaml"
         path.write_text(to_yaml(random_graph(seed, passes)))
         plan = compile_spec(frontend(path, size=(16, 16)).spec, policy=policy, memory_provider=_worker["memory"])
-        result = execute_plan(plan, validate=True, frames=2, check_data=True)
+        result = _worker["gpu"].load(plan).run_and_check(2, check_data=True)
         record.update(messages=[str(m) for m in result.messages], data_ok=result.data_ok,
                       mismatches=[str(m) for m in result.mismatches[:5]])
     except Exception as exc:  # noqa: BLE001 - a crash is a finding, reported with the case

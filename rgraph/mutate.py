@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import copy
 import time
-from contextlib import ExitStack
 from collections.abc import Callable, Iterable
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from typing import Any
 

@@ -123,8 +123,8 @@ def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: boo
 
 
 def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) -> SweepResult:
-    """Render every setting of ``request``; write images and error maps under ``out_dir``."""
-    from rgraph.sweep import plots  # matplotlib: only when sweeping
+    """Render every setting of ``request`` on one device; write images and error maps under ``out_dir``."""
+    from rgraph.api import open_device
 
     source = load_graph(resolve_graph(request.graph))
     settings = expand(source, request.knobs, base=request.base, reference=request.reference, grid=request.grid)
@@ -132,7 +132,15 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
     distinct: dict[tuple, Setting] = {}
     for s in settings:
         distinct.setdefault(params_key(resolved_params[s.label]), s)
-    plans = _compile_all(request, list(distinct.values()))
+    with open_device(validate=request.validate, device=request.device, verbose=False) as gpu:  # one device
+        plans = _compile_all(request, list(distinct.values()), gpu)
+        return _render_all(request, out_dir, settings, resolved_params, distinct, plans, gpu, progress)
+
+
+def _render_all(request: SweepRequest, out_dir: Path, settings: list[Setting], resolved_params: dict,
+                distinct: dict[tuple, Setting], plans: dict[tuple, Plan], gpu: Any, progress: bool) -> SweepResult:
+    from rgraph.sweep import plots  # matplotlib: only when sweeping
+
     extremes = set(extreme_labels(settings, request.knobs, request.grid))
     notes: list[str] = []
     renderings: dict[tuple, _Rendering] = {}
@@ -147,7 +155,7 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
             key = params_key(resolved_params[s.label])
             if key not in renderings:
                 step(s.label)
-                renderings[key] = _render(request, plans[key], notes)
+                renderings[key] = _render(request, plans[key], notes, gpu)
             rendering = renderings[key]
             if reference is None:
                 reference = rendering
@@ -181,27 +189,22 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
     )
 
 
-def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, Plan]:
-    """Plans by params key, compiled with the live device's memory requirements."""
+def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> dict[tuple, Plan]:
+    """Plans by params key, compiled with the memory requirements of ``gpu``, the device that renders them."""
     from rgraph.compiler.pipeline import compile_graph_plan
-    from rgraph.vk.memreq import live_requirements
 
     source = load_graph(resolve_graph(request.graph))
     plans: dict[tuple, Plan] = {}
-    with live_requirements(request.device) as (memory, _device):
-        for s in settings:
-            plans[params_key(resolved(source, s.overrides))] = compile_graph_plan(
-                request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
-                policy=request.policy, memory=memory,
-                extra_outputs=[request.hdr] if request.hdr else [])
+    memory = gpu.memory_requirements()
+    for s in settings:
+        plans[params_key(resolved(source, s.overrides))] = compile_graph_plan(
+            request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
+            policy=request.policy, memory=memory, extra_outputs=[request.hdr] if request.hdr else [])
     return plans
 
 
-def _render(request: SweepRequest, plan: Plan, notes: list[str]) -> _Rendering:
-    from rgraph.vk.executor import execute_plan
-
-    result = execute_plan(plan.to_json_dict(), validate=request.validate, frames=request.frames, device_index=request.device,
-                          check_data=False, read_outputs=True)
+def _render(request: SweepRequest, plan: Plan, notes: list[str], gpu: Any) -> _Rendering:
+    result = gpu.load(plan).run_and_check(request.frames, check_data=False, read_outputs=True)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None

@@ -19,7 +19,6 @@ import pytest
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.random_graph import random_graph, to_yaml
 from rgraph.vk.lower.batches import make_batches
-from rgraph.vk.lower.workarounds.layer_races import avoid_layer_races, racing_batches, touched_resources
 from rgraph.vk.lower.semaphores import (
     BatchSync,
     batch_semaphores,
@@ -27,6 +26,7 @@ from rgraph.vk.lower.semaphores import (
     semaphore_edges,
     submission_order,
 )
+from rgraph.vk.lower.workarounds.layer_races import avoid_layer_races, racing_batches, touched_resources
 
 ALL = 1 << 16
 SETS = 2

@@ -24,8 +24,8 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable
 from dataclasses import replace
 
-from rgraph.vk.lower.model import BarrierSpec
 from rgraph.vk.lower.context import BarrierContext
+from rgraph.vk.lower.model import BarrierSpec
 
 
 def _overlaps(a: dict | None, b: dict | None) -> bool:

@@ -1,7 +1,7 @@
 """Transfer stages widened to ALL_TRANSFER for Khronos validation 1.3.239.
 
 The compiler names the stage a transfer usage runs in (``COPY`` for ``transfer_src`` and
-``transfer_dst``, rgraph/compiler/usages.py). Synchronization validation 1.3.239 misreports
+``transfer_dst`` in the usage table of the compiler package). Synchronization validation 1.3.239 misreports
 barriers and semaphore waits that name the narrower transfer stages (COPY, BLIT, RESOLVE,
 CLEAR) for copy commands, so the runtime records them as ALL_TRANSFER, a superset (the same
 dependency or a wider one). This rewrite applies to the whole plan before lowering: pass

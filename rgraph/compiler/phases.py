@@ -25,9 +25,11 @@ from typing import TYPE_CHECKING
 
 from rgraph.compiler import memory
 from rgraph.compiler.emit import emit as emit_plan
-from rgraph.compiler.sync import SyncResult, synchronize as synchronize_passes
+from rgraph.compiler.sync import SyncResult
+from rgraph.compiler.sync import synchronize as synchronize_passes
 from rgraph.errors import RGraphError
-from rgraph.ir.cull import Culling, cull as cull_spec
+from rgraph.ir.cull import Culling
+from rgraph.ir.cull import cull as cull_spec
 from rgraph.memory.model import Placement
 from rgraph.spec.specialize import PassSpec, Spec
 

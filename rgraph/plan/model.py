@@ -83,8 +83,8 @@ class Barrier:
 
 
 @dataclass(frozen=True, slots=True)
-class Wait:
-    """Wait on queue ``queue``'s timeline semaphore for ``value``; ``stages``: dst stage mask."""
+class TimelineValue:
+    """A value of queue ``queue``'s timeline semaphore and a stage mask (``Wait``, ``Signal``)."""
 
     queue: str
     value: int
@@ -92,12 +92,13 @@ class Wait:
 
 
 @dataclass(frozen=True, slots=True)
-class Signal:
-    """Signal this pass's queue's timeline semaphore to ``value``; ``stages``: src stage mask."""
+class Wait(TimelineValue):
+    """Wait for ``queue``'s timeline to reach ``value`` before the pass; ``stages``: dst stage mask."""
 
-    queue: str
-    value: int
-    stages: Names
+
+@dataclass(frozen=True, slots=True)
+class Signal(TimelineValue):
+    """Signal this pass's queue's timeline to ``value`` after the pass; ``stages``: src stage mask."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,10 +13,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from rgraph.jsonloc import locate
 from rgraph.errors import RGraphError
+from rgraph.jsonloc import locate
 
-PLAN_FORMAT = "rgraph-plan/1"
+from rgraph.plan.model import PLAN_FORMAT  # noqa: E402
 
 Plan = dict[str, Any]
 

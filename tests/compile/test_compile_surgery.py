@@ -1,13 +1,13 @@
 """The bundled surgery graph: golden plans, determinism, and scene-driven culling."""
 
 from __future__ import annotations
-from locations import TESTS
 
 import json
 import os
 from pathlib import Path
 
 import pytest
+from locations import TESTS
 
 from rgraph.cli import main
 from rgraph.compiler.pipeline import compile_graph

@@ -130,3 +130,12 @@ def test_inspect_lowered_prints_every_pass_and_batch(tmp_path, capsys, surgery):
     assert "semaphore: batch" in out and "family 0 -> 1" in out
     assert main(["inspect", str(path), "--lowered", "--no-layer-workarounds"]) == 0
     assert "layer workarounds: none" in capsys.readouterr().out
+
+
+def test_typed_plan_lowers_like_its_document():
+    import rgraph
+
+    compiled = rgraph.compile("surgery", size=(64, 64), profile="lavapipe")
+    typed, document = lower(compiled.plan, SEPARATE), lower(compiled.as_dict(), SEPARATE)
+    assert (typed.passes, typed.batches, typed.edges, typed.order) == \
+        (document.passes, document.batches, document.edges, document.order)

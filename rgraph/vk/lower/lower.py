@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from rgraph.plan.model import Plan
+
 from rgraph.vk.lower.barriers import lower_barriers
 from rgraph.vk.lower.batches import first_frame_releases, make_batches
 from rgraph.vk.lower.model import Batch, PassRecording, Recording
@@ -23,12 +25,17 @@ class LoweringError(ValueError):
     """The plan's semaphores cannot be ordered (a wait for a later or missing signal, a cycle)."""
 
 
-def lower(plan: dict, queues: QueueLayout, *, one_batch_per_pass: bool = False,
+def lower(plan: Plan | dict, queues: QueueLayout, *, one_batch_per_pass: bool = False,
           workarounds: Iterable[str] = LAYER_WORKAROUNDS) -> Recording:
     """The recording of ``plan`` on ``queues``: per pass its barrier calls, the batches (one
     command buffer each; ``one_batch_per_pass`` under validation, so that messages name the
     pass), the frame's semaphore edges and the host submission order. ``workarounds``: the
-    validation-layer rewrites to apply (``rgraph.vk.lower.workarounds``; () for none)."""
+    validation-layer rewrites to apply (``rgraph.vk.lower.workarounds``; () for none).
+
+    ``plan`` is a typed ``rgraph.plan.Plan`` or its JSON document; the rewrites read the
+    document (``Recording.plan`` is the document the runtime executes)."""
+    if isinstance(plan, Plan):
+        plan = plan.to_json_dict()
     enabled = check_names(tuple(workarounds))
     disabled = [name for name in LAYER_WORKAROUNDS if name not in enabled]
     if "transfer_stages" in enabled:

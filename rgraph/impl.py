@@ -8,7 +8,7 @@ A pass implementation is a class registered under a name::
     class Tonemap(PassImpl):
         def __init__(self, setup):          # rgraph.vk.passkit.PassSetup: pipelines, views, params
             ...
-        def record(self, rec, frame_set):   # rgraph.vk.record.RecordContext: no barrier calls
+        def record(self, rec, frame_set):   # rgraph.vk.record_context.RecordContext: no barrier calls
             ...
 
 Built-in implementations live in ``rgraph.passes`` (``passes/`` in a checkout) and

@@ -19,7 +19,7 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import PassSetup
 from rgraph.vk.probe import PROBE
-from rgraph.vk.record import RecordContext
+from rgraph.vk.record_context import RecordContext
 from rgraph.vk.resources import ResourceSet
 
 ATTACHMENT_USAGES = ("color_attachment", "color_attachment_blend", "depth_attachment", "depth_read")

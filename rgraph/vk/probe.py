@@ -22,7 +22,7 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import PassSetup
 from rgraph.vk.probe_glsl import ProbeShaders, generate
-from rgraph.vk.record import RecordContext
+from rgraph.vk.record_context import RecordContext
 from rgraph.vk.resources import HostBuffer, Resource
 from rgraph.vk.runtime.staging import fill_bytes, image_copy_regions
 

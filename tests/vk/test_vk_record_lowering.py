@@ -1,4 +1,4 @@
-"""Plan barriers -> sync2 structs (``rgraph.vk.record.lower_barriers``), pure: a fake device
+"""Plan barriers -> barrier calls (``rgraph.vk.lower.barriers.lower_barriers``), pure: a fake device
 with a separate compute queue family (as on NVIDIA) checks the exact structs of ownership
 transfers, which lavapipe (one queue family) never records."""
 

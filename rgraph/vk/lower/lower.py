@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from rgraph.plan.model import Plan
-
 from rgraph.vk.lower.barriers import lower_barriers
 from rgraph.vk.lower.batches import first_frame_releases, make_batches
 from rgraph.vk.lower.model import Batch, PassRecording, Recording

@@ -10,7 +10,8 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph.vk.loader import vk
-from rgraph.vk.record import RecordContext, barrier_batches
+from rgraph.vk.record import barrier_batches
+from rgraph.vk.record_context import RecordContext
 from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT, pool
 
 

@@ -139,3 +139,25 @@ def test_typed_plan_lowers_like_its_document():
     typed, document = lower(compiled.plan, SEPARATE), lower(compiled.as_dict(), SEPARATE)
     assert (typed.passes, typed.batches, typed.edges, typed.order) == \
         (document.passes, document.batches, document.edges, document.order)
+
+
+@pytest.mark.parametrize(("seed", "passes"), [(10, 10), (1, 15), (20, 20)])
+def test_true_transfer_stages_record_as_the_old_all_transfer_plans(seed, passes):
+    """With the workarounds on, a plan naming COPY (the compiler's usage table now) records
+    exactly what the same plan naming ALL_TRANSFER (the table before) recorded."""
+    import json
+    import tempfile
+    from pathlib import Path
+
+    from rgraph.random_graph import random_graph, to_yaml
+
+    path = Path(tempfile.mkdtemp()) / f"g{seed}.yaml"
+    path.write_text(to_yaml(random_graph(seed, passes)))
+    plan = compile_graph(str(path), size=(16, 16), policy="aliased")
+    text = json.dumps(plan)
+    assert '"COPY"' in text, "the seed should have a transfer usage"
+    old = json.loads(text.replace('"COPY"', '"ALL_TRANSFER"'))
+    for queues in (SINGLE, SEPARATE):
+        new_rec, old_rec = lower(plan, queues), lower(old, queues)
+        assert (new_rec.passes, new_rec.edges, new_rec.order, new_rec.first_frame) == \
+            (old_rec.passes, old_rec.edges, old_rec.order, old_rec.first_frame)

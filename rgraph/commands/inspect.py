@@ -110,6 +110,18 @@ def emit_dot(plan: dict[str, Any], dest: str, out: TextIO) -> None:
         _write(dest, text)
 
 
+def _warn_if_not_runnable(path: str, err: TextIO) -> None:
+    """The views show partial plans too; say when the typed loader (``rgraph run``) refuses one."""
+    from rgraph.plan import load
+
+    try:
+        load(path)
+    except RGraphError as exc:
+        d = exc.first
+        print(f"{d.location}: warning: {d.message} (rgraph run refuses this plan; the views show what is there)",
+              file=err)
+
+
 def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None = None) -> int:
     from rgraph.report import text
     from rgraph.report.table import make_console
@@ -117,6 +129,8 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
     plan = obtain_plan(args)
+    if args.target.endswith(".json"):
+        _warn_if_not_runnable(args.target, err)
     console = make_console(out)
     dot_to_stdout = args.dot == "-"
     timings = load_timings(args.timings) if args.timings else None

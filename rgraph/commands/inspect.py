@@ -119,7 +119,7 @@ def emit_dot(plan: dict[str, Any], dest: str, out: TextIO) -> None:
         _write(dest, text)
 
 
-def lowered_text(plan: dict[str, Any], queues: str, workarounds: bool = True) -> str:
+def lowered_text(plan: Any, queues: str, workarounds: bool = True) -> str:
     """``--lowered``: the recording of ``plan`` on the ``queues`` model, as text."""
     from rgraph.vk.lower import LAYER_WORKAROUNDS, LoweringError, lower
     from rgraph.vk.lower.queues import MODELS
@@ -132,6 +132,18 @@ def lowered_text(plan: dict[str, Any], queues: str, workarounds: bool = True) ->
     return format_recording(recording)
 
 
+def _warn_if_not_runnable(path: str, err: TextIO) -> None:
+    """The views show partial plans too; say when the typed loader (``rgraph run``) refuses one."""
+    from rgraph.plan import load
+
+    try:
+        load(path)
+    except RGraphError as exc:
+        d = exc.first
+        print(f"{d.location}: warning: {d.message} (rgraph run refuses this plan; the views show what is there)",
+              file=err)
+
+
 def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None = None) -> int:
     from rgraph.report import text
     from rgraph.report.table import make_console
@@ -139,11 +151,16 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
     plan = obtain_plan(args)
+    if args.target.endswith(".json") and not args.lowered:
+        _warn_if_not_runnable(args.target, err)
     console = make_console(out)
     dot_to_stdout = args.dot == "-"
     timings = load_timings(args.timings) if args.timings else None
-    if args.lowered:
-        out.write(lowered_text(plan, args.queues, args.layer_workarounds))
+    if args.lowered:  # what rgraph run would record: a plan file must pass the typed loader
+        from rgraph.plan import load
+
+        source = load(args.target) if args.target.endswith(".json") else plan
+        out.write(lowered_text(source, args.queues, args.layer_workarounds))
     if not (args.barriers or args.memory or dot_to_stdout or args.lowered):
         text.print_summary(console, plan, timings)
     if args.barriers:

@@ -26,13 +26,19 @@ def plan_state(st: csync.State) -> pm.State:
     return pm.State(tuple(sorted(st.stages)), tuple(sorted(st.access)), st.layout, st.queue)
 
 
+@lru_cache(maxsize=65536)
+def _range_pair(mips: tuple[int, int], layers: tuple[int, int]) -> pm.Subresource:
+    return pm.Subresource(mips, layers)  # immutable: one object per distinct pair of ranges
+
+
 def _subresource(res: ResourceSpec, mips, layers) -> pm.Subresource | None:
-    return pm.Subresource(tuple(mips), tuple(layers)) if res.is_image else None
+    return _range_pair(tuple(mips), tuple(layers)) if res.is_image else None
 
 
 def _barrier(b: csync.Barrier, resources: Mapping[str, ResourceSpec]) -> pm.Barrier:
-    return pm.Barrier(b.resource, _subresource(resources[b.resource], b.mips, b.layers), plan_state(b.key.src),
-                      plan_state(b.key.dst), tuple(b.key.aliases))
+    key = b.key
+    return pm.Barrier(b.resource, _subresource(resources[b.resource], b.mips, b.layers), plan_state(key.src),
+                      plan_state(key.dst), key.aliases)
 
 
 def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.EndState:

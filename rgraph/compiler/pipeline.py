@@ -67,25 +67,6 @@ def frontend(
     return Frontend(source, scene, spec)
 
 
-def compile_plan(
-    spec: Spec,
-    *,
-    policy: str = DEFAULT_POLICY,
-    memory_provider: MemoryRequirementsProvider | None = None,
-    profile_name: str | None = None,
-) -> Plan:
-    """Spec -> typed plan (the part benchmarked by benchmarks/compile_scaling.py)."""
-    # The compiler allocates many small acyclic objects; the cyclic collector would rescan
-    # the whole (large) heap again and again. Nothing here creates reference cycles.
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        return compilation(spec, policy=policy, memory_provider=memory_provider, profile_name=profile_name).plan
-    finally:
-        if enabled:
-            gc.enable()
-
-
 def compilation(
     spec: Spec,
     *,
@@ -99,7 +80,22 @@ def compilation(
 
         memory_provider = ProfileMemoryRequirements.named(DEFAULT_PROFILE)
         profile_name = profile_name or DEFAULT_PROFILE
-    return run_phases(Compilation(spec, policy, memory_provider, profile_name or "device"))
+    # The compiler allocates many small acyclic objects; the cyclic collector would rescan
+    # the whole (large) heap again and again. Nothing here creates reference cycles.
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return run_phases(Compilation(spec, policy, memory_provider, profile_name or "device"))
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def compile_plan(spec: Spec, **options: Any) -> Plan:
+    """Spec -> typed plan (the part benchmarked by benchmarks/compile_scaling.py); options as ``compilation``."""
+    plan = compilation(spec, **options).plan
+    assert plan is not None
+    return plan
 
 
 def compile_spec(spec: Spec, **options: Any) -> dict[str, Any]:

@@ -13,7 +13,7 @@ Problem = tuple[str, str]
 
 
 def check_consistency(plan: Plan) -> Problem | None:
-    for check in (_queues, _passes, _resources):
+    for check in (_queues, _vocabulary, _passes, _resources):
         for problem in check(plan):
             return problem
     return None
@@ -35,6 +35,37 @@ def _queues(plan: Plan) -> Iterator[Problem]:
     for i, name in enumerate(plan.outputs):
         if name not in plan.resource_by_name:
             yield f"outputs[{i}]", f"no resource {name!r} in resources"
+
+
+def _word(value: str, words: tuple[str, ...] | frozenset[str], where: str, what: str) -> Iterator[Problem]:
+    if value not in words:
+        yield where, f"unknown {what} {value!r} (expected one of {', '.join(sorted(words))})"
+
+
+def _vocabulary(plan: Plan) -> Iterator[Problem]:
+    """Pass kinds, usages and formats are the closed vocabularies of FORMAT.md."""
+    from rgraph.spec.vocabulary import PASS_KINDS, USAGES
+
+    for i, p in enumerate(plan.passes):
+        yield from _word(p.kind, PASS_KINDS, f"passes[{i}].kind", "pass kind")
+        for j, a in enumerate(p.accesses):
+            yield from _word(a.usage, USAGES, f"passes[{i}].accesses[{j}].usage", "usage")
+    for i, r in enumerate(plan.resources):
+        for j, u in enumerate(r.usages):
+            yield from _word(u, USAGES, f"resources[{i}].usages[{j}]", "usage")
+        if r.format is not None and not _known_format(r.format):
+            yield f"resources[{i}].format", f"unknown format {r.format!r} (VkFormat without VK_FORMAT_)"
+        elif r.format is None and r.is_image:
+            yield f"resources[{i}].format", f"image {r.name!r} needs a format, got null"
+
+
+def _known_format(name: str) -> bool:
+    from rgraph.formats import lookup
+
+    try:
+        return lookup(name).vk_name == name
+    except KeyError:
+        return False
 
 
 def _queue(plan: Plan, queue: str, where: str) -> Iterator[Problem]:

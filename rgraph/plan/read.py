@@ -16,7 +16,7 @@ from types import MappingProxyType
 from typing import Any, NoReturn
 
 from rgraph.errors import RGraphError
-from rgraph.jsonloc import locate
+from rgraph.jsonloc import locate, path_parts
 from rgraph.plan.model import (
     IMAGE_KEYS,
     LIFETIMES,
@@ -361,21 +361,12 @@ def _plan(doc: Any) -> Plan:
 
 # -- entry points ------------------------------------------------------------------------
 
-_PART = re.compile(r"\[(\d+)\]|([^.\[\]]+)")
-
-
-def _parts(where: Where) -> list[str | int]:
-    if where == "top level":
-        return []
-    return [int(index) if index else key for index, key in _PART.findall(where)]
-
-
 def from_json_dict(doc: Any, file: str = "<plan>", text: str | None = None) -> Plan:
     """The plan model of a decoded plan document; ``text`` (its JSON) locates errors."""
     try:
         return _plan(doc)
     except _Shape as exc:
-        line, col = locate(text, _parts(exc.where)) if text is not None else (1, 1)
+        line, col = locate(text, path_parts(exc.where)) if text is not None else (1, 1)
         raise RGraphError.in_file(file, f"malformed plan: {exc.where}: {exc.message}", line, col) from None
 
 

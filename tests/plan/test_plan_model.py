@@ -115,6 +115,12 @@ CASES = [
     (lambda d: d["passes"][P]["accesses"][A]["subresource"].update(mips=[0, 9]),
      rf"passes\[{P}\]\.accesses\[{A}\]\.subresource\.mips: range \[0, 9\] exceeds"),
     (lambda d: d["resources"].append(copy.deepcopy(d["resources"][0])), r"resources\[\d+\]: duplicate resource"),
+    (lambda d: d["passes"][0].update(kind="magic"), r"passes\[0\]\.kind: unknown pass kind 'magic'"),
+    (lambda d: d["passes"][P]["accesses"][A].update(usage="sampledd"),
+     rf"passes\[{P}\]\.accesses\[{A}\]\.usage: unknown usage 'sampledd'"),
+    (lambda d: d["resources"][0]["usages"].append("bogus"), r"resources\[0\]\.usages\[\d+\]: unknown usage 'bogus'"),
+    (lambda d: next(r for r in d["resources"] if r["kind"] == "image").update(format="R8G8B8A8_FANCY"),
+     r"resources\[\d+\]\.format: unknown format 'R8G8B8A8_FANCY'"),
 ]
 
 

@@ -161,3 +161,15 @@ def test_true_transfer_stages_record_as_the_old_all_transfer_plans(seed, passes)
         new_rec, old_rec = lower(plan, queues), lower(old, queues)
         assert (new_rec.passes, new_rec.edges, new_rec.order, new_rec.first_frame) == \
             (old_rec.passes, old_rec.edges, old_rec.order, old_rec.first_frame)
+
+
+def test_inspect_lowered_refuses_a_partial_plan_with_one_line(tmp_path, capsys, surgery):
+    import json
+
+    broken = json.loads(json.dumps(surgery))
+    del broken["passes"][2]["barriers"]
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(broken))
+    assert main(["inspect", str(path), "--lowered"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "malformed plan: passes[2]: missing key 'barriers'" in err[0], err

@@ -7,8 +7,9 @@
         result = exe.run(frames=3)                         # timings, validation messages
         images = exe.read_outputs()                        # name -> numpy array
 
-``gpu.load`` accepts a ``Compiled``, a typed ``Plan``, a plan dict or a plan file; ``gpu.memory_requirements()``
-is the provider the compiler sizes resources with (``compile_graph(..., memory=...)``).
+``gpu.load`` accepts a ``Compiled``, a typed ``Plan``, a plan dict or a plan file;
+``gpu.memory_requirements()`` is the provider the compiler sizes resources with
+(``compile_graph(..., memory=...)``). docs/api.md has the whole API.
 Everything a device needs is closed when the ``with`` block ends; executables close first.
 """
 
@@ -104,7 +105,7 @@ class Gpu:
 
     def close(self) -> list[Any]:
         """Close every executable, then the device and instance; every message logged."""
-        for exe in self._executables:
+        for exe in list(self._executables):
             exe.close()
         self._executables = []
         if self.device is not None and self.device.handle is not None:
@@ -210,9 +211,12 @@ class Executable:
         return result
 
     def close(self) -> list[Any]:
+        """Destroy this plan's objects (the device stays open); its messages."""
         if not self._closed:
             self._closed = True
             self.executor.close()
+            if self in self.gpu._executables:
+                self.gpu._executables.remove(self)
         return self.messages
 
     def __enter__(self) -> Executable:

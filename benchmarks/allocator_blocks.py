@@ -4,8 +4,8 @@ blocks of 0 (one VkDeviceMemory per buffer), 4, 16, 64, 256 MiB; load time and f
 For each mix (rigid: every mesh device-local and uploaded once; deformable: every mesh
 host-visible, one copy per frame in flight, rewritten each frame; mixed: the scene's own
 deformable meshes, 10%) and each block size, compiles ``graphs/allocator_lines.yaml`` with
-the ``alloc.*`` params and runs it with ``rgraph.vk.executor.execute_plan`` (a fresh
-instance and device per run). Figures come from the ``mesh_lines`` pass itself
+the ``alloc.*`` params and runs it on one device (``rgraph.open_device``; each run loads
+its plan afresh, so its memory blocks are allocated and freed within the run). Figures come from the ``mesh_lines`` pass itself
 (``MeshLines.last_report``: wall clock around the real Vulkan calls) and from the run's
 timings (timestamp queries):
 
@@ -82,17 +82,16 @@ def compile_plan(args: argparse.Namespace, block_mib: int, mix: str, memory: Any
     return compile_graph(GRAPH, params=params, size=args.size, memory=memory)
 
 
-def run_one(args: argparse.Namespace, plan: dict, block_mib: int, mix: str, frames: int) -> dict[str, Any]:
+def run_one(gpu: Any, args: argparse.Namespace, plan: dict, block_mib: int, mix: str, frames: int) -> dict[str, Any]:
     from rgraph.impl import lookup
     from rgraph.vk.errors import ExecutionError
-    from rgraph.vk.executor import execute_plan
 
     cls: Any = lookup("mesh_lines")
     cls.last_report = {}
     t0 = time.perf_counter()
     row: dict[str, Any] = {"mix": mix, "block_mib": block_mib}
     try:
-        result = execute_plan(plan, validate=args.validate, frames=frames, device_index=args.device)
+        result = gpu.load(plan).run_and_check(frames, check_data=False)
     except ExecutionError as exc:
         row.update(cls.last_report)
         row["error"] = str(exc)
@@ -176,27 +175,32 @@ def plot(rows: list[dict[str, Any]], sizes: list[int], path: Path, title: str) -
     plt.close(fig)
 
 
-def compile_all(args: argparse.Namespace) -> tuple[dict[tuple[str, int], dict], dict, str, int]:
+def compile_all(gpu: Any, args: argparse.Namespace) -> tuple[dict[tuple[str, int], dict], dict, str, int]:
     """Every plan (and a tiny warm-up one), compiled with the image memory requirements of the
     device that will run them; the device's name and maxMemoryAllocationCount."""
-    from rgraph.vk.memreq import live_requirements
-
-    with live_requirements(args.device) as (memory, device):
-        plans = {(mix, block): compile_plan(args, block, mix, memory) for mix in args.mix for block in args.sizes}
-        warm = compile_plan(argparse.Namespace(**{**vars(args), "meshes": 16, "segments": 4}), 4, "mixed", memory)
-        return plans, warm, device.name, int(device.properties.limits.maxMemoryAllocationCount)
+    memory = gpu.memory_requirements()
+    plans = {(mix, block): compile_plan(args, block, mix, memory) for mix in args.mix for block in args.sizes}
+    warm = compile_plan(argparse.Namespace(**{**vars(args), "meshes": 16, "segments": 4}), 4, "mixed", memory)
+    return plans, warm, gpu.name, int(gpu.device.properties.limits.maxMemoryAllocationCount)
 
 
 def main(argv: list[str] | None = None) -> int:
+    import rgraph
+
     args = parse_args(argv)
-    plans, warm, device_name, limit = compile_all(args)
+    with rgraph.open_device(validate=args.validate, device=args.device, verbose=False) as gpu:
+        return measure(gpu, args, argv)
+
+
+def measure(gpu: Any, args: argparse.Namespace, argv: list[str] | None) -> int:
+    plans, warm, device_name, limit = compile_all(gpu, args)
     print(f"device: {device_name}; maxMemoryAllocationCount = {limit}; meshes {args.meshes} x "
           f"{args.segments} segments; {args.frames} frames at {args.size[0]}x{args.size[1]}"
           f"{'; validation on' if args.validate else ''}", flush=True)
-    run_one(args, warm, 4, "mixed", 2)  # warm-up (SPIR-V cache, pipeline JIT, imports): not reported
+    run_one(gpu, args, warm, 4, "mixed", 2)  # warm-up (SPIR-V cache, pipeline JIT, imports): not reported
     rows = []
     for (mix, block), plan in plans.items():
-        row = run_one(args, plan, block, mix, args.frames)
+        row = run_one(gpu, args, plan, block, mix, args.frames)
         rows.append(row)
         state = row.get("error") or f"load {row['load_ms']:.0f} ms, frame {row['frame_ms']:.2f} ms"
         print(f"  {mix} block {block} MiB: {state}", file=sys.stderr, flush=True)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rgraph.compiler.pipeline import compile_spec, frontend  # noqa: E402
+from rgraph.compiler.pipeline import compile_plan, frontend  # noqa: E402
 from rgraph.random_graph import random_graph, to_yaml  # noqa: E402
 
 
@@ -32,9 +32,9 @@ def measure(passes: int, policy: str, repeats: int) -> tuple[float, int, int]:
     plan = {}
     for _ in range(repeats):
         start = time.perf_counter()
-        plan = compile_spec(spec, policy=policy)
+        plan = compile_plan(spec, policy=policy)
         times.append(time.perf_counter() - start)
-    return statistics.median(times), len(plan["passes"]), plan["stats"]["barriers"]
+    return statistics.median(times), len(plan.passes), plan.stats.barriers
 
 
 def main() -> None:

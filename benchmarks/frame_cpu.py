@@ -34,16 +34,16 @@ import statistics
 import time
 from typing import Any
 
+import rgraph
 from rgraph.compiler.pipeline import compile_graph
-from rgraph.vk.executor import FRAME_CALLS, Executor, marks_per_frame
-from rgraph.vk.memreq import live_requirements
+from rgraph.vk.executor import FRAME_CALLS, marks_per_frame
 
 
-def compile_for_device(size: tuple[int, int], policy: str | None = None, graph: str = "surgery",
+def compile_for_device(gpu: rgraph.Gpu, size: tuple[int, int], policy: str | None = None, graph: str = "surgery",
                        sync: str | None = None) -> tuple[dict, str, bool]:
-    with live_requirements() as (memory, device):
-        plan = compile_graph(graph, size=size, policy=policy, memory=memory, **({"sync": sync} if sync else {}))
-        return plan, device.name, device.physical.device_type != "cpu"
+    plan = compile_graph(graph, size=size, policy=policy, memory=gpu.memory_requirements(),
+                         **({"sync": sync} if sync else {}))
+    return plan, gpu.name, gpu.choice["type"] != "cpu"
 
 
 def probe_only(plan: dict) -> dict:
@@ -51,16 +51,13 @@ def probe_only(plan: dict) -> dict:
     return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
 
 
-def frame_cpu_us(plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, Any]:
+def frame_cpu_us(gpu: rgraph.Gpu, plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, Any]:
     """Per frame (microseconds, frame start to next frame start): blocked in the fence wait,
     each Vulkan call, and Python (the rest); ``calls``: vkQueueSubmit2 calls per frame."""
-    executor = Executor(plan, validate=False, device_index=None, verbose=False, one_call_per_queue=one_call_per_queue)
     marks: list[float] = []
-    try:
-        executor.run_frames(frames, marks=marks)
-        calls = len(executor.submit_calls[0])
-    finally:
-        executor.close()
+    with gpu.load(plan, one_call_per_queue=one_call_per_queue) as exe:
+        exe.run(frames, marks=marks)
+        calls = len(exe.executor.submit_calls[0])
     return frame_parts(marks, calls)
 
 
@@ -86,25 +83,23 @@ def frame_parts(marks: list[float], calls: int, skip: int = 10) -> dict[str, Any
     return parts
 
 
-def gpu_busy(plan: dict, frames: int) -> dict[str, float]:
-    executor = Executor(plan, validate=False, device_index=None, verbose=False)
-    try:
-        executor.run_frames(20)  # warm-up (pipelines, caches, clocks)
+def gpu_busy(gpu: rgraph.Gpu, plan: dict, frames: int) -> dict[str, float]:
+    with gpu.load(plan) as exe:
+        exe.run(20)  # warm-up (pipelines, caches, clocks)
         t0 = time.perf_counter()
-        timings = executor.run_frames(frames)
+        timings = exe.run(frames).timings
         wall_ms = (time.perf_counter() - t0) * 1000.0 / frames
-    finally:
-        executor.close()
     span = timings["total_ms"] or 0.0
     summed = min(sum(v for v in timings["passes"].values() if v is not None), span)
     return {"wall_ms": wall_ms, "span_ms": span, "sum_ms": summed, "span_fraction": span / wall_ms,
             "sum_fraction": summed / wall_ms, "cpu_submit_ms": timings["cpu_submit_ms"]}
 
 
-def compare_sync(size: tuple[int, int], frames: int, policy: str | None, passes: str, rounds: int) -> None:
+def compare_sync(gpu: rgraph.Gpu, size: tuple[int, int], frames: int, policy: str | None, passes: str,
+                 rounds: int) -> None:
     plans = {}
     for mode in ("normal", "naive"):
-        plan, device, _ = compile_for_device(size, policy, sync=mode)
+        plan, device, _ = compile_for_device(gpu, size, policy, sync=mode)
         plans[mode] = probe_only(plan) if passes == "probe" else plan
     print(f"device: {device}")
     print(f"surgery {size[0]}x{size[1]} ({passes} passes), {frames} frames per round; normal: "
@@ -113,7 +108,7 @@ def compare_sync(size: tuple[int, int], frames: int, policy: str | None, passes:
     results: dict[str, list[dict[str, float]]] = {"normal": [], "naive": []}
     for r in range(rounds):
         for mode in ("normal", "naive") if r % 2 == 0 else ("naive", "normal"):
-            busy = gpu_busy(plans[mode], frames)
+            busy = gpu_busy(gpu, plans[mode], frames)
             results[mode].append(busy)
             print(f"  round {r} {mode:6s}: wall {busy['wall_ms']:.3f} ms/frame, GPU span {busy['span_ms']:.3f} ms")
     wall = {m: statistics.median(b["wall_ms"] for b in v) for m, v in results.items()}
@@ -140,15 +135,20 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3,
                         help="rounds of the CPU measurement and of --compare-sync (default 3)")
     args = parser.parse_args()
+    with rgraph.open_device(validate=False, verbose=False) as gpu:  # one device for every measurement
+        measure(gpu, args)
+
+
+def measure(gpu: rgraph.Gpu, args: argparse.Namespace) -> None:
     if args.compare_sync:
         cw, ch = (int(x) for x in args.compare_sync.lower().split("x"))
-        compare_sync((cw, ch), args.busy_frames, args.policy, args.passes, args.rounds)
+        compare_sync(gpu, (cw, ch), args.busy_frames, args.policy, args.passes, args.rounds)
         return
     w, h = (int(x) for x in args.size.lower().split("x"))
-    plan, device, is_gpu = compile_for_device((w, h), args.policy)
+    plan, device, is_gpu = compile_for_device(gpu, (w, h), args.policy)
     if args.passes == "probe":
         plan = probe_only(plan)
-    parts = frame_cpu_us(plan, args.frames)
+    parts = frame_cpu_us(gpu, plan, args.frames)
     passes = len(plan["passes"])
     print(f"device: {device}")
     print(f"surgery {w}x{h} ({args.passes} passes): {passes} passes, "
@@ -166,7 +166,7 @@ def main() -> None:
     for r in range(args.rounds):  # same process: rounds alternate one call per queue / per run of batches
         for mode in ("per run", "per queue") if r % 2 == 0 else ("per queue", "per run"):
             if r or mode == "per run":
-                rounds[mode].append(frame_cpu_us(plan, args.frames, one_call_per_queue=mode == "per queue"))
+                rounds[mode].append(frame_cpu_us(gpu, plan, args.frames, one_call_per_queue=mode == "per queue"))
     for mode, measured in rounds.items():
         python = [statistics.median(m["python"]) for m in measured]
         runtime = [statistics.median(m["runtime"]) for m in measured]
@@ -179,10 +179,10 @@ def main() -> None:
     if not is_gpu:
         print("GPU busy fraction: skipped (CPU device: lavapipe runs the frame on CPU threads)")
         return
-    plan1080, _, _ = compile_for_device((1920, 1080), args.policy)
+    plan1080, _, _ = compile_for_device(gpu, (1920, 1080), args.policy)
     if args.passes == "probe":
         plan1080 = probe_only(plan1080)
-    busy = gpu_busy(plan1080, args.busy_frames)
+    busy = gpu_busy(gpu, plan1080, args.busy_frames)
     print(f"surgery 1920x1080, {args.busy_frames} frames: wall {busy['wall_ms']:.3f} ms/frame, GPU span "
           f"{busy['span_ms']:.3f} ms, GPU pass sum {busy['sum_ms']:.3f} ms, submit CPU {busy['cpu_submit_ms']:.3f} ms")
     print(f"GPU busy fraction: span/wall {100 * busy['span_fraction']:.1f}%, sum/wall "

@@ -39,18 +39,20 @@ def case(seed: int, max_passes: int) -> tuple[int, int, str]:
 
 
 def run_chunk(entries: list[tuple[int, int, str]]) -> list[dict[str, Any]]:
-    """One worker process's cases: the device is opened once for memory requirements (a
-    failure is reported with every case), then each graph compiled and run."""
-    from rgraph.vk.memreq import live_requirements
+    """One worker process's cases: the device is opened once (validation on) for memory
+    requirements and every run (a failure is reported with every case), then each graph
+    compiled and run on it."""
+    import rgraph
 
     tmp = Path(tempfile.mkdtemp(prefix="rgraph-fuzz-"))
     with ExitStack() as stack:
         try:
-            memory, _device = stack.enter_context(live_requirements())
+            gpu = stack.enter_context(rgraph.open_device(validate=True, verbose=False))
         except Exception as exc:  # noqa: BLE001 - reported per case
             error = f"worker could not open the device: {type(exc).__name__}: {exc}"
             return [failed(entry, error) for entry in entries]
-        return [run_case(entry, memory, tmp) for entry in entries]
+        memory = gpu.memory_requirements()
+        return [run_case(entry, gpu, memory, tmp) for entry in entries]
 
 
 def failed(entry: tuple[int, int, str], error: str) -> dict[str, Any]:
@@ -59,11 +61,10 @@ def failed(entry: tuple[int, int, str], error: str) -> dict[str, Any]:
             "ok": False, "seconds": 0.0}
 
 
-def run_case(entry: tuple[int, int, str], memory: Any, tmp: Path) -> dict[str, Any]:
+def run_case(entry: tuple[int, int, str], gpu: Any, memory: Any, tmp: Path) -> dict[str, Any]:
     """Compile and run one graph; its messages, data check and any exception."""
     from rgraph.compiler.pipeline import compile_spec, frontend
     from rgraph.random_graph import random_graph, to_yaml
-    from rgraph.vk.executor import execute_plan
 
     seed, passes, policy = entry
     record: dict[str, Any] = {"seed": seed, "passes": passes, "policy": policy}
@@ -72,7 +73,7 @@ def run_case(entry: tuple[int, int, str], memory: Any, tmp: Path) -> dict[str, A
         path = tmp / f"g_{seed}_{passes}.yaml"
         path.write_text(to_yaml(random_graph(seed, passes)))
         plan = compile_spec(frontend(path, size=(16, 16)).spec, policy=policy, memory_provider=memory)
-        result = execute_plan(plan, validate=True, frames=2, check_data=True)
+        result = gpu.load(plan).run_and_check(2, check_data=True)
         record.update(messages=[str(m) for m in result.messages], data_ok=result.data_ok,
                       mismatches=[str(m) for m in result.mismatches[:5]])
     except Exception as exc:  # noqa: BLE001 - a crash is a finding, reported with the case

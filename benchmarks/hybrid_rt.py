@@ -31,12 +31,13 @@ GBUFFER_PASSES = ("gbuffer",)
 
 def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: int, params: dict[str, str],
          extra: tuple[str, ...] = ()) -> tuple[dict, dict[str, Any]]:
-    from rgraph.vk.executor import execute_plan
-    from rgraph.vk.memreq import compile_for_device
+    from rgraph.api import open_device
+    from rgraph.compiler.pipeline import compile_graph
 
-    plan = compile_for_device(graph, None, scene_path=scene, size=size, camera=camera, params=params,
-                              extra_outputs=list(extra))
-    result = execute_plan(plan, frames=frames, read_outputs=True)
+    with open_device(validate=False, verbose=False) as gpu:  # one device sizes and runs the plan
+        plan = compile_graph(graph, scene_path=scene, size=size, camera=camera, params=params,
+                             extra_outputs=list(extra), memory=gpu.memory_requirements())
+        result = gpu.load(plan).run_and_check(frames, check_data=False, read_outputs=True)
     return result.timings, result.outputs
 
 

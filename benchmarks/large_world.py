@@ -135,14 +135,17 @@ def has_float64(device_index: int | None = None) -> tuple[bool, str]:
 
 def gpu_run(mode: int, distance: float, *, size: tuple[int, int], frames: int, instances: int, triangles: int,
             validate: bool = False, device_index: int | None = None) -> dict[str, Any]:
-    """Median GPU ms of the transform pass, the image, and validation messages."""
-    from rgraph.vk.executor import execute_plan
-    from rgraph.vk.memreq import compile_for_device
+    """Median GPU ms of the transform pass, the image, and validation messages (one device
+    compiles and runs)."""
+    import rgraph
+    from rgraph.compiler.pipeline import compile_graph
 
-    plan = compile_for_device(GPU_GRAPH, device_index, size=size, params={"lw.mode": str(mode), "lw.distance": repr(float(distance)),
-                                                       "lw.instances": str(instances), "lw.triangles": str(triangles)})
-    result = execute_plan(plan, validate=validate, frames=frames, device_index=device_index, read_outputs=True,
-                          check_data=False)
+    with rgraph.open_device(validate=validate, device=device_index, verbose=False) as gpu:
+        plan = compile_graph(GPU_GRAPH, size=size, memory=gpu.memory_requirements(),
+                             params={"lw.mode": str(mode), "lw.distance": repr(float(distance)),
+                                     "lw.instances": str(instances), "lw.triangles": str(triangles)})
+        result = gpu.load(plan).run_and_check(frames, check_data=False, read_outputs=True)
+        result.messages = gpu.close()
     ms = (result.timings or {}).get("passes", {}).get("transform")
     return {"ms": ms, "image": result.outputs.get("color"), "messages": [str(m) for m in result.messages],
             "device": result.device_name}

@@ -54,27 +54,26 @@ def scene_with_lights(count: int, folder: Path) -> Path:
     return path
 
 
-def run_once(scene: Path, size: tuple[int, int], params: dict[str, str], frames: int) -> dict[str, Any]:
+def run_once(gpu: Any, scene: Path, size: tuple[int, int], params: dict[str, str], frames: int) -> dict[str, Any]:
     from rgraph.passes.cluster_report import stats_of
     from rgraph.passes.tonemap_ref import srgb_codes
 
-    from rgraph.vk.executor import execute_plan
-    from rgraph.vk.memreq import compile_for_device
+    from rgraph.compiler.pipeline import compile_graph
 
-    plan = compile_for_device(GRAPH, scene_path=scene, size=size, params=params)
-    result = execute_plan(plan, frames=frames, read_outputs=True)
+    plan = compile_graph(GRAPH, scene_path=scene, size=size, params=params, memory=gpu.memory_requirements())
+    result = gpu.load(plan).run_and_check(frames, check_data=False, read_outputs=True)
     t = result.timings
     return {"device": result.device_name, "frame_ms": t.get("total_ms"),
             "passes_ms": {k: v for k, v in t["passes"].items()}, "stats": stats_of(result.outputs["cluster_stats"]),
             "codes": srgb_codes(result.outputs["color"][..., :3])}
 
 
-def scaling(size: tuple[int, int], counts: list[int], frames: int, max_indices: int) -> list[dict[str, Any]]:
+def scaling(gpu: Any, size: tuple[int, int], counts: list[int], frames: int, max_indices: int) -> list[dict[str, Any]]:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in counts:
             scene = scene_with_lights(n, Path(tmp))
-            runs = {name: run_once(scene, size, {**p, "clusters.max_indices": str(max_indices)}, frames)
+            runs = {name: run_once(gpu, scene, size, {**p, "clusters.max_indices": str(max_indices)}, frames)
                     for name, p in RUNS.items()}
             ref = runs["all_lights"]["codes"]
             row: dict[str, Any] = {"lights": n, "device": runs["all_lights"]["device"]}
@@ -115,17 +114,15 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def lighting_test(size: tuple[int, int], frames: int) -> dict[str, Any] | None:
+def lighting_test(gpu: Any, size: tuple[int, int], frames: int) -> dict[str, Any] | None:
     """Frame time, FPS and GPU busy of lighting_test.yaml (clustered), as frame_cpu.gpu_busy measures."""
     from benchmarks.frame_cpu import gpu_busy
-    from rgraph.vk.memreq import compile_for_device, live_requirements
+    from rgraph.compiler.pipeline import compile_graph
 
-    with live_requirements() as (_memory, device):
-        is_gpu = device.physical.device_type != "cpu"
-    if not is_gpu or frames <= 0:
+    if gpu.choice["type"] == "cpu" or frames <= 0:
         return None
-    plan = compile_for_device(GRAPH, scene_path=SCENES / "lighting_test.yaml", size=size)
-    busy = gpu_busy(plan, frames)
+    plan = compile_graph(GRAPH, scene_path=SCENES / "lighting_test.yaml", size=size, memory=gpu.memory_requirements())
+    busy = gpu_busy(gpu, plan, frames)
     return {**busy, "fps": 1000.0 / busy["wall_ms"]}
 
 
@@ -140,9 +137,12 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     w, h = (int(x) for x in args.size.lower().split("x"))
     counts = [int(c) for c in args.counts.split(",") if c.strip()]
-    rows = scaling((w, h), counts, args.frames, args.max_indices)
-    print(table(rows))
-    busy = lighting_test((w, h), args.busy_frames)
+    import rgraph
+
+    with rgraph.open_device(validate=False, verbose=False) as gpu:  # one device for every run
+        rows = scaling(gpu, (w, h), counts, args.frames, args.max_indices)
+        print(table(rows))
+        busy = lighting_test(gpu, (w, h), args.busy_frames)
     if busy is None:
         print("lighting test GPU busy: skipped (CPU device, or --busy-frames 0)")
     else:

@@ -12,8 +12,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from rgraph.api import compile_for_device
 from rgraph.random_graph import random_graph, to_yaml
-from rgraph.vk.memreq import compile_for_device
 
 
 def main() -> None:

@@ -51,16 +51,16 @@ def instances(quick: bool) -> list[tuple[str, str, list[Block]]]:
 
 def graph_instances(size: tuple[int, int] = (1920, 1080)) -> list[tuple[str, list[Block]]]:
     """The transient resources of each bundled graph (default scene) at ``size``, as blocks."""
-    from rgraph.compiler.pipeline import compile_graph
+    import rgraph
     from rgraph.resources import bundled_graphs
 
     out = []
     for name in bundled_graphs():
-        plan = compile_graph(name, size=size, policy="dedicated")
+        plan = rgraph.compile(name, size=size, policy="dedicated").plan
         blocks = [
-            Block(r["name"], r["first"], r["last"], r["bytes"], r["alignment"], r["memory_class"])
-            for r in plan["resources"]
-            if r["lifetime"] == "transient"
+            Block(r.name, r.first, r.last, r.bytes, r.alignment, r.memory_class)
+            for r in plan.resources
+            if r.lifetime == "transient"
         ]
         out.append((f"{name}@{size[0]}x{size[1]}", blocks))
     return out
@@ -68,12 +68,14 @@ def graph_instances(size: tuple[int, int] = (1920, 1080)) -> list[tuple[str, lis
 
 def print_graph_savings(size: tuple[int, int] = (1920, 1080)) -> None:
     """Whole-plan memory of each bundled graph per policy: peak, bound and saving vs unaliased."""
-    from rgraph.compiler.pipeline import compile_graph
+    import rgraph
     from rgraph.resources import bundled_graphs
 
     for name in bundled_graphs():
         for policy in ("dedicated", "aliased", "tlsf", "blocks:64MiB"):
-            st = compile_graph(name, size=size, policy=policy)["stats"]
+            m = rgraph.compile(name, size=size, policy=policy).memory_analysis()
+            st = {"peak_bytes": m.peak_bytes, "lower_bound_bytes": m.lower_bound_bytes,
+                  "unaliased_bytes": m.unaliased_bytes}
             saving = 1 - st["peak_bytes"] / st["unaliased_bytes"]
             print(
                 f"{name}@{size[0]}x{size[1]} {policy:<13} peak {st['peak_bytes'] / 2**20:8.1f} MiB  "

@@ -8,7 +8,7 @@ A pass implementation is a class registered under a name::
     class Tonemap(PassImpl):
         def __init__(self, setup):          # rgraph.vk.passkit.PassSetup: pipelines, views, params
             ...
-        def record(self, rec, frame_set):   # rgraph.vk.record.RecordContext: no barrier calls
+        def record(self, rec, frame_set):   # rgraph.vk.record_context.RecordContext: no barrier calls
             ...
 
 Built-in implementations live in ``rgraph.passes`` (``passes/`` in a checkout) and
@@ -38,11 +38,15 @@ class PassImpl:
     - ``attachment_load``: resource -> ``"clear"``, ``"load"`` or ``"dont_care"`` (default:
       ``load`` for blended colour and for depth written after an earlier writer in the frame,
       ``clear`` otherwise);
-    - ``clear_values``: resource -> RGBA floats (colour) or a depth float (default 0: reversed-Z far).
+    - ``clear_values``: resource -> RGBA floats (colour) or a depth float (default 0: reversed-Z far);
+    - ``owns_render_pass``: True when the implementation creates its render passes itself
+      (``setup.own``) and begins and ends them in ``record`` (the probe: one per layer);
+      otherwise the runtime makes one from the pass's attachments and wraps ``record`` in it.
     """
 
     attachment_load: ClassVar[dict[str, str]] = {}
     clear_values: ClassVar[dict[str, Any]] = {}
+    owns_render_pass: ClassVar[bool] = False
 
     def __init__(self, setup: Any) -> None:
         self.setup = setup

@@ -25,6 +25,7 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Callable, Iterable
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -368,12 +369,13 @@ class Report:
 
 def mutation_report(plan: dict, *, oracles: Iterable[str] = ORACLES, kinds: Iterable[str] = KINDS,
                     frames: int = 2, device_index: int | None = None,
-                    progress: Callable[[int, int, Outcome], None] | None = None) -> Report:
+                    progress: Callable[[int, int, Outcome], None] | None = None, gpu: Any = None) -> Report:
     """Run every mutant of ``plan`` through ``oracles``; the unmutated plan runs first as a baseline.
 
     Every pass runs the probe implementation (any ``impl`` is set aside): the probe performs
     each declared access and writes values the CPU simulation predicts, which is what makes
-    the data-flow oracle see a missing barrier.
+    the data-flow oracle see a missing barrier. Every run uses one device: ``gpu``
+    (``rgraph.open_device``; with validation when syncval is an oracle), else one opened here.
     """
     oracles = [o for o in ORACLES if o in set(oracles)]
     plan = probe_only(plan)
@@ -381,33 +383,34 @@ def mutation_report(plan: dict, *, oracles: Iterable[str] = ORACLES, kinds: Iter
     runner: Runner | None = None
     device_name: str | None = None
     same_family = True
-    if {"syncval", "data"} & set(oracles):
-        from rgraph.vk.executor import execute_plan
+    with ExitStack() as stack:
+        if {"syncval", "data"} & set(oracles):
+            from rgraph.api import open_device
 
-        validate = "syncval" in oracles
-        check_data = "data" in oracles
+            check_data = "data" in oracles
+            if gpu is None:
+                gpu = stack.enter_context(open_device(validate="syncval" in oracles, device=device_index,
+                                                      verbose=False))
+            device = gpu
 
-        def runner(p: dict) -> Any:
-            return execute_plan(p, validate=validate, frames=frames, device_index=device_index,
-                                check_data=check_data)
+            def runner(p: dict) -> Any:
+                return device.load(p).run_and_check(frames, check_data=check_data)
 
-        same_family = _same_family(plan, device_index)
-    base = Mutant("baseline (unmutated)", "baseline", BarrierUnit({}, None, None), "", plan)
-    baseline = run_oracles(base, oracles, runner)
-    if runner is not None and baseline.error is None:
-        device_name = _device_name_cache.get("name")
-    outcomes = []
-    todo = mutants(plan, kinds)
-    for n, m in enumerate(todo):
-        outcome = run_oracles(m, oracles, runner)
-        explain(plan, outcome, oracles, same_family)
-        outcomes.append(outcome)
-        if progress is not None:
-            progress(n + 1, len(todo), outcome)
+            queues = plan.get("queues") or sorted({p["queue"] for p in plan["passes"]})
+            same_family = all(gpu.device.same_family(queues[0], q) for q in queues)
+        base = Mutant("baseline (unmutated)", "baseline", BarrierUnit({}, None, None), "", plan)
+        baseline = run_oracles(base, oracles, runner)
+        if runner is not None and baseline.error is None:
+            device_name = gpu.name
+        outcomes = []
+        todo = mutants(plan, kinds)
+        for n, m in enumerate(todo):
+            outcome = run_oracles(m, oracles, runner)
+            explain(plan, outcome, oracles, same_family)
+            outcomes.append(outcome)
+            if progress is not None:
+                progress(n + 1, len(todo), outcome)
     return Report(plan, oracles, device_name, baseline, outcomes, time.perf_counter() - t0)
-
-
-_device_name_cache: dict[str, str] = {}
 
 
 def probe_only(plan: dict) -> dict:
@@ -415,21 +418,3 @@ def probe_only(plan: dict) -> dict:
     if not any(p.get("impl") for p in plan["passes"]):
         return plan
     return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
-
-
-def _same_family(plan: dict, device_index: int | None) -> bool:
-    """Whether every plan queue maps to one queue family on the device."""
-    from rgraph.vk.device import create_device
-    from rgraph.vk.instance import create_instance
-
-    instance = create_instance(validate=False)
-    try:
-        device = create_device(instance, device_index, verbose=False)
-        try:
-            _device_name_cache["name"] = device.name
-            queues = plan.get("queues") or sorted({p["queue"] for p in plan["passes"]})
-            return all(device.same_family(queues[0], q) for q in queues)
-        finally:
-            device.destroy()
-    finally:
-        instance.destroy()

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rgraph.vk.readback import write_png
+from rgraph.png import write_png
 
 GOLDEN_DIR = Path(__file__).parent / "golden" / "images"
 UPDATE_ENV = "RGRAPH_UPDATE_GOLDEN"

@@ -33,10 +33,10 @@ from rgraph.check.hazards import (
     WAW,
     Hazard,
 )
-from rgraph.check.jsonloc import locate
 from rgraph.check.plan import Plan, PlanShapeError, read_plan
 from rgraph.check.replay import Replay
 from rgraph.errors import RGraphError
+from rgraph.jsonloc import locate
 
 __all__ = [
     "ALIASING_HANDOFF", "ALIASING_OVERLAP", "ALL_KINDS", "FINAL_STATE", "LAYOUT_MISMATCH", "LIFETIME",

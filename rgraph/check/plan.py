@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph.check import vocab
-from rgraph.check.jsonloc import PathPart, format_path
+from rgraph.jsonloc import PathPart, format_path
 
 Rect = tuple[int, int, int, int]  # mip begin, mip end, layer begin, layer end (half-open)
 LIFETIMES = ("transient", "persistent", "imported", "output")

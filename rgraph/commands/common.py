@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import argparse
 import re
+from typing import TYPE_CHECKING
 
 from rgraph.errors import RGraphError
+
+if TYPE_CHECKING:
+    from rgraph.plan import Plan
 
 _SIZE = re.compile(r"^(\d+)x(\d+)$")
 
@@ -64,10 +68,10 @@ def add_sync_argument(parser: argparse.ArgumentParser) -> None:
                              "every pass, all passes on the graphics queue, no semaphores (for comparison)")
 
 
-def compile_from_args(args: argparse.Namespace) -> dict:
-    from rgraph.compiler.pipeline import compile_graph
+def compile_from_args(args: argparse.Namespace) -> Plan:
+    from rgraph.compiler.pipeline import compile_graph_plan
 
-    return compile_graph(
+    return compile_graph_plan(
         args.graph,
         scene_path=args.scene,
         params=parse_params(args.param),

@@ -5,8 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rgraph.commands.common import add_compile_arguments, add_graph_arguments, compile_from_args
+
+if TYPE_CHECKING:
+    from rgraph.plan import Plan
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -20,10 +24,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.plan import dumps
+    from rgraph.plan import dump
 
     plan = compile_from_args(args)
-    text = dumps(plan)
+    text = dump(plan)
     if args.json:
         return _json(args, plan, text)
     if args.output:
@@ -34,17 +38,17 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _json(args: argparse.Namespace, plan: dict, text: str) -> int:
+def _json(args: argparse.Namespace, plan: Plan, text: str) -> int:
     from rgraph.commands.jsonout import document, emit
-    from rgraph.report.summary import counted_barriers
 
     if args.output:
         Path(args.output).write_text(text)
-    barriers, releases = counted_barriers(plan)
-    body = {"file": plan.get("source"), "graph": plan.get("graph"), "output": args.output,
-            "passes": [p["name"] for p in plan["passes"]], "culled": plan.get("culled") or [],
-            "barriers": barriers, "releases": releases, "stats": plan.get("stats") or {}}
+    doc = plan.to_json_dict()
+    body = {"file": plan.source, "graph": plan.graph, "output": args.output,
+            "passes": [p.name for p in plan.passes], "culled": doc["culled"],
+            "barriers": plan.barrier_count, "releases": sum(len(p.releases) for p in plan.passes),
+            "stats": doc["stats"]}
     if not args.output:
-        body["plan"] = plan
+        body["plan"] = doc
     emit(document("compile", True, **body))
     return 0

@@ -32,6 +32,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="the pass graph as DOT (stdout; OUT.dot/.gv for text, OUT.svg/.pdf/.png rendered by graphviz)",
     )
     parser.add_argument("--html", metavar="OUT", help="write a self-contained HTML report")
+    parser.add_argument("--lowered", action="store_true",
+                        help="what the runtime will record (rgraph/vk/lower): barrier calls per pass, batches, "
+                             "semaphore edges, submit order; no device needed")
+    parser.add_argument("--queues", choices=("single", "separate"), default="single",
+                        help="queue-family layout for --lowered: single (default: one graphics+compute+transfer "
+                             "family, as on lavapipe) or separate (graphics, compute and transfer families, as on "
+                             "NVIDIA)")
+    parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
+                        help="--lowered without the validation-layer 1.3.239 workarounds")
     parser.add_argument("--json", action="store_true",
                         help="print the summary (and --barriers/--memory) as JSON (docs/cli-json.md)")
     parser.add_argument("--timings", metavar="T.json",
@@ -127,6 +136,31 @@ def emit_dot(plan: dict[str, Any], dest: str, out: TextIO) -> None:
         raise RGraphError.in_file(COMMAND_LINE, f"--dot {dest}: unknown suffix; use one of {known} (or no file for stdout)")
 
 
+def lowered_text(plan: Any, queues: str, workarounds: bool = True) -> str:
+    """``--lowered``: the recording of ``plan`` on the ``queues`` model, as text."""
+    from rgraph.vk.lower import LAYER_WORKAROUNDS, LoweringError, lower
+    from rgraph.vk.lower.queues import MODELS
+    from rgraph.vk.lower.text import format_recording
+
+    try:
+        recording = lower(plan, MODELS[queues](), workarounds=LAYER_WORKAROUNDS if workarounds else ())
+    except LoweringError as exc:
+        raise RGraphError.in_file(COMMAND_LINE, f"--lowered: {exc}") from None
+    return format_recording(recording)
+
+
+def _warn_if_not_runnable(path: str, err: TextIO) -> None:
+    """The views show partial plans too; say when the typed loader (``rgraph run``) refuses one."""
+    from rgraph.plan import load
+
+    try:
+        load(path)
+    except RGraphError as exc:
+        d = exc.first
+        print(f"{d.location}: warning: {d.message} (rgraph run refuses this plan; the views show what is there)",
+              file=err)
+
+
 def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None = None) -> int:
     from rgraph.report import text
     from rgraph.report.table import make_console
@@ -134,11 +168,18 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
     plan = obtain_plan(args)
+    if args.target.endswith(".json") and not args.lowered:
+        _warn_if_not_runnable(args.target, err)
     console = make_console(out)
     dot_to_stdout = args.dot == "-"
     timings = load_timings(args.timings) if args.timings else None
     if timings is not None:
         check_timings_size(plan, timings, args.timings)
+    if args.lowered:  # what rgraph run would record: a plan file must pass the typed loader
+        from rgraph.plan import load
+
+        source = load(args.target) if args.target.endswith(".json") else plan
+        out.write(lowered_text(source, args.queues, args.layer_workarounds))
     if args.json:
         if dot_to_stdout:
             raise RGraphError.in_file(COMMAND_LINE, "--json and --dot to stdout both print; give --dot a file")
@@ -147,7 +188,7 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
 
         emit(document("inspect", True, **inspect_document(plan, timings, barriers=args.barriers,
                                                            memory=args.memory)), out)
-    elif not (args.barriers or args.memory or dot_to_stdout):
+    elif not (args.barriers or args.memory or dot_to_stdout or args.lowered):
         text.print_summary(console, plan, timings)
     if args.barriers and not args.json:
         text.print_barriers(console, plan)

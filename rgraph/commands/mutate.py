@@ -42,16 +42,13 @@ def _choices(text: str, allowed: tuple[str, ...], option: str) -> list[str]:
     return items
 
 
-def _compile(args: argparse.Namespace, need_device: bool) -> dict:
+def _compile(args: argparse.Namespace, gpu) -> dict:
+    """The plan; sized by ``gpu`` (the device the mutants run on) when there is one."""
     from rgraph.compiler.pipeline import compile_graph
 
-    kwargs = dict(scene_path=args.scene, params=parse_params(args.param), size=parse_size(args.size),
-                  policy=args.policy)
-    if not need_device:
-        return compile_graph(args.graph, **kwargs)
-    from rgraph.vk.memreq import compile_for_device
-
-    return compile_for_device(args.graph, args.device, **kwargs)
+    return compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
+                         size=parse_size(args.size), policy=args.policy,
+                         memory=gpu.memory_requirements() if gpu is not None else None)
 
 
 def print_report(report, out=sys.stdout) -> None:
@@ -133,11 +130,22 @@ def run(args: argparse.Namespace) -> int:
             print(f"[{n}/{total}] {outcome.mutant.name}: {', '.join(outcome.caught_by) or 'uncaught'}",
                   file=sys.stderr)
 
+    from contextlib import ExitStack
+
+    from rgraph.api import open_device
+
     try:
-        plan = _compile(args, runtime)
-        oracles = _without_crashing_layer(plan, oracles)
-        report = mutation_report(plan, oracles=oracles, kinds=kinds, frames=args.frames,
-                                 device_index=args.device, progress=progress)
+        with ExitStack() as stack:  # one device: it sizes the plan and runs every mutant
+            gpu = (stack.enter_context(open_device(validate="syncval" in oracles, device=args.device,
+                                                   verbose=False)) if runtime else None)
+            plan = _compile(args, gpu)
+            kept = _without_crashing_layer(plan, oracles)
+            if gpu is not None and kept != oracles:  # the same device without the crashing layer
+                gpu.close()
+                gpu = stack.enter_context(open_device(validate=False, device=args.device, verbose=False))
+            oracles = kept
+            report = mutation_report(plan, oracles=oracles, kinds=kinds, frames=args.frames,
+                                     device_index=args.device, progress=progress, gpu=gpu)
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2

@@ -1,4 +1,11 @@
-"""``rgraph run G-or-PLAN``: compile (sizes from the live device) and execute on Vulkan."""
+"""``rgraph run G-or-PLAN``: compile (sizes from the live device) and execute on Vulkan.
+
+One instance and one device (``rgraph.open_device``) serve both: the compiler sizes resources
+with the device's memory requirements, then the same device runs the plan. A plan file is
+loaded through the typed loader (``rgraph.plan.load``) and replayed by the independent
+checker (``rgraph.check``) first; a malformed plan or one with hazards is refused (exit 2)
+unless ``--unchecked``.
+"""
 
 from __future__ import annotations
 
@@ -8,13 +15,26 @@ import json
 import sys
 from pathlib import Path
 
-from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
+from rgraph.commands.common import (
+    add_graph_arguments,
+    add_sync_argument,
+    default_size_text,
+    parse_params,
+    parse_size,
+)
 from rgraph.errors import RGraphError
+
+COMMAND_LINE = "<command line>"
+
+
+class DefaultSize(str):
+    """The default ``--size`` (a str subclass), so that a plan file can tell it was not given."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
     add_graph_arguments(parser)
+    parser.set_defaults(size=DefaultSize(default_size_text()))  # a plan file has its own size
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
@@ -25,35 +45,70 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--out", type=Path, help="write the first output image as PNG")
     parser.add_argument("--timings", type=Path,
                         help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
+    parser.add_argument("--heatmap", type=Path,
+                        help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
     parser.add_argument("--trace", type=Path, metavar="OUT.json",
                         help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
                              "a track per queue, passes as slices, barriers, semaphore waits as flows")
-    parser.add_argument("--heatmap", type=Path,
-                        help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.add_argument("--json", action="store_true",
                         help="print the result (timings, validation messages, data check) as JSON (docs/cli-json.md)")
+    parser.add_argument("--unchecked", action="store_true",
+                        help="run a plan file even if rgraph check finds hazards in it")
+    parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
+                        help="record the plan without the validation-layer 1.3.239 workarounds "
+                             "(rgraph/vk/lower/workarounds; validation messages are then reported, not avoided)")
     parser.set_defaults(func=run)
 
 
-def _load_plan(args: argparse.Namespace) -> dict:
-    path = Path(args.graph)
-    if path.suffix == ".json" and path.is_file():
-        from rgraph.check import load_plan_file
+def is_plan_file(target: str) -> bool:
+    path = Path(target)
+    return path.suffix == ".json" and path.is_file()
 
-        plan, _ = load_plan_file(path)
-        if plan.get("format") != "rgraph-plan/1":
-            raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
-        if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
-            from rgraph.compiler.pipeline import apply_sync_mode
 
-            plan = apply_sync_mode(plan, "naive")
-        return plan
-    from rgraph.vk.memreq import compile_for_device
+def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
+    """A plan file through the typed loader (malformed: ``RGraphError``, one located line),
+    then replayed by ``rgraph.check``: hazards are refused (``RGraphError``) unless ``unchecked``."""
+    from rgraph.plan import load, to_json_dict
 
-    return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
-                              size=parse_size(args.size), policy=args.policy, sync=args.sync,
-                              schedule=args.schedule, camera=args.camera)
+    model = load(path)
+    if model.format != "rgraph-plan/1":
+        raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
+    if not unchecked:
+        from rgraph.check import check_file
+
+        _checked, hazards = check_file(path)
+        if hazards:
+            first = hazards[0].message.splitlines()[0]
+            raise RGraphError.in_file(
+                path, f"rgraph check finds {len(hazards)} hazard{'s' if len(hazards) != 1 else ''} in this plan "
+                      f"(first: {first}); see 'rgraph check {path}', or pass --unchecked to run it anyway")
+    return to_json_dict(model)
+
+
+def _plan_from_file(args: argparse.Namespace) -> dict:
+    given = [flag for flag, value in (("--size", not isinstance(args.size, DefaultSize)), ("--scene", args.scene),
+                                      ("-p", args.param),
+                                      ("--policy", args.policy),
+                                      ("--schedule", args.schedule != "declaration")) if value]
+    if given:
+        verb = "applies" if len(given) == 1 else "apply"
+        raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only {verb} when compiling a graph, not to "
+                                                f"a plan file (its size is {_plan_size(args.graph)})")
+    plan = load_checked_plan(Path(args.graph), unchecked=args.unchecked)
+    if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
+        from rgraph.compiler.pipeline import apply_sync_mode
+
+        plan = apply_sync_mode(plan, "naive")
+    return plan
+
+
+def _plan_size(path: str) -> str:
+    try:
+        size = json.loads(Path(path).read_text()).get("size")
+        return f"{size[0]}x{size[1]}"
+    except Exception:  # noqa: BLE001 -- only for the message
+        return "fixed"
 
 
 def _print_table(plan: dict, timings: dict) -> None:
@@ -109,17 +164,32 @@ def _report_clusters(args: argparse.Namespace, outputs: dict) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rgraph.api import open_device
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
-    from rgraph.vk.executor import execute_plan
+    from rgraph.vk.lower import LAYER_WORKAROUNDS
 
+    if args.frames < 1:
+        print("rgraph: error: --frames must be at least 1", file=sys.stderr)
+        return 2
+    plan = _plan_from_file(args) if is_plan_file(args.graph) else None
     try:
-        plan = _load_plan(args)
-        outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
-        if args.heatmap and "light_heat" not in outputs:
-            raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' (see graphs/clustered.yaml)")
-        result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
-                              check_data=args.check_data, out_png=args.out, verbose=True,
-                              read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
+        with open_device(validate=args.validate, device=args.device) as gpu:
+            if plan is None:
+                from rgraph.compiler.pipeline import compile_graph
+
+                plan = compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
+                                     size=parse_size(args.size), policy=args.policy,
+                                     sync=args.sync, schedule=args.schedule, camera=args.camera,
+                                     memory=gpu.memory_requirements())
+            outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
+            if args.heatmap and "light_heat" not in outputs:
+                raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' "
+                                                      "(see graphs/clustered.yaml)")
+            exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else ())
+            result = exe.run_and_check(args.frames, check_data=args.validate if args.check_data is None
+                                       else args.check_data, out_png=args.out,
+                                       read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
+            result.messages = gpu.close()  # the device's teardown included
     except (VulkanUnavailable, ExecutionError) as exc:
         if args.json:
             from rgraph.commands.jsonout import diagnostic, document, emit
@@ -149,6 +219,8 @@ def run(args: argparse.Namespace) -> int:
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)
+    if not args.layer_workarounds:
+        print("rgraph: recorded without the validation-layer workarounds", file=sys.stderr)
     if args.validate:
         print(f"rgraph: {len(result.messages)} validation message(s)", file=sys.stderr)
         if result.messages:

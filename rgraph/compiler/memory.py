@@ -28,15 +28,27 @@ class MemoryRequirementsProvider(Protocol):
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements: ...
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
+class Requirement:
+    """What the provider says one resource needs, and its tiling (optimal images, linear buffers)."""
+
+    bytes: int
+    alignment: int
+    memory_type_bits: int
+    tiling: str
+
+
+@dataclass(frozen=True, slots=True)
 class ResourceMemory:
+    """A used resource's memory as the plan records it (the measure phase's result)."""
+
     bytes: int
     alignment: int
     memory_type_bits: int
     memory_class: str
-    usages: tuple[str, ...]
-    first: int | None
-    last: int | None
+    usages: tuple[str, ...]  # sorted union over the kept passes
+    first: int  # executed pass indices
+    last: int
 
 
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
@@ -69,8 +81,8 @@ def requirements(
     used: Mapping[str, set[str]],
     outputs: Sequence[str],
     provider: MemoryRequirementsProvider,
-) -> dict[str, tuple[int, int, int, str]]:
-    """(bytes, alignment, memory_type_bits, tiling) per used resource."""
+) -> dict[str, Requirement]:
+    """The requirement of each used resource, in name order."""
     out = {}
     for name in sorted(used):
         res = resources[name]
@@ -88,36 +100,46 @@ def requirements(
                 tiling = "linear"
         except RGraphError as err:
             raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None
-        out[name] = (size, align, bits, tiling)
+        out[name] = Requirement(size, align, bits, tiling)
     return out
 
 
-def memory_classes(reqs: Mapping[str, tuple[int, int, int, str]]) -> dict[str, str]:
+def memory_classes(reqs: Mapping[str, Requirement]) -> dict[str, str]:
     """Class per resource: tiling, plus the memoryTypeBits when a tiling has several."""
     bits_by_tiling: dict[str, set[int]] = {}
-    for _, _, bits, tiling in reqs.values():
-        bits_by_tiling.setdefault(tiling, set()).add(bits)
+    for r in reqs.values():
+        bits_by_tiling.setdefault(r.tiling, set()).add(r.memory_type_bits)
     out = {}
-    for name, (_, _, bits, tiling) in reqs.items():
-        cls = f"device_local_{tiling}"
-        out[name] = cls if len(bits_by_tiling[tiling]) == 1 else f"{cls}_types_{bits:x}"
+    for name, r in reqs.items():
+        cls = f"device_local_{r.tiling}"
+        out[name] = cls if len(bits_by_tiling[r.tiling]) == 1 else f"{cls}_types_{r.memory_type_bits:x}"
     return out
+
+
+def resource_memory(
+    reqs: Mapping[str, Requirement], used: Mapping[str, set[str]], spans: Mapping[str, tuple[int, int]]
+) -> dict[str, ResourceMemory]:
+    """Requirements, classes, usages and lifetimes of the used resources, in name order."""
+    classes = memory_classes(reqs)
+    return {
+        name: ResourceMemory(r.bytes, r.alignment, r.memory_type_bits, classes[name], tuple(sorted(used[name])),
+                             spans[name][0], spans[name][1])
+        for name, r in reqs.items()
+    }
 
 
 def place_resources(
     resources: Mapping[str, ResourceSpec],
-    reqs: Mapping[str, tuple[int, int, int, str]],
-    classes: Mapping[str, str],
-    spans: Mapping[str, tuple[int, int]],
+    memory: Mapping[str, ResourceMemory],
     policy: str,
     outputs: Sequence[str],
 ) -> Placement:
     """Place transients with ``policy``; give every other resource its own heap."""
     aliasable = [
-        n for n in sorted(reqs) if resources[n].lifetime == "transient" and n not in outputs
+        n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in outputs
     ]
     blocks = [
-        Block(n, spans[n][0], spans[n][1], reqs[n][0], reqs[n][1], classes[n]) for n in aliasable
+        Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
     ]
     from rgraph.memory import place
 
@@ -125,20 +147,21 @@ def place_resources(
     offsets = dict(placed.offsets)
     heaps = list(placed.heaps)
     extra = 0
-    for n in sorted(set(reqs) - set(aliasable)):
-        heap = Heap(len(heaps), reqs[n][0], classes[n], reqs[n][1])
+    for n in sorted(set(memory) - set(aliasable)):
+        m = memory[n]
+        heap = Heap(len(heaps), m.bytes, m.memory_class, m.alignment)
         heaps.append(heap)
         offsets[n] = (heap.id, 0)
-        extra += reqs[n][0]
+        extra += m.bytes
     s = placed.stats
     stats = PlacementStats(
         s.policy, s.peak_bytes + extra, s.lower_bound_bytes + extra, s.unaliased_bytes + extra,
-        s.allocations + len(reqs) - len(aliasable), s.seconds,
+        s.allocations + len(memory) - len(aliasable), s.seconds,
     )
     return Placement(offsets, heaps, stats)
 
 
-def alias_sources(placement: Placement, reqs, spans: Mapping[str, tuple[int, int]]) -> dict[str, list[str]]:
+def alias_sources(placement: Placement, memory: Mapping[str, ResourceMemory]) -> dict[str, list[str]]:
     """For each resource, the earlier resources whose memory it reuses and that it must wait for.
 
     An earlier overlapping resource is skipped when a later one, itself overlapping both,
@@ -150,18 +173,18 @@ def alias_sources(placement: Placement, reqs, spans: Mapping[str, tuple[int, int
     for names in by_heap.values():
         if len(names) < 2:
             continue
-        ordered = sorted(names, key=lambda n: (spans[n][0], n))
+        ordered = sorted(names, key=lambda n: (memory[n].first, n))
         for i, r in enumerate(ordered):
-            r_lo, r_hi = _range(placement, reqs, r)
+            r_lo, r_hi = _range(placement, memory, r)
             preds = [
                 p for p in ordered[:i]
-                if spans[p][1] < spans[r][0] and _overlaps((r_lo, r_hi), _range(placement, reqs, p))
+                if memory[p].last < memory[r].first and _overlaps((r_lo, r_hi), _range(placement, memory, p))
             ]
             keep = []
             for p in preds:
-                p_rng = _intersect(_range(placement, reqs, p), (r_lo, r_hi))
+                p_rng = _intersect(_range(placement, memory, p), (r_lo, r_hi))
                 covered = any(
-                    q != p and spans[p][1] < spans[q][0] and _contains(_range(placement, reqs, q), p_rng)
+                    q != p and memory[p].last < memory[q].first and _contains(_range(placement, memory, q), p_rng)
                     for q in preds
                 )
                 if not covered:
@@ -171,9 +194,9 @@ def alias_sources(placement: Placement, reqs, spans: Mapping[str, tuple[int, int
     return out
 
 
-def _range(placement: Placement, reqs, name: str) -> tuple[int, int]:
+def _range(placement: Placement, memory: Mapping[str, ResourceMemory], name: str) -> tuple[int, int]:
     off = placement.offsets[name][1]
-    return off, off + reqs[name][0]
+    return off, off + memory[name].bytes
 
 
 def _overlaps(a: tuple[int, int], b: tuple[int, int]) -> bool:

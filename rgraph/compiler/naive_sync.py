@@ -15,39 +15,46 @@ it unchanged:
 Memory placement, culling and pass order are the normal plan's.
 
     from rgraph.compiler.naive_sync import naive_sync
-    plan = naive_sync(compile_graph("surgery"))
+    plan = naive_sync(compile_graph_plan("surgery"))   # a Plan (a plan dict gives a dict)
 """
 
 from __future__ import annotations
 
-import copy
 from collections import defaultdict
-from typing import Any
+from dataclasses import replace
+from typing import Any, overload
 
 from rgraph.compiler.sync import mip_layer_rectangles
+from rgraph.plan import from_json_dict, to_json_dict
+from rgraph.plan.model import Barrier, CellState, EndState, Plan, PlanResource, State, Subresource
 
 QUEUE = "graphics"
-SRC = {"stages": ["ALL_COMMANDS"], "access": ["MEMORY_WRITE"]}
-DST = {"stages": ["ALL_COMMANDS"], "access": ["MEMORY_READ", "MEMORY_WRITE"]}
+SRC_STAGES, SRC_ACCESS = ("ALL_COMMANDS",), ("MEMORY_WRITE",)
+DST_STAGES, DST_ACCESS = ("ALL_COMMANDS",), ("MEMORY_READ", "MEMORY_WRITE")
 
 Cell = tuple[int, int]  # (mip, layer); buffers: (0, 0)
 
 
-def naive_sync(plan: dict[str, Any]) -> dict[str, Any]:
-    """A copy of ``plan`` with naive synchronization (see the module docstring)."""
-    out = copy.deepcopy(plan)
-    resources = {r["name"]: r for r in out["resources"]}
+@overload
+def naive_sync(plan: Plan) -> Plan: ...
+@overload
+def naive_sync(plan: dict[str, Any]) -> dict[str, Any]: ...
+
+
+def naive_sync(plan: Plan | dict[str, Any]) -> Plan | dict[str, Any]:
+    """``plan`` with naive synchronization (see the module docstring); a dict gives a dict."""
+    if isinstance(plan, dict):
+        return to_json_dict(naive_sync(from_json_dict(plan)))
+    resources = plan.resource_by_name
     layouts = {name: _initial_layouts(res) for name, res in resources.items()}
     aliases = _alias_names(plan)
     handed_over: set[str] = set()
-    count = 0
-    for p in out["passes"]:
-        p["queue"] = QUEUE
-        p["waits"], p["signals"], p["releases"] = [], [], []
+    passes = []
+    for p in plan.passes:
         wanted: dict[str, dict[Cell, str | None]] = defaultdict(dict)
-        for a in p["accesses"]:
-            for cell in _cells(resources[a["resource"]], a["subresource"]):
-                wanted[a["resource"]][cell] = a["layout"]
+        for a in p.accesses:
+            for cell in _cells(resources[a.resource], a.subresource):
+                wanted[a.resource][cell] = a.layout
         barriers = []
         for name in sorted(wanted):
             res = resources[name]
@@ -57,68 +64,66 @@ def naive_sync(plan: dict[str, Any]) -> dict[str, Any]:
                 layouts[name][cell] = layout
             for (old, new), cells in sorted(groups.items(), key=lambda kv: (str(kv[0][0]), str(kv[0][1]))):
                 for rect in mip_layer_rectangles(cells):
-                    barriers.append(_barrier(res, rect, old, new, aliases.get(name) if name not in handed_over else None))
+                    barriers.append(_barrier(res, rect, old, new, aliases.get(name, ()) if name not in handed_over
+                                             else ()))
             handed_over.add(name)
-        p["barriers"] = barriers
-        count += len(barriers)
-    out["queues"] = [QUEUE]
-    for res in out["resources"]:
-        for key in ("initial", "final"):
-            _move_to_graphics(res.get(key))
-    out["stats"] = {**out.get("stats", {}), "sync": "naive", "barriers": count, "semaphores": 0}
-    return out
+        passes.append(replace(p, queue=QUEUE, waits=(), signals=(), releases=(), barriers=tuple(barriers)))
+    count = sum(len(p.barriers) for p in passes)
+    return replace(
+        plan, queues=(QUEUE,), passes=tuple(passes),
+        resources=tuple(replace(r, initial=_on_graphics(r.initial), final=_on_graphics(r.final))
+                        for r in plan.resources),
+        stats=replace(plan.stats, sync="naive", barriers=count, semaphores=0),
+    )
 
 
-def _initial_layouts(res: dict) -> dict[Cell, str | None]:
-    if res["kind"] != "image":
+def _initial_layouts(res: PlanResource) -> dict[Cell, str | None]:
+    if not res.is_image:
         return {(0, 0): None}
-    initial = res.get("initial")
+    initial = res.initial
     default = "UNDEFINED"
-    if isinstance(initial, dict) and res["lifetime"] in ("persistent", "imported"):
-        default = initial["layout"]
-    out = {(m, layer): default for m in range(res["mips"]) for layer in range(res["layers"])}
-    if isinstance(initial, list):  # non-uniform: one entry per rectangle of cells
+    if isinstance(initial, State) and res.lifetime in ("persistent", "imported"):
+        default = initial.layout
+    out = {(m, layer): default for m in range(res.mips or 1) for layer in range(res.layers or 1)}
+    if isinstance(initial, tuple):  # non-uniform: one entry per cell rectangle
         for entry in initial:
-            for cell in _cells(res, entry["subresource"]):
-                out[cell] = entry["layout"]
+            for cell in _cells(res, entry.subresource):
+                out[cell] = entry.state.layout
     return out
 
 
-def _alias_names(plan: dict) -> dict[str, Any]:
+def _alias_names(plan: Plan) -> dict[str, tuple[str, ...]]:
     """Per resource, the ``aliases`` of its normal plan's hand-off barriers (names merged)."""
     found: dict[str, list[str]] = {}
-    for p in plan["passes"]:
-        for b in p["barriers"]:
-            names = b.get("aliases")
-            if names:
-                merged = found.setdefault(b["resource"], [])
-                for n in [names] if isinstance(names, str) else names:
-                    if n not in merged:
-                        merged.append(n)
-    return {k: (v[0] if len(v) == 1 else sorted(v)) for k, v in found.items()}
+    for p in plan.passes:
+        for b in p.barriers:
+            if b.aliases:
+                merged = found.setdefault(b.resource, [])
+                merged.extend(n for n in b.aliases if n not in merged)
+    return {k: (tuple(v) if len(v) == 1 else tuple(sorted(v))) for k, v in found.items()}
 
 
-def _cells(res: dict, sub: dict | None) -> list[Cell]:
-    if res["kind"] != "image":
+def _cells(res: PlanResource, sub: Subresource | None) -> list[Cell]:
+    if not res.is_image:
         return [(0, 0)]
-    sub = sub or {"mips": [0, res["mips"]], "layers": [0, res["layers"]]}
-    return [(m, layer) for m in range(*sub["mips"]) for layer in range(*sub["layers"])]
+    mips, layers = (sub.mips, sub.layers) if sub is not None else ((0, res.mips or 1), (0, res.layers or 1))
+    return [(m, layer) for m in range(*mips) for layer in range(*layers)]
 
 
-def _barrier(res: dict, rect, old: str | None, new: str | None, aliases: Any) -> dict:
-    image = res["kind"] == "image"
-    return {
-        "resource": res["name"],
-        "subresource": {"mips": list(rect[0]), "layers": list(rect[1])} if image else None,
-        "src": {**SRC, "layout": old if image else None, "queue": QUEUE},
-        "dst": {**DST, "layout": new if image else None, "queue": QUEUE},
-        "aliases": aliases if image and old == "UNDEFINED" or not image and aliases else None,
-    }
+def _barrier(res: PlanResource, rect, old: str | None, new: str | None, aliases: tuple[str, ...]) -> Barrier:
+    image = res.is_image
+    return Barrier(
+        resource=res.name,
+        subresource=Subresource(tuple(rect[0]), tuple(rect[1])) if image else None,
+        src=State(SRC_STAGES, SRC_ACCESS, old if image else None, QUEUE),
+        dst=State(DST_STAGES, DST_ACCESS, new if image else None, QUEUE),
+        aliases=aliases if image and old == "UNDEFINED" or not image else (),
+    )
 
 
-def _move_to_graphics(state: Any) -> None:
-    if isinstance(state, dict):
-        state["queue"] = QUEUE
-    elif isinstance(state, list):
-        for entry in state:
-            entry["queue"] = QUEUE
+def _on_graphics(state: EndState) -> EndState:
+    if isinstance(state, State):
+        return replace(state, queue=QUEUE)
+    if isinstance(state, tuple):
+        return tuple(CellState(c.subresource, replace(c.state, queue=QUEUE)) for c in state)
+    return state

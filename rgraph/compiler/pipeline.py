@@ -1,28 +1,26 @@
-"""Graph file + scene + params -> plan: the compiler's stages in order.
+"""Graph file + scene + params -> plan: the front end, then the compiler's phases.
 
-    load -> specialize -> cull -> schedule -> lifetimes/placement -> sync -> plan
+    load -> specialize -> [cull -> schedule -> measure -> place -> synchronize -> emit]
 
-Each stage is a pure function of the previous one's value; only the memory-requirements
-provider may talk to a device.
+The bracketed phases are ``rgraph.compiler.phases.PHASES``: each a pure function of one
+``Compilation`` value. The ``Spec`` is not changed after specialization (extra outputs
+and the scene path make a new one). Only the memory-requirements provider may talk to
+a device.
 """
 
 from __future__ import annotations
 
 import gc
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from rgraph.compiler import memory
-from rgraph.compiler.accel import size_accels
 from rgraph.compiler.memory import MemoryRequirementsProvider
-from rgraph.compiler.sync import synchronize
-from rgraph.defaults import DEFAULT_SIZE  # re-exported: the one default everywhere
+from rgraph.compiler.phases import Compilation, run_phases
+from rgraph.defaults import DEFAULT_SCHEDULE, DEFAULT_SIZE  # re-exported: the one default everywhere
 from rgraph.errors import RGraphError
-from rgraph.ir.cull import cull
-from rgraph.ir.schedule import DEFAULT_SCHEDULE, schedule_passes
-from rgraph.plan import build_plan
+from rgraph.plan import Plan, to_json_dict
 from rgraph.resources import resolve_graph, resolve_scene
 from rgraph.spec.loader import GraphSource, load_graph
 from rgraph.spec.pydantic_errors import did_you_mean
@@ -64,76 +62,62 @@ def frontend(
     features = scene.features if scene else ALL_PRESENT
     resolved = resolve_params(source, params or {})
     spec = specialize(source, features=features, params=resolved, size=size, scene_name=scene.name if scene else None)
-    spec.scene_source = str(scene.path) if scene is not None and scene.path is not None else None
+    if scene is not None and scene.path is not None:
+        spec = replace(spec, scene_source=str(scene.path))
     return Frontend(source, scene, spec)
 
 
-def compile_spec(
+def compilation(
     spec: Spec,
     *,
     policy: str = DEFAULT_POLICY,
     memory_provider: MemoryRequirementsProvider | None = None,
     profile_name: str | None = None,
     schedule: str = DEFAULT_SCHEDULE,
-) -> dict[str, Any]:
-    """Spec -> plan dict (the part benchmarked by benchmarks/compile_scaling.py)."""
-    # The compiler allocates many small acyclic objects; the cyclic collector would rescan
-    # the whole (large) heap again and again. Nothing here creates reference cycles.
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        return _compile_spec(spec, policy, memory_provider, profile_name, schedule)
-    finally:
-        if enabled:
-            gc.enable()
-
-
-def _compile_spec(spec, policy, memory_provider, profile_name, schedule=DEFAULT_SCHEDULE) -> dict[str, Any]:
-    culling = cull(spec)
-    passes = schedule_passes(culling.passes, schedule)  # default: declaration order minus culled passes
+) -> Compilation:
+    """The ``Compilation`` after every phase (``.plan`` is the result); ``schedule``: ``--schedule``."""
     if memory_provider is None:
         from rgraph.memory_requirements import ProfileMemoryRequirements
 
         memory_provider = ProfileMemoryRequirements.named(DEFAULT_PROFILE)
         profile_name = profile_name or DEFAULT_PROFILE
-    passes = size_accels(spec, passes, memory_provider)
-    used = memory.usages_by_resource(passes)
-    spans = memory.lifetimes(passes)
-    reqs = memory.requirements(spec.resources, used, spec.outputs, memory_provider)
-    classes = memory.memory_classes(reqs)
+    # The compiler allocates many small acyclic objects; the cyclic collector would rescan
+    # the whole (large) heap again and again. Nothing here creates reference cycles.
+    enabled = gc.isenabled()
+    gc.disable()
     try:
-        placement = memory.place_resources(spec.resources, reqs, classes, spans, policy, spec.outputs)
-    except ValueError as exc:
-        raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
-    aliases = memory.alias_sources(placement, reqs, spans)
-    culled_passes = {c.pass_name for c in culling.culled}
-    culled_used = {
-        r: u for r, u in memory.usages_by_resource([p for p in spec.passes if p.name in culled_passes]).items()
-        if r not in reqs
-    }
-    culled_bytes = {r: v[0] for r, v in memory.requirements(spec.resources, culled_used, spec.outputs, memory_provider).items()}
-    sync = synchronize(passes, spec.resources, aliases)
-    plan = build_plan(
-        spec, culling, passes, sync, placement, reqs, classes, spans, used, profile_name or "device",
-        culled_bytes
-    )
-    if schedule != DEFAULT_SCHEDULE:
-        plan["stats"]["schedule"] = schedule  # absent = declaration order
+        return run_phases(Compilation(spec, policy, memory_provider, profile_name or "device", schedule))
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def compile_plan(spec: Spec, **options: Any) -> Plan:
+    """Spec -> typed plan (the part benchmarked by benchmarks/compile_scaling.py); options as ``compilation``."""
+    plan = compilation(spec, **options).plan
+    assert plan is not None
     return plan
 
 
-def add_outputs(spec: Spec, names: Sequence[str]) -> None:
-    """Append resources ``names`` to ``spec.outputs`` (a name already there is kept once)."""
+def compile_spec(spec: Spec, **options: Any) -> dict[str, Any]:
+    """``compile_plan`` as the decoded JSON document (for code that still reads plan dicts)."""
+    return to_json_dict(compile_plan(spec, **options))
+
+
+def with_outputs(spec: Spec, names: Sequence[str]) -> Spec:
+    """``spec`` with resources ``names`` appended to its outputs (one already there is kept once)."""
+    outputs = list(spec.outputs)
     for name in names:
         if name not in spec.resources:
             raise RGraphError.in_file(
                 "<command line>", f"extra output '{name}' is not a resource{did_you_mean(name, spec.resources)}"
             )
-        if name not in spec.outputs:
-            spec.outputs.append(name)
+        if name not in outputs:
+            outputs.append(name)
+    return spec if outputs == spec.outputs else replace(spec, outputs=outputs)
 
 
-def compile_graph(
+def compile_graph_plan(
     graph: str | Path,
     scene_path: str | Path | None = None,
     params: Mapping[str, str] | None = None,
@@ -145,8 +129,8 @@ def compile_graph(
     sync: str = "normal",
     schedule: str = DEFAULT_SCHEDULE,
     camera: int = 0,
-) -> dict[str, Any]:
-    """Compile a graph file (or bundled graph name) into a plan dict.
+) -> Plan:
+    """Compile a graph file (or bundled graph name) into a typed plan.
 
     ``extra_outputs`` names resources kept as outputs besides the graph's own (their
     writers are not culled and the runtime reads them back), e.g. an HDR intermediate.
@@ -154,7 +138,7 @@ def compile_graph(
     before every pass, one queue, no semaphores), for comparison.
     """
     front = frontend(graph, scene_path, params, size)
-    add_outputs(front.spec, extra_outputs)
+    spec = with_outputs(front.spec, extra_outputs)
     provider = memory
     profile_name = None
     if provider is None and profile is not None:
@@ -162,11 +146,10 @@ def compile_graph(
 
         provider = ProfileMemoryRequirements.named(profile)
         profile_name = provider.name
-    chosen = policy or front.source.memory_policy or DEFAULT_POLICY
-    plan = compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name,
-                        schedule=schedule)
+    chosen = policy or spec.memory_policy or DEFAULT_POLICY
+    plan = compile_plan(spec, policy=chosen, memory_provider=provider, profile_name=profile_name, schedule=schedule)
     if camera:
-        plan["camera"] = check_camera(front.scene, camera)
+        plan = replace(plan, camera=check_camera(front.scene, camera))
     return apply_sync_mode(plan, sync)
 
 
@@ -183,10 +166,15 @@ def check_camera(scene: Scene | None, camera: int) -> int:
     return camera
 
 
+def compile_graph(*args: Any, **kwargs: Any) -> dict[str, Any]:
+    """``compile_graph_plan`` as the decoded JSON document (for code that still reads plan dicts)."""
+    return to_json_dict(compile_graph_plan(*args, **kwargs))
+
+
 SYNC_MODES = ("normal", "naive")
 
 
-def apply_sync_mode(plan: dict[str, Any], sync: str) -> dict[str, Any]:
+def apply_sync_mode(plan: Plan, sync: str) -> Plan:
     """``plan`` as is ("normal") or transformed by ``rgraph.compiler.naive_sync`` ("naive")."""
     if sync == "normal":
         return plan

@@ -59,9 +59,10 @@ _TABLE: dict[str, tuple[tuple[str, ...] | None, tuple[str, ...], str | None]] = 
     "vertex": (("VERTEX_ATTRIBUTE_INPUT",), ("VERTEX_ATTRIBUTE_READ",), None),
     "index": (("INDEX_INPUT",), ("INDEX_READ",), None),
     "indirect": (("DRAW_INDIRECT",), ("INDIRECT_COMMAND_READ",), None),
-    # ALL_TRANSFER rather than COPY: validation layer 1.3.239 misreports the narrower stages.
-    "transfer_src": (("ALL_TRANSFER",), ("TRANSFER_READ",), "TRANSFER_SRC_OPTIMAL"),
-    "transfer_dst": (("ALL_TRANSFER",), ("TRANSFER_WRITE",), "TRANSFER_DST_OPTIMAL"),
+    # the stage copies run in; the runtime widens it to ALL_TRANSFER for validation layer
+    # 1.3.239 (rgraph/vk/lower/workarounds/transfer_stages.py), the plan keeps the true one
+    "transfer_src": (("COPY",), ("TRANSFER_READ",), "TRANSFER_SRC_OPTIMAL"),
+    "transfer_dst": (("COPY",), ("TRANSFER_WRITE",), "TRANSFER_DST_OPTIMAL"),
     # a build writes the structure (a refit also reads it: ``refit=True``)
     "accel_build": (("ACCELERATION_STRUCTURE_BUILD_KHR",), ("ACCELERATION_STRUCTURE_WRITE_KHR",), None),
     "accel_read": (None, ("ACCELERATION_STRUCTURE_READ_KHR",), None),

@@ -8,15 +8,13 @@ and column.
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from rgraph.check.jsonloc import locate
 from rgraph.errors import RGraphError
-
-PLAN_FORMAT = "rgraph-plan/1"
+from rgraph.jsonloc import locate, path_parts
+from rgraph.plan.model import PLAN_FORMAT
 
 Plan = dict[str, Any]
 
@@ -32,16 +30,6 @@ def load_plan(path: str | Path) -> Plan:
 
 def _join(where: str, key: str) -> str:
     return f"{where}.{key}" if where else key
-
-
-_PATH_PART = re.compile(r"\[(\d+)\]|([^.\[\]]+)")
-
-
-def path_parts(where: str) -> list[str | int]:
-    """``passes[3].src`` -> ``["passes", 3, "src"]`` (``top level`` -> ``[]``)."""
-    if where == "top level":
-        return []
-    return [int(index) if index else key for index, key in _PATH_PART.findall(where)]
 
 
 class _Checker:

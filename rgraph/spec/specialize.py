@@ -107,6 +107,7 @@ class Spec:
     outputs: list[str]
     removed: list[tuple[str, str]]  # (pass, reason) for `requires` the scene lacks
     scene_source: str | None = None  # the scene file's path (the runtime builds its geometry)
+    memory_policy: str | None = None  # the graph's default placement policy (``memory_policy:``)
 
 
 _SELECTOR = re.compile(r"^(?P<name>[^\[\]]+?)\s*(\[(?P<sel>[^\]]*)\])?$")
@@ -232,6 +233,7 @@ def specialize(
         passes=passes,
         outputs=outputs,
         removed=removed,
+        memory_policy=source.memory_policy,
     )
 
 

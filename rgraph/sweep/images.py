@@ -14,7 +14,7 @@ from rgraph.sweep.metrics import linear_to_srgb
 
 
 def output_image_resources(plan: dict) -> list[dict]:
-    """The plan's output images, in the plan's ``outputs`` order."""
+    """The plan's output images (plan dict resources), in the plan's ``outputs`` order."""
     by_name = {r["name"]: r for r in plan["resources"]}
     names = plan.get("outputs") or [r["name"] for r in plan["resources"] if r["lifetime"] == "output"]
     return [by_name[n] for n in names if n in by_name and by_name[n]["kind"] == "image"]

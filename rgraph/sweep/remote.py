@@ -150,9 +150,11 @@ def render_job(job: RenderJob) -> Any:
     index = _device_index(request)
     if index != request.device:
         request = dataclasses.replace(request, device=index)
-    plans = _compile_all(request, [job.setting])
-    (plan,) = plans.values()
-    rendering = _render(request, plan)
+    from rgraph.api import open_device
+
+    with open_device(validate=request.validate, device=request.device, verbose=False) as gpu:
+        (plan,) = _compile_all(request, [job.setting], gpu).values()
+        rendering = _render(request, plan, gpu)
     if job.reference is not None:
         from rgraph.sweep.compare import compare
 

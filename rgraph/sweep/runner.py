@@ -145,10 +145,13 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
     collector = Collector(request, settings, resolved_params, out_dir)
     with _progress_bar(progress, len(distinct)) as bar:
         if executor is None:
-            plans = _compile_all(request, list(distinct.values()))
-            for key, s in distinct.items():
-                bar.step(s.label)
-                collector.add(key, _render(request, plans[key]))
+            from rgraph.api import open_device
+
+            with open_device(validate=request.validate, device=request.device, verbose=False) as gpu:  # one device
+                plans = _compile_all(request, list(distinct.values()), gpu)
+                for key, s in distinct.items():
+                    bar.step(s.label)
+                    collector.add(key, _render(request, plans[key], gpu))
         else:
             from rgraph.sweep.remote import jobs, render_job
 
@@ -158,27 +161,23 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
     return collector.result()
 
 
-def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, dict]:
-    """Plans by params key, compiled with the live device's memory requirements."""
+def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> dict[tuple, dict]:
+    """Plans by params key, compiled with the memory requirements of ``gpu`` (``rgraph.open_device``),
+    the device that renders them."""
     from rgraph.compiler.pipeline import compile_graph
-    from rgraph.vk.memreq import live_requirements
 
     source = load_graph(resolve_graph(request.graph))
     plans: dict[tuple, dict] = {}
-    with live_requirements(request.device) as (memory, _device):
-        for s in settings:
-            plans[params_key(resolved(source, s.overrides))] = compile_graph(
-                request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
-                policy=request.policy, memory=memory,
-                extra_outputs=[request.hdr] if request.hdr else [])
+    memory = gpu.memory_requirements()
+    for s in settings:
+        plans[params_key(resolved(source, s.overrides))] = compile_graph(
+            request.graph, scene_path=request.scene, params=s.overrides, size=request.size,
+            policy=request.policy, memory=memory, extra_outputs=[request.hdr] if request.hdr else [])
     return plans
 
 
-def _render(request: SweepRequest, plan: dict) -> _Rendering:
-    from rgraph.vk.executor import execute_plan
-
-    result = execute_plan(plan, validate=request.validate, frames=request.frames, device_index=request.device,
-                          check_data=False, read_outputs=True)
+def _render(request: SweepRequest, plan: dict, gpu: Any) -> _Rendering:
+    result = gpu.load(plan).run_and_check(request.frames, check_data=False, read_outputs=True)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None

@@ -18,7 +18,8 @@ from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import PassSetup
-from rgraph.vk.record import RecordContext
+from rgraph.vk.probe_rt import probe_class
+from rgraph.vk.record_context import RecordContext
 from rgraph.vk.resources import ResourceSet
 
 ATTACHMENT_USAGES = ("color_attachment", "color_attachment_blend", "depth_attachment", "depth_read")
@@ -42,15 +43,21 @@ def _load_op(a: dict, impl: type[PassImpl], first_writes: set[str]) -> str:
     return "clear"
 
 
+def overrides_update(p: ImplPass) -> bool:
+    """Whether the pass's implementation has per-frame host work (``PassImpl.update``)."""
+    return type(p.impl).update is not PassImpl.update
+
+
 class ImplPass:
-    """One plan pass executed by its registered implementation, for every frame-in-flight set."""
+    """One plan pass executed by its registered implementation (the probe, ``PROBE``, for a
+    pass without ``impl:``), for every frame-in-flight set."""
 
     def __init__(self, device: Device, plan: dict, plan_pass: dict, resources: ResourceSet, *, sets: int,
-                 scene: Any, samplers: dict[str, Any]) -> None:
+                 scene: Any, samplers: dict[str, Any], accels: Any = None) -> None:
         self.device = device
         self.p = plan_pass
         try:
-            impl_class = lookup(plan_pass["impl"])
+            impl_class = lookup(plan_pass["impl"]) if plan_pass.get("impl") else probe_class(plan_pass)
         except KeyError as exc:
             raise ExecutionError(f"pass {plan_pass['name']!r}: {exc.args[0]}") from None
         self.render_pass = None
@@ -58,10 +65,10 @@ class ImplPass:
         self.clear_values: list[Any] = []
         self.extent: tuple[int, int] | None = None
         layers = 1
-        if plan_pass["kind"] == "raster":
+        if plan_pass["kind"] == "raster" and not impl_class.owns_render_pass:
             layers = self._prepare_render_pass(plan, resources, sets, impl_class)
         self.setup = PassSetup(device, plan, plan_pass, resources, sets=sets, render_pass=self.render_pass,
-                               extent=self.extent, layers=layers, scene=scene, samplers=samplers)
+                               extent=self.extent, layers=layers, scene=scene, samplers=samplers, accels=accels)
         self.impl = impl_class(self.setup)
 
     def _prepare_render_pass(self, plan: dict, resources: ResourceSet, sets: int, impl: type[PassImpl]) -> int:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from typing import Any
 
 from rgraph.vk import names
 from rgraph.vk.device import Device
@@ -85,7 +84,8 @@ class DeviceMemoryRequirements:
 @contextmanager
 def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceMemoryRequirements, Device]]:
     """The memory-requirements provider of the live device that ``execute_plan(...,
-    device_index=device_index)`` will use, and that device; both destroyed on exit."""
+    device_index=device_index)`` will use, and that device; both destroyed on exit
+    (``rgraph.open_device`` keeps one device for compiling and running instead)."""
     from rgraph.vk.device import choose_physical_device, create_device, list_physical_devices
     from rgraph.vk.instance import create_instance
     from rgraph.vk.rt_device import supported
@@ -101,12 +101,3 @@ def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceM
     finally:
         instance.destroy()
 
-
-def compile_for_device(graph: Any, device_index: int | None = None, **options: Any) -> dict:
-    """``compile_graph(graph, **options)`` with sizes and alignments from the live device that
-    ``execute_plan(..., device_index=device_index)`` will use (a plan compiled for another
-    device's profile is refused by the runtime's requirements cross-check)."""
-    from rgraph.compiler.pipeline import compile_graph
-
-    with live_requirements(device_index) as (memory, _device):
-        return compile_graph(graph, memory=memory, **options)

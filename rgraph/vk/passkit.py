@@ -103,7 +103,8 @@ class PassSetup:
 
     def __init__(self, device: Device, plan: dict, plan_pass: dict, resources: ResourceSet, *,
                  sets: int, render_pass: Any = None, extent: tuple[int, int] | None = None,
-                 layers: int = 1, scene: Any = None, samplers: dict[str, Any] | None = None) -> None:
+                 layers: int = 1, scene: Any = None, samplers: dict[str, Any] | None = None,
+                 accels: Any = None) -> None:
         self.device = device
         self.plan = plan
         self.plan_pass = plan_pass
@@ -118,6 +119,7 @@ class PassSetup:
         self.params = PassParams({**plan.get("params", {}), **plan_pass.get("params", {})})
         self.features: dict[str, Any] = dict(plan.get("features", {}))
         self._scene = scene
+        self.accels = accels  # rgraph.vk.accel.AccelSet of the plan's accels (None: none)
         self._samplers = samplers if samplers is not None else {}
         self._objects: list[tuple[str, Any]] = []
         self._host_buffers: list[HostBuffer] = []

@@ -1,7 +1,8 @@
-"""The probe implementation on the device: pipelines, descriptors, render passes, copies.
+"""The probe on the device: a registered ``PassImpl`` (``PROBE``) built on ``PassSetup``.
 
 What each pass computes is ``rgraph.probe.semantics``; its shaders come from
-``rgraph.vk.probe_glsl``. Everything is created once; ``record`` only records.
+``rgraph.vk.probe_glsl``; the data check of its outputs is ``rgraph.probe.check``.
+Everything is created once; ``record`` only records.
 """
 
 from __future__ import annotations
@@ -12,15 +13,21 @@ from pathlib import Path
 from typing import Any
 
 from rgraph import formats
+from rgraph.impl import PassImpl, register
 from rgraph.probe.semantics import analyze, mip_extent, subresources
-from rgraph.probe.values import HEADER_WORDS, codec, has_header, header_words, modulus
+from rgraph.probe.values import HEADER_WORDS, has_header, modulus
 from rgraph.vk import names
 from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
+from rgraph.vk.passkit import PassSetup
 from rgraph.vk.probe_glsl import ProbeShaders, generate
-from rgraph.vk.record import RecordContext
-from rgraph.vk.resources import HostBuffer, Resource, ResourceSet, destroy_owned
+from rgraph.vk.record_context import RecordContext
+from rgraph.vk.resources import HostBuffer, Resource
+from rgraph.vk.runtime.staging import fill_bytes, image_copy_regions
+
+#: The registered name of the probe implementation: passes without ``impl:`` run it.
+PROBE = "rgraph.probe"
 
 _GENERATED = Path(tempfile.gettempdir()) / "rgraph-probe-glsl"
 
@@ -45,68 +52,28 @@ def _module(device: Device, spirv: bytes) -> Any:
     return v.vkCreateShaderModule(device.handle, info, None)
 
 
-def texel_bytes(format_name: str, w: int, h: int) -> int:
-    info = formats.lookup(format_name)
-    bw, bh = info.block_extent[0], info.block_extent[1]
-    return -(-w // bw) * -(-h // bh) * info.block_bytes
+@register(PROBE)
+class Probe(PassImpl):
+    """One plan pass executed by the probe, for every frame-in-flight set: the implementation
+    of every pass without ``impl:``. It makes its own render passes (one framebuffer per
+    layer of a layered attachment, ``owns_render_pass``) and its own descriptor sets (by
+    access, as a pass may access one resource twice); ``setup`` owns every object."""
 
+    owns_render_pass = True
 
-def fill_bytes(resource: dict, value: int | None, sub_list: list, plan_size: tuple[int, int]) -> bytes:
-    """Staging contents that make ``sub_list`` of ``resource`` hold ``value`` (zeros if unknown)."""
-    import numpy as np
-
-    if resource["kind"] == "buffer":
-        n = int(resource["size_bytes"] or resource["bytes"]) // 4
-        words = np.full(n, value or 0, dtype=np.uint32)
-        if has_header(resource):
-            words[:HEADER_WORDS] = header_words(plan_size)
-        return words.tobytes() + b"\0" * (int(resource["size_bytes"] or resource["bytes"]) - 4 * n)
-    c = codec(resource["format"])
-    out = []
-    for mip, _layer in sub_list:
-        w, h = mip_extent(resource, mip)
-        if c is None or value is None:
-            out.append(b"\0" * texel_bytes(resource["format"], w, h))
-        else:
-            out.append(c.encode(value) * (w * h))
-    return b"".join(out)
-
-
-def image_copy_regions(resource: dict, access: dict, buffer_offset: int = 0) -> tuple[list[Any], int]:
-    """VkBufferImageCopy per (mip, layer) of an access range, tightly packed in subresources() order."""
-    v = vk()
-    aspect = names.aspect_mask(resource["format"])
-    if formats.lookup(resource["format"]).has_depth:
-        aspect = v.VK_IMAGE_ASPECT_DEPTH_BIT
-    regions, offset = [], buffer_offset
-    for mip, layer in subresources(access):
-        w, h = mip_extent(resource, mip)
-        regions.append(v.VkBufferImageCopy(
-            bufferOffset=offset, bufferRowLength=0, bufferImageHeight=0,
-            imageSubresource=v.VkImageSubresourceLayers(aspectMask=aspect, mipLevel=mip, baseArrayLayer=layer,
-                                                        layerCount=1),
-            imageOffset=v.VkOffset3D(x=0, y=0, z=0), imageExtent=v.VkExtent3D(width=w, height=h, depth=1)))
-        offset += texel_bytes(resource["format"], w, h)
-    return regions, offset - buffer_offset
-
-
-class ProbePass:
-    """One plan pass executed by the probe, for every frame-in-flight set."""
-
-    def __init__(self, device: Device, plan: dict, plan_pass: dict, resources: ResourceSet, sampler: Any) -> None:
-        self.device = device
-        self.plan = plan
-        self.p = plan_pass
-        self.resources = resources
-        self.sampler = sampler
-        self.res_plan = {r["name"]: r for r in plan["resources"]}
-        self.plan_size = tuple(plan.get("size") or (64, 64))
-        self.objects: list[tuple[str, Any]] = []  # (destroy function name, handle), destroyed in reverse
-        self.host_buffers: list[HostBuffer] = []
+    def __init__(self, setup: PassSetup) -> None:
+        super().__init__(setup)
+        self.device = setup.device
+        self.plan = setup.plan
+        self.p = setup.plan_pass
+        self.resources = setup.resources
+        self.sampler = setup.sampler("nearest")
+        self.res_plan = {r["name"]: r for r in self.plan["resources"]}
+        self.plan_size = setup.size
         self.sets: list[Any] = []
         self.framebuffers: list[list[Any]] = []
         self.shaders: ProbeShaders | None = None
-        if plan_pass["kind"] == "transfer":
+        if self.p["kind"] == "transfer":
             self._prepare_transfer()
         else:
             self._prepare_shaders()
@@ -118,8 +85,7 @@ class ProbePass:
 
     # ------------------------------------------------------------------ setup
     def _own(self, destroy: str, handle: Any) -> Any:
-        self.objects.append((destroy, handle))
-        return handle
+        return self.setup.own(destroy, handle)
 
     def _resource(self, access_index: int, set_index: int) -> Resource:
         return self.resources.get(self.p["accesses"][access_index]["resource"], set_index)
@@ -316,9 +282,8 @@ class ProbePass:
             res = self.res_plan[a["resource"]]
             m = modulus(res)
             data = fill_bytes(res, copy.seed % m if m else None, subresources(a), self.plan_size)
-            buf = HostBuffer.create(self.device, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
+            buf = self.setup.host_buffer(len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
             buf.write(data)
-            self.host_buffers.append(buf)
             regions = image_copy_regions(res, a)[0] if res["kind"] == "image" else None
             self.staging[copy.dst_access] = (buf, regions)
         self.scratch: dict[tuple[int, int], HostBuffer] = {}
@@ -328,12 +293,10 @@ class ProbePass:
                 res = self.res_plan[a["resource"]]
                 size = (image_copy_regions(res, a)[1] if res["kind"] == "image"
                         else int(res["size_bytes"] or res["bytes"]))
-                buf = HostBuffer.create(self.device, size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT)
-                self.host_buffers.append(buf)
-                self.scratch[(s, i)] = buf
+                self.scratch[(s, i)] = self.setup.host_buffer(size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT)
 
     # ------------------------------------------------------------------ record
-    def record(self, ctx: RecordContext, set_index: int) -> None:
+    def record(self, ctx: RecordContext, set_index: int) -> None:  # type: ignore[override]
         if self.p["kind"] == "transfer":
             self._record_transfer(ctx, set_index)
             return
@@ -414,6 +377,3 @@ class ProbePass:
                 ctx.copy_image_to_buffer(src.handle, names.layout(a["layout"]), buf.handle, regions)
             else:
                 ctx.copy_buffer(src.handle, buf.handle, [v.VkBufferCopy(srcOffset=0, dstOffset=0, size=buf.size)])
-
-    def destroy(self) -> None:
-        destroy_owned(self.device, self.objects, self.host_buffers)

@@ -12,13 +12,12 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph.vk.accel import AccelSet
-from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
-from rgraph.vk.probe import ProbePass, compile_glsl
+from rgraph.vk.passkit import PassSetup
+from rgraph.vk.probe import PROBE, Probe, compile_glsl
 from rgraph.vk.probe_rt_glsl import generate_rt
-from rgraph.vk.record import RecordContext
-from rgraph.vk.resources import ResourceSet
+from rgraph.vk.record_context import RecordContext
 from rgraph.vk.rt_pipeline import all_rt_stages, create_rt_pipeline
 
 
@@ -28,9 +27,23 @@ def needs_ray_tracing(plan: dict) -> bool:
             or any(p["kind"] == "raytrace" for p in plan["passes"]))
 
 
+def has_raytrace(plan: dict) -> bool:
+    """Whether a plan has raytrace passes (the device then also enables VK_KHR_maintenance6)."""
+    return any(p["kind"] == "raytrace" for p in plan["passes"])
+
+
 #: The newest Khronos validation layer known to crash inside vkCreateRayTracingPipelinesKHR
 #: (Debian's 1.3.239 on lavapipe: even a raygen-only pipeline; core checks off, it crashes at bind).
 CRASHING_LAYER = (1, 3, 239)
+
+
+def layer_crashes() -> bool:
+    """Whether the installed validation layer is one that crashes on ray tracing pipelines (it
+    also predates VK_KHR_maintenance6, so a validated device is created without it)."""
+    from rgraph.vk.instance import validation_layer_version
+
+    version = validation_layer_version()
+    return version is not None and version <= CRASHING_LAYER
 
 
 def refuse_layer_for_ray_tracing(plan: dict) -> None:
@@ -40,32 +53,35 @@ def refuse_layer_for_ray_tracing(plan: dict) -> None:
     if not any(p["kind"] == "raytrace" for p in plan["passes"]):
         return
     version = validation_layer_version()
-    if version is not None and version <= CRASHING_LAYER:
+    if layer_crashes() and version is not None:
         raise ExecutionError(
             f"--validate: the installed Khronos validation layer {'.'.join(map(str, version))} crashes inside "
             "vkCreateRayTracingPipelinesKHR; run raytrace passes without --validate (the data check and "
             "`rgraph check` cover them; the layer tracks no ray tracing hazards anyway)")
 
 
-def probe_pass(device: Device, plan: dict, plan_pass: dict, resources: ResourceSet, sampler: Any,
-               accels: AccelSet | None) -> ProbePass:
-    """The probe implementation of ``plan_pass``, ray tracing aware."""
+def probe_class(plan_pass: dict) -> type[Probe]:
+    """The probe implementation of ``plan_pass`` (a pass without ``impl:``), ray tracing aware."""
+    from rgraph.impl import lookup
+
     if plan_pass["kind"] == "raytrace":
-        return RayTraceProbePass(device, plan, plan_pass, resources, sampler, accels)
+        return RayTraceProbe
     if any(a["usage"] == "accel_build" for a in plan_pass["accesses"]):
-        return AccelBuildProbePass(device, plan, plan_pass, resources, sampler, accels)
+        return AccelBuildProbe
     if any(a["usage"] == "accel_read" for a in plan_pass["accesses"]):
         raise ExecutionError(f"pass {plan_pass['name']!r}: the probe reads accels in raytrace passes only "
                              "(no ray queries)")
-    return ProbePass(device, plan, plan_pass, resources, sampler)
+    return lookup(PROBE)  # type: ignore[return-value]
 
 
-class AccelBuildProbePass(ProbePass):
-    def __init__(self, device, plan, plan_pass, resources, sampler, accels: AccelSet | None) -> None:
-        super().__init__(device, plan, plan_pass, resources, sampler)
-        assert accels is not None
-        self.accels = accels
-        self.builds = [a["resource"] for a in plan_pass["accesses"] if a["usage"] == "accel_build"]
+class AccelBuildProbe(Probe):
+    """A compute probe pass that then builds (or refits) each accel it writes."""
+
+    def __init__(self, setup: PassSetup) -> None:
+        super().__init__(setup)
+        assert setup.accels is not None
+        self.accels: AccelSet = setup.accels
+        self.builds = [a["resource"] for a in self.p["accesses"] if a["usage"] == "accel_build"]
 
     def record(self, ctx: RecordContext, set_index: int) -> None:
         super().record(ctx, set_index)
@@ -73,10 +89,12 @@ class AccelBuildProbePass(ProbePass):
             ctx.build_accel(self.accels, name, set_index)
 
 
-class RayTraceProbePass(ProbePass):
-    def __init__(self, device, plan, plan_pass, resources, sampler, accels: AccelSet | None) -> None:
-        self.accels = accels
-        super().__init__(device, plan, plan_pass, resources, sampler)
+class RayTraceProbe(Probe):
+    """A raytrace pass: the compute probe as raygen shader plus rays against each accel read."""
+
+    def __init__(self, setup: PassSetup) -> None:
+        self.accels: AccelSet | None = setup.accels
+        super().__init__(setup)
 
     def _prepare_shaders(self) -> None:
         self.rt = generate_rt(self.p, self.res_plan, self.plan_size)

@@ -1,20 +1,20 @@
 """The checker's happens-before model on tiny plans, and its building blocks."""
 
 from __future__ import annotations
-from locations import TESTS
 
 import json
 
 import pytest
+from locations import TESTS
 from plans.check_builder import access, barrier, gpass, plan_of, resource, scope
 
 from rgraph.check import RAW, SEMAPHORE, WAR, WAW, check_plan
 from rgraph.check.aliasing import analyse
 from rgraph.check.cells import CellMap, merge_rects
 from rgraph.check.chains import ChainRegistry
-from rgraph.check.jsonloc import locate
 from rgraph.check.plan import read_plan
 from rgraph.check.vocab import ALL_STAGES, STAGE_BIT, access_mask, stage_mask
+from rgraph.jsonloc import locate
 
 BUF = None  # buffers have no layout
 

@@ -1,17 +1,17 @@
 """The bundled surgery graph: golden plans, determinism, and scene-driven culling."""
 
 from __future__ import annotations
-from locations import TESTS
 
 import json
 import os
 from pathlib import Path
 
 import pytest
+from locations import TESTS
 
 from rgraph.cli import main
 from rgraph.compiler.pipeline import compile_graph
-from rgraph.plan import dumps
+from rgraph.plan import dumps_json as dumps
 from rgraph.resources import graphs_dir
 
 GOLDEN = TESTS / "golden"

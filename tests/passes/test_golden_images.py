@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from golden_images import UPDATE_ENV, assert_image_close, read_png, to_rgba8
 
-from rgraph.vk.readback import write_png
+from rgraph.png import write_png
 
 
 def _filtered_png(pixels: np.ndarray, colour_type: int, filters: list[int]) -> bytes:

@@ -114,3 +114,21 @@ def test_shape_errors_in_a_file_carry_line_and_column(capsys, tmp_path):
     col = text.splitlines()[line - 1].index('"COMPUTE_SHADER"') + 1
     assert err.strip() == (f"{path}:{line}:{col}: error: malformed plan: passes[3].barriers[1].src.stages: "
                            "expected a list, got \"COMPUTE_SHADER\"")
+
+
+def test_partial_plans_render_with_a_warning_from_the_typed_loader(capsys, tmp_path):
+    """inspect shows what a partial plan has, and says where the typed loader (rgraph run) refuses it."""
+    from report_plans.helpers import MINIMAL
+
+    code, out, err = inspect(capsys, str(MINIMAL))
+    assert code == 0 and "Schedule (2 passes)" in out
+    assert err.startswith(f"{MINIMAL}:5:5: warning: malformed plan: passes[0]: missing key 'impl'")
+    assert err.count("\n") == 1
+    plan = load(FORWARD)
+    del plan["passes"][3]["barriers"]
+    path = tmp_path / "no_barriers.json"
+    path.write_text(json.dumps(plan, indent=1))
+    code, out, err = inspect(capsys, str(path))
+    assert code == 0 and "warning: malformed plan: passes[3]: missing key 'barriers'" in err
+    code, _, err = inspect(capsys, str(FORWARD))
+    assert code == 0 and err == ""

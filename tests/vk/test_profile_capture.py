@@ -3,7 +3,6 @@ usage: the capture failed there with a traceback), clean errors, and a captured 
 reproduces the live device's plan."""
 
 from __future__ import annotations
-from locations import TESTS
 
 import json
 import subprocess
@@ -11,6 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from locations import TESTS
 
 from rgraph.memory_requirements import ProfileMemoryRequirements, align_up
 from rgraph.vk.profile_capture import BUFFER_USAGES, ProfileCaptureError, _measure_buffers
@@ -64,8 +64,8 @@ def test_profiles_without_per_usage_rounding_still_load() -> None:
 def test_captured_profile_compiles_the_plan_the_live_device_gets(tmp_path: Path) -> None:
     """End to end: capture the default device's profile with the CLI, then compile a bundled
     graph offline with it; the plan's memory layout equals the one compiled against the device."""
+    from rgraph.api import compile_for_device
     from rgraph.compiler.pipeline import compile_graph
-    from rgraph.vk.memreq import compile_for_device
 
     out = tmp_path / "device.json"
     formats = "R8G8B8A8_UNORM,R16G16B16A16_SFLOAT,R32_SFLOAT,D32_SFLOAT,B10G11R11_UFLOAT_PACK32"

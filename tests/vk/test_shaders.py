@@ -1,7 +1,6 @@
 """glslc compilation: stages, defines, the content-hash cache, errors, shader directories."""
 
 from __future__ import annotations
-from locations import ROOT, TESTS
 
 import os
 import shutil
@@ -10,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from locations import ROOT, TESTS
 
 from rgraph.errors import RGraphError
 from rgraph.vk import shaders

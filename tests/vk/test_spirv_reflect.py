@@ -1,7 +1,6 @@
 """Pure-Python SPIR-V reflection, checked on real glslc output and against spirv-dis."""
 
 from __future__ import annotations
-from locations import ROOT, TESTS
 
 import importlib.util
 import re
@@ -11,6 +10,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from locations import ROOT, TESTS
 
 from rgraph.vk import spirv_grammar
 from rgraph.vk.shaders import compile_shader

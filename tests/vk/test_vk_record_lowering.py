@@ -1,4 +1,4 @@
-"""Plan barriers -> sync2 structs (``rgraph.vk.record.lower_barriers``), pure: a fake device
+"""Plan barriers -> barrier calls (``rgraph.vk.lower.barriers.lower_barriers``), pure: a fake device
 with a separate compute queue family (as on NVIDIA) checks the exact structs of ownership
 transfers, which lavapipe (one queue family) never records."""
 
@@ -9,7 +9,8 @@ import pytest
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.random_graph import random_graph, to_yaml
 from rgraph.stages import fit_to_queue, queue_supports
-from rgraph.vk.record import BarrierSpec, lower_barriers
+from rgraph.vk.lower.barriers import lower_barriers
+from rgraph.vk.lower.model import BarrierSpec
 
 TWO_FAMILIES = {"graphics": 0, "compute": 1, "transfer": 2}
 ONE_FAMILY = {"graphics": 0, "compute": 0, "transfer": 0}
@@ -219,7 +220,7 @@ def test_first_frame_releases_are_the_wrap_around_handoffs(seed, passes, policy,
     """Frame 0's first-use acquires of persistent resources pair with releases from a previous
     frame that does not exist (H100 fuzz seeds 13/12 and 48/16): the runtime records exactly
     the releases whose acquire comes at or before them in the frame, once, after init."""
-    from rgraph.vk.executor import first_frame_releases
+    from rgraph.vk.lower.batches import first_frame_releases
     from rgraph.vk.resources import SHARED
 
     plan = _random_plan(seed, passes, policy)
@@ -257,7 +258,7 @@ def test_transition_after_reads_of_a_write_names_that_write():
     a semaphore wait -> transition. The transition names the write's stages and MEMORY_WRITE;
     a post-write barrier that lost its src access (a mutation) is not repaired; another
     layer's reads do not count."""
-    from rgraph.vk.after_reads import writers_before_reads
+    from rgraph.vk.lower.workarounds.after_reads import writers_before_reads
 
     plan = {"passes": [
         {"accesses": [_access("a", ["COMPUTE_SHADER"], True)], "barriers": []},
@@ -294,7 +295,7 @@ def test_buffer_barrier_before_a_write_after_reads_names_the_earlier_write():
     """H100 fuzz seed 1/22: a persistent buffer written by compute, read as indirect and
     uniform, then written again; the write-after-read barrier (execution only in the plan)
     names the earlier write's stages and MEMORY_WRITE."""
-    from rgraph.vk.after_reads import writers_before_reads
+    from rgraph.vk.lower.workarounds.after_reads import writers_before_reads
 
     plan = {"passes": [
         {"accesses": [_buffer_access(["DRAW_INDIRECT"], False)],
@@ -312,7 +313,7 @@ def test_barrier_after_reads_also_names_the_waits_made_on_its_queue():
     """H100 fuzz seed 231271/12: compute writes, graphics reads it (indirect), waits for compute
     twice more, then writes: the write-after-read barrier names the stages of every wait made
     so far on the graphics VkQueue (the layer's chain for the write is the last wait's)."""
-    from rgraph.vk.after_reads import src_additions
+    from rgraph.vk.lower.workarounds.after_reads import src_additions
 
     def wait(stages):
         return {"queue": "compute", "value": 1, "stages": stages}
@@ -332,7 +333,7 @@ def test_barrier_after_reads_also_names_the_waits_made_on_its_queue():
 def test_aliased_first_use_after_reads_names_the_waits_made_on_its_queue():
     """H100 fuzz seed 0/28 (aliased): a first use from UNDEFINED after the previous occupant's
     reads names the stages of the waits made on its VkQueue; its src access stays MEMORY_READ."""
-    from rgraph.vk.after_reads import src_additions
+    from rgraph.vk.lower.workarounds.after_reads import src_additions
 
     first_use = _barrier("b", ["COMPUTE_SHADER"], [], "UNDEFINED", "GENERAL")
     plan = {"passes": [
@@ -365,7 +366,7 @@ def test_aliased_buffer_first_use_after_reads_names_waits_and_the_write():
     """H100 fuzz 885/24 aliased: buf6 written (fragment), read as a uniform, graphics waits for
     compute, then buf1 (same memory) is first written by a dispatch. Its barrier (reads' stages,
     no access) names the wait's stages and buf6's write; an emptied post-write scope does not."""
-    from rgraph.vk.after_reads import src_additions
+    from rgraph.vk.lower.workarounds.after_reads import src_additions
 
     def buf(name, stages, write):
         return {"resource": name, "subresource": None, "stages": stages, "write": write}
@@ -389,7 +390,7 @@ def test_layout_change_after_an_acquire_names_the_waits_of_its_queue():
     """H100 fuzz 422/25 and 156/32: a persistent image written on compute in one frame and
     acquired by graphics in the next, after graphics waited for compute elsewhere. The layout
     change recorded after the acquire names every wait stage of the graphics VkQueue."""
-    from rgraph.vk.after_reads import src_additions
+    from rgraph.vk.lower.workarounds.after_reads import src_additions
 
     acquire = _barrier("img", ["COMPUTE_SHADER"], ["SHADER_STORAGE_WRITE"], "GENERAL", "SHADER_READ_ONLY_OPTIMAL")
     acquire["src"]["queue"] = "compute"
@@ -413,7 +414,7 @@ def test_partly_seen_handoff_gets_a_global_barrier_in_the_same_call():
     packed) takes over img6 (8x8 RGBA16F, two layers: 1,024 bytes, packed alike). The layer
     applies img16's hand-off to its 320 packed bytes only, so the hand-off also records a
     global memory barrier: the hand-off's src scope before ALL_COMMANDS."""
-    from rgraph.vk.packed_ranges import packed_bytes, partial_handoffs
+    from rgraph.vk.lower.workarounds.packed_ranges import packed_bytes, partial_handoffs
 
     img6 = {"name": "img6", "kind": "image", "format": "R16G16B16A16_SFLOAT", "extent": [8, 8, 1], "mips": 1,
             "layers": 2, "bytes": 1024, "heap": 1, "offset": 0}

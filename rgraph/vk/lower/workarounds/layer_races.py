@@ -20,7 +20,7 @@ batches the model finds clean (every bundled graph) get no extra edge.
 
 from __future__ import annotations
 
-from rgraph.vk.semaphore_edges import BatchSync, SemaphoreEdge, semaphore_edges, submission_order
+from rgraph.vk.lower.semaphores import BatchSync, SemaphoreEdge, semaphore_edges, submission_order
 
 MODEL_FRAMES = 3  # frame 0 has no previous frame; frames 1 and 2 are the steady state for both sets
 

@@ -12,7 +12,7 @@ occupants back, ``write_barriers: 0``; 1080/32, 1337/40 and 333/36 alike).
 
 Where that happens the runtime records, with the hand-off, a global VkMemoryBarrier2 with the
 hand-off's src scope and dst ALL_COMMANDS / MEMORY_READ|MEMORY_WRITE
-(``rgraph.vk.record.lower_barriers``): the previous occupant's accesses are then ordered before
+(``global_after`` below): the previous occupant's accesses are then ordered before
 everything after, in the layer's model and on the device (where the image barrier already
 ordered them before the new occupant; the global one adds only that later commands wait too).
 """
@@ -20,7 +20,13 @@ ordered them before the new occupant; the global one adds only that later comman
 from __future__ import annotations
 
 from rgraph import formats
-from rgraph.vk.after_reads import alias_names
+from rgraph.vk.lower.context import BarrierContext
+from rgraph.vk.lower.model import BarrierSpec
+from rgraph.vk.lower.workarounds.after_reads import alias_names
+
+#: dst scope of the global barrier that completes a partly seen hand-off: every later command.
+GLOBAL_DST_STAGES = ("ALL_COMMANDS",)
+GLOBAL_DST_ACCESS = ("MEMORY_READ", "MEMORY_WRITE")
 
 
 def packed_bytes(resource: dict) -> int:
@@ -70,3 +76,12 @@ def partial_handoffs(plan: dict) -> list[set[int]]:
                     found.add(index)
         out.append(found)
     return out
+
+
+def global_after(spec: BarrierSpec, ctx: BarrierContext) -> list[BarrierSpec]:
+    """A partly seen hand-off (``ctx.partial_handoff``) is followed, in the same call, by a
+    global memory barrier with its src scope, ordering it before every later command."""
+    if ctx.partial_handoff and ctx.group == 0 and spec.src_stages:
+        return [spec, BarrierSpec(None, None, spec.src_stages, spec.src_access, GLOBAL_DST_STAGES,
+                                  GLOBAL_DST_ACCESS, None, None)]
+    return [spec]

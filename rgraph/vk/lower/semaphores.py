@@ -25,28 +25,23 @@ from __future__ import annotations
 
 from collections.abc import Hashable, Iterable
 from dataclasses import dataclass
+from typing import Any
+
+from rgraph.vk.lower.model import SemaphoreEdge
 
 
 @dataclass(frozen=True)
 class BatchSync:
-    """What the executor knows of one batch: its plan queue, the VkQueue it runs on, the plan
-    waits of its first pass and the plan signals of its last pass as (plan queue, value, stage
-    mask), and the resources its passes access or transition (for rgraph.vk.layer_races)."""
+    """What the lowering knows of one batch: its plan queue, the VkQueue it runs on, the plan
+    waits of its first pass and the plan signals of its last pass as (plan queue, value,
+    stages: a frozenset of stage names, or an int mask), and the resources its passes access
+    or transition (for ``workarounds.layer_races``)."""
 
     plan_queue: str
     vk_queue: Hashable
-    waits: tuple[tuple[str, int, int], ...]
-    signals: tuple[tuple[str, int, int], ...]
+    waits: tuple[tuple[str, int, Any], ...]
+    signals: tuple[tuple[str, int, Any], ...]
     resources: frozenset[str] = frozenset()
-
-
-@dataclass(frozen=True)
-class SemaphoreEdge:
-    signal_batch: int
-    wait_batch: int
-    signal_stages: int
-    wait_stages: int
-    frame_edge: bool  # signalled at the end of one frame, waited at the start of the next
 
 
 @dataclass(frozen=True)
@@ -55,14 +50,16 @@ class SemaphoreUse:
 
     semaphore: int
     offset: int
-    stages: int
+    stages: Any
 
 
-def semaphore_edges(batches: list[BatchSync], all_commands: int,
+def semaphore_edges(batches: list[BatchSync], all_commands: Any,
                     extra: Iterable[tuple[int, int]] = ()) -> list[SemaphoreEdge]:
     """The edges of one frame (see the module docstring); ``all_commands`` is the stage mask
     of frame edges and of ``extra`` in-frame edges (signal batch, wait batch) that the plan
-    does not need (rgraph.vk.layer_races adds them; they merge like plan waits)."""
+    does not need (``workarounds.layer_races`` adds them; they merge like plan waits). Stage
+    sets merge with ``|`` (frozensets of names, or int masks)."""
+    none = type(all_commands)()
     signalled_by: dict[tuple[str, int], int] = {}
     for bi, batch in enumerate(batches):
         for queue, value, _stages in batch.signals:
@@ -85,7 +82,7 @@ def semaphore_edges(batches: list[BatchSync], all_commands: int,
             latest[key] = (source, signal_stages, stages)
     for source, bi in extra:
         key = (bi, batches[source].vk_queue)
-        prev_source, prev_signal, prev_wait = latest.get(key, (source, 0, 0))
+        prev_source, prev_signal, prev_wait = latest.get(key, (source, none, none))
         latest[key] = (max(source, prev_source), prev_signal | all_commands, prev_wait | all_commands)
     edges = [SemaphoreEdge(source, wait, signal_stages, wait_stages, False)
              for (wait, _q), (source, signal_stages, wait_stages) in sorted(latest.items(), key=lambda kv: kv[0][0])]
@@ -101,7 +98,7 @@ def semaphore_edges(batches: list[BatchSync], all_commands: int,
     return edges
 
 
-def _signal_stages(batch: BatchSync, queue: str, value: int) -> int:
+def _signal_stages(batch: BatchSync, queue: str, value: int) -> Any:
     return next(stages for q, v, stages in batch.signals if (q, v) == (queue, value))
 
 

@@ -1,12 +1,13 @@
 """Find where a value sits in JSON text, given its path (keys and list indices).
 
-Used only when a plan is malformed, to turn a path like ``passes[3].barriers[0].src``
+Used when a plan is malformed (rgraph.plan.load, rgraph check), to turn a path like ``passes[3].barriers[0].src``
 into the 1-based line and column an editor shows.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Sequence
 from json.decoder import scanstring
 
@@ -80,3 +81,13 @@ def format_path(path: Sequence[PathPart]) -> str:
     for part in path:
         out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else part)
     return out or "top level"
+
+
+_PATH_PART = re.compile(r"\[(\d+)\]|([^.\[\]]+)")
+
+
+def path_parts(where: str) -> list[PathPart]:
+    """``passes[3].src`` -> ``["passes", 3, "src"]`` (``top level`` -> ``[]``)."""
+    if where == "top level":
+        return []
+    return [int(index) if index else key for index, key in _PATH_PART.findall(where)]

@@ -13,7 +13,7 @@ uniform reads in the next, a wait for compute in between, and the next storage w
 reported WRITE_AFTER_WRITE against the previous frame's). The runtime then names the write
 itself in the barrier's src scope (its stages, MEMORY_WRITE): a second availability operation
 for a write that is already available, a no-op by the spec, in the form that layer checks
-first (``rgraph.vk.record``).
+first (``name_read_write`` below).
 
 Only barriers whose latest earlier access to an overlapping subresource is a read count, so
 a barrier that lost its src access (a mutation, a generator bug) is never repaired here.
@@ -22,6 +22,10 @@ a barrier that lost its src access (a mutation, a generator bug) is never repair
 from __future__ import annotations
 
 from collections.abc import Callable, Hashable
+from dataclasses import replace
+
+from rgraph.vk.lower.context import BarrierContext
+from rgraph.vk.lower.model import BarrierSpec
 
 
 def _overlaps(a: dict | None, b: dict | None) -> bool:
@@ -122,3 +126,57 @@ def _after_reads_from_undefined(barrier: dict) -> bool:
     replaced its chain for the previous occupant's write with the last wait's stages)."""
     src = barrier["src"]
     return src["layout"] == "UNDEFINED" and bool(src["stages"]) and not src["access"]
+
+
+# ----------------------------------------------------------------- the rewrites (per struct)
+
+#: srcAccessMask of a layout transition that follows reads (see ``memory_read_after_reads``);
+#: with the write those reads read, when it is known (``name_read_write``).
+AFTER_READS_ACCESS = ("MEMORY_READ",)
+AFTER_WRITE_READS_ACCESS = ("MEMORY_READ", "MEMORY_WRITE")
+
+
+def _is_transition_after_reads(spec: BarrierSpec) -> bool:
+    return (spec.old_layout is not None and spec.old_layout != spec.new_layout and bool(spec.src_stages)
+            and not spec.src_access)
+
+
+def name_read_write(spec: BarrierSpec, ctx: BarrierContext) -> list[BarrierSpec]:
+    """An ordinary barrier after reads (src stages, no src access) whose reads read a write
+    with stages ``ctx.write_stages`` (``src_additions``, which says why the 1.3.239 layer
+    needs it) also names that write in its src scope: its stages and MEMORY_READ|MEMORY_WRITE
+    (a repeated availability operation for a write already available, a no-op by the spec).
+    Layout transitions and buffer or same-layout barriers before a write alike. A transition
+    from UNDEFINED (aliased memory after the previous occupant's reads) gets the stages only
+    (``memory_read_after_reads`` names MEMORY_READ); ownership transfers keep their
+    spec-mandated masks."""
+    write_stages = ctx.write_stages
+    if (write_stages and spec.src_stages and not spec.src_access and spec.src_family is None
+            and spec.dst_family is None):
+        stages = tuple(sorted(set(spec.src_stages) | set(write_stages)))
+        if spec.old_layout == "UNDEFINED":
+            return [replace(spec, src_stages=stages)]
+        return [replace(spec, src_stages=stages, src_access=AFTER_WRITE_READS_ACCESS)]
+    return [spec]
+
+
+def memory_read_after_reads(spec: BarrierSpec, ctx: BarrierContext) -> list[BarrierSpec]:
+    """A layout transition whose src scope is reads only (src stages, no src access) gets
+    srcAccessMask MEMORY_READ. By the spec this is a no-op: availability operations concern
+    writes, the write before those reads was made available by the barrier in front of them,
+    and the transition is ordered after it through the reads' stages (an execution chain).
+    The 1.3.239 layer credits that chain inside one command buffer but not at submit time
+    across command buffers: there it wants the transition's src access scope to meet the
+    accesses the write was made visible to (the reads), and otherwise reports
+    WRITE_AFTER_WRITE for "storage write -> (barrier, no layout change) -> storage read ->
+    transition" (random graphs seed 0 and 9, tests/vk/test_run_fuzz.py), and likewise for an
+    aliased resource's first transition (from UNDEFINED) after the previous occupant's reads
+    (seeds 0 and 32 with 10 passes, aliased). Naming the reads in srcAccessMask records the
+    same dependency in the form the layer understands. Applied after fitting the barrier to
+    the queue family, so that a src scope left without accesses there gets it too. From
+    UNDEFINED even with a src access: aliased memory whose previous occupants ended with
+    reads and with writes (seed 0/32 aliased, lavapipe and H100) names the reads too."""
+    if (_is_transition_after_reads(spec) or (spec.old_layout == "UNDEFINED" and spec.src_stages)) \
+            and "MEMORY_READ" not in spec.src_access:
+        return [replace(spec, src_access=tuple(sorted({*spec.src_access, *AFTER_READS_ACCESS})))]
+    return [spec]

@@ -1,0 +1,148 @@
+"""The emit phase: the compiler's results -> the typed plan (``rgraph.plan.model``).
+
+Everything is sorted or in a defined order here, so that the same inputs give the same
+plan (and ``rgraph.plan.dump`` the same bytes).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from functools import lru_cache
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+from rgraph.compiler import sync as csync
+from rgraph.defaults import DEFAULT_SCHEDULE
+from rgraph.plan import model as pm
+from rgraph.spec.specialize import PassSpec, ResourceSpec
+
+if TYPE_CHECKING:
+    from rgraph.compiler.phases import Compilation
+
+SIGNAL_STAGES = ("ALL_COMMANDS",)
+
+
+@lru_cache(maxsize=65536)
+def plan_state(st: csync.State) -> pm.State:
+    return pm.State(tuple(sorted(st.stages)), tuple(sorted(st.access)), st.layout, st.queue)
+
+
+@lru_cache(maxsize=65536)
+def _range_pair(mips: tuple[int, int], layers: tuple[int, int]) -> pm.Subresource:
+    return pm.Subresource(mips, layers)  # immutable: one object per distinct pair of ranges
+
+
+def _subresource(res: ResourceSpec, mips, layers) -> pm.Subresource | None:
+    return _range_pair(tuple(mips), tuple(layers)) if res.is_image else None
+
+
+def _barrier(b: csync.Barrier, resources: Mapping[str, ResourceSpec]) -> pm.Barrier:
+    key = b.key
+    return pm.Barrier(b.resource, _subresource(resources[b.resource], b.mips, b.layers), plan_state(key.src),
+                      plan_state(key.dst), key.aliases)
+
+
+def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.EndState:
+    """One state when every cell agrees. Otherwise: None for transients (nothing outlives the
+    frame), a per-cell list for the others (docs/plan.md)."""
+    if not states:
+        return None
+    distinct = set(states.values())
+    if len(distinct) == 1:
+        return plan_state(next(iter(distinct)))
+    if lifetime == "transient":
+        return None
+    return tuple(pm.CellState(pm.Subresource((mip, mip + 1), (layer, layer + 1)), plan_state(st))
+                 for (_, mip, layer), st in sorted(states.items()))
+
+
+def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+    return MappingProxyType(dict(sorted(mapping.items())))
+
+
+def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
+    resources, passes, sync = c.spec.resources, c.passes, c.sync
+    assert sync is not None
+    signal_values = _signal_values(passes, sync)
+    out = []
+    for i, p in enumerate(passes):
+        ps = sync.passes[i]
+        accesses = tuple(
+            pm.Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
+                      tuple(sorted(s.stages)), tuple(sorted(s.access)), s.layout, a.write)
+            for a, s in zip(p.accesses, sync.access_sync[i], strict=True)
+        )
+        out.append(pm.PlanPass(
+            name=p.name, index=i, device=0, queue=p.queue, kind=p.kind, impl=p.impl, params=_frozen(p.params),
+            accesses=accesses,
+            barriers=tuple(_barrier(b, resources) for b in ps.barriers),
+            releases=tuple(_barrier(b, resources) for b in ps.releases),
+            waits=tuple(pm.Wait(w.queue, signal_values[w.signal_pass], tuple(sorted(w.stages))) for w in ps.waits),
+            signals=(pm.Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
+        ))
+    return tuple(out)
+
+
+def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
+    spec, sync, placement = c.spec, c.sync, c.placement
+    assert sync is not None and placement is not None
+    out = []
+    for name in sorted(c.memory):
+        res, mem = spec.resources[name], c.memory[name]
+        heap, offset = placement.offsets[name]
+        lifetime = "output" if (name in c.spec.outputs and res.lifetime == "transient") else res.lifetime
+        image = res.is_image
+        out.append(pm.PlanResource(
+            name=name, kind=res.kind, format=res.format.vk_name if res.format else None, bytes=mem.bytes,
+            size_bytes=None if image else res.bytes, alignment=mem.alignment, memory_type_bits=mem.memory_type_bits,
+            memory_class=mem.memory_class, usages=mem.usages, lifetime=lifetime, first=mem.first, last=mem.last,
+            heap=heap, offset=offset,
+            initial=_end_state(lifetime, sync.initial.get(name)), final=_end_state(lifetime, sync.final.get(name)),
+            extent=tuple(res.extent) if image else None, mips=res.mips if image else None,
+            layers=res.layers if image else None, samples=res.samples if image else None,
+            accel=res.accel.as_plan() if res.accel is not None else None, scratch_of=res.scratch_of,
+        ))
+    return tuple(out)
+
+
+def emit(c: Compilation) -> pm.Plan:
+    """The plan of a compilation that went through every earlier phase."""
+    spec, placement, culling = c.spec, c.placement, c.culling
+    assert placement is not None and culling is not None
+    passes = _passes(c)
+    by_name = {p.name: p for p in spec.passes}
+    st = placement.stats
+    return pm.Plan(
+        graph=spec.name, source=spec.source, scene=spec.scene_name, scene_source=c.spec.scene_source,
+        size=tuple(spec.size), params=_frozen(spec.params), features=_frozen(spec.features),
+        device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if any(p.queue == q for p in passes)),
+        passes=passes,
+        culled=tuple(_culled(x.pass_name, x.reason, by_name[x.pass_name], c) for x in culling.culled),
+        dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
+        resources=_resources(c),
+        heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
+        outputs=tuple(c.spec.outputs),
+        stats=pm.Stats(
+            barriers=sum(len(p.barriers) for p in passes), semaphores=sum(1 for p in passes if p.signals),
+            peak_bytes=st.peak_bytes, lower_bound_bytes=st.lower_bound_bytes, unaliased_bytes=st.unaliased_bytes,
+            allocations=st.allocations, policy=st.policy,
+            schedule=None if c.schedule == DEFAULT_SCHEDULE else c.schedule,  # absent = declaration order
+        ),
+    )
+
+
+def _culled(name: str, reason: str, p: PassSpec, c: Compilation) -> pm.Culled:
+    """A culled pass with the resources only culled passes used, and their bytes."""
+    only = tuple(sorted({a.resource for a in p.accesses} - set(c.memory)))
+    return pm.Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
+
+
+def _signal_values(passes: Sequence[PassSpec], sync: csync.SyncResult) -> dict[int, int]:
+    """Timeline values per queue, 1, 2, ... in plan order."""
+    counters: dict[str, int] = {}
+    values: dict[int, int] = {}
+    for i, p in enumerate(passes):
+        if sync.passes[i].signal:
+            counters[p.queue] = counters.get(p.queue, 0) + 1
+            values[i] = counters[p.queue]
+    return values

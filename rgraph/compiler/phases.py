@@ -1,0 +1,138 @@
+"""The compiler's phases: one ``Compilation`` value through a visible list of pure functions.
+
+    PHASES = cull -> schedule -> size_accels -> measure -> place -> synchronize -> emit
+
+Each phase takes a ``Compilation`` and returns a new one with its fields filled in
+(``dataclasses.replace``); none mutates its input or the ``Spec``. Only ``measure`` calls
+out, to the memory-requirements provider (a device profile or a live device).
+
+networkx: ``Compilation.graph`` is the dependency DAG of the scheduled passes
+(``rgraph.ir.graph.build_graph``), built on demand for views and tests; ``--schedule
+async-early`` orders passes with ``networkx.lexicographical_topological_sort`` on it
+(``rgraph.ir.schedule``). The default path does without it: dependencies are found in
+program order, so every edge points forward and declaration order already *is* the
+lexicographic topological order keyed by declaration index; culling is a backwards walk
+over read-after-write edges that ``rgraph.ir.graph.raw_ancestors`` does on the edge dict
+it already has. Building a DiGraph for either costs more than the phase itself
+(benchmarks/compile_scaling.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+from rgraph.compiler import memory
+from rgraph.compiler.emit import emit as emit_plan
+from rgraph.compiler.sync import SyncResult
+from rgraph.compiler.sync import synchronize as synchronize_passes
+from rgraph.defaults import DEFAULT_SCHEDULE
+from rgraph.errors import RGraphError
+from rgraph.ir.cull import Culling
+from rgraph.ir.cull import cull as cull_spec
+from rgraph.ir.schedule import schedule_passes
+from rgraph.memory.model import Placement
+from rgraph.spec.specialize import PassSpec, Spec
+
+if TYPE_CHECKING:
+    import networkx as nx
+
+    from rgraph.compiler.memory import MemoryRequirementsProvider
+    from rgraph.plan.model import Plan
+
+
+@dataclass(frozen=True)
+class Compilation:
+    """Inputs of a compile and the results of every phase run so far (None: not yet)."""
+
+    spec: Spec
+    policy: str
+    provider: MemoryRequirementsProvider
+    profile_name: str
+    schedule: str = DEFAULT_SCHEDULE  # rgraph.ir.schedule mode (``--schedule``)
+    culling: Culling | None = None
+    passes: tuple[PassSpec, ...] = ()  # scheduled (executed) order
+    memory: Mapping[str, memory.ResourceMemory] = field(default_factory=dict)  # used resources, name order
+    culled_bytes: Mapping[str, int] = field(default_factory=dict)  # resources only culled passes use
+    placement: Placement | None = None
+    aliases: Mapping[str, list[str]] = field(default_factory=dict)  # resource -> earlier occupants it waits for
+    sync: SyncResult | None = None
+    plan: Plan | None = None
+
+    @cached_property
+    def graph(self) -> nx.DiGraph:
+        """The dependency DAG of the scheduled passes (node attribute ``order``)."""
+        from rgraph.ir.graph import build_graph
+
+        return build_graph(self.passes)
+
+
+def cull(c: Compilation) -> Compilation:
+    """Drop passes whose results reach no output and reads with no producer."""
+    return replace(c, culling=cull_spec(c.spec))
+
+
+def schedule(c: Compilation) -> Compilation:
+    """Executed order of the kept passes (``rgraph.ir.schedule``; default: declaration order)."""
+    assert c.culling is not None
+    return replace(c, passes=tuple(schedule_passes(c.culling.passes, c.schedule)))
+
+
+def size_accels(c: Compilation) -> Compilation:
+    """Accels sized on the provider (``rgraph.compiler.accel``): a new ``Spec`` whose
+    resources hold each used accel's layout and its build scratch buffer; build passes
+    also write the scratch (refits read the accel)."""
+    from rgraph.compiler.accel import size_accels as size
+
+    if not any(r.kind == "accel" for r in c.spec.resources.values()):
+        return c
+    spec = replace(c.spec, resources=dict(c.spec.resources))
+    return replace(c, spec=spec, passes=tuple(size(spec, list(c.passes), c.provider)))
+
+
+def measure(c: Compilation) -> Compilation:
+    """Sizes, alignments and memory classes of the used resources (and of culled-only ones)."""
+    assert c.culling is not None
+    spec = c.spec
+    used = memory.usages_by_resource(c.passes)
+    reqs = memory.requirements(spec.resources, used, spec.outputs, c.provider)
+    culled = {x.pass_name for x in c.culling.culled}
+    culled_used = {r: u for r, u in memory.usages_by_resource([p for p in spec.passes if p.name in culled]).items()
+                   if r not in reqs}
+    culled_reqs = memory.requirements(spec.resources, culled_used, spec.outputs, c.provider)
+    return replace(c, memory=memory.resource_memory(reqs, used, memory.lifetimes(c.passes)),
+                   culled_bytes={r: q.bytes for r, q in culled_reqs.items()})
+
+
+def place(c: Compilation) -> Compilation:
+    """Heaps and offsets: transients by the allocator policy (may alias), others dedicated."""
+    try:
+        placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs)
+    except ValueError as exc:
+        raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
+    return replace(c, placement=placement, aliases=memory.alias_sources(placement, c.memory))
+
+
+def synchronize(c: Compilation) -> Compilation:
+    """Barriers, queue-ownership releases, semaphore waits and signals per pass."""
+    return replace(c, sync=synchronize_passes(list(c.passes), c.spec.resources, c.aliases))
+
+
+def emit(c: Compilation) -> Compilation:
+    """The typed plan (``rgraph.plan.model.Plan``)."""
+    return replace(c, plan=emit_plan(c))
+
+
+Phase = Callable[[Compilation], Compilation]
+PHASES: tuple[tuple[str, Phase], ...] = (
+    ("cull", cull), ("schedule", schedule), ("size_accels", size_accels), ("measure", measure), ("place", place),
+    ("synchronize", synchronize), ("emit", emit),
+)
+
+
+def run_phases(c: Compilation, phases: tuple[tuple[str, Phase], ...] = PHASES) -> Compilation:
+    for _name, phase in phases:
+        c = phase(c)
+    return c

@@ -1,0 +1,70 @@
+"""PNG output: an output image as RGBA8 (rendered colour, or the probe's value view) and a
+minimal PNG writer."""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from rgraph.probe.values import codec
+
+
+def image_to_rgba8(resource: dict, data: bytes, width: int, height: int) -> np.ndarray:
+    """An (h, w, 4) uint8 view of probe values (scaled to 0..255 by the format's value range)."""
+    c = codec(resource["format"])
+    if c is None:
+        return np.zeros((height, width, 4), dtype=np.uint8)
+    values = c.decode(data).reshape(height, width, c.components).astype(np.float64)
+    scaled = np.clip(values * (255.0 / max(c.modulus - 1, 1)), 0, 255).astype(np.uint8)
+    rgba = np.zeros((height, width, 4), dtype=np.uint8)
+    rgba[..., 3] = 255
+    for ch in range(min(c.components, 4)):
+        rgba[..., ch] = scaled[..., ch]
+    if c.components == 1:
+        rgba[..., 1] = rgba[..., 2] = rgba[..., 0]
+    return rgba
+
+
+def write_png(path: Path, rgba: np.ndarray) -> None:
+    """A minimal RGBA8 PNG writer (zlib + struct)."""
+    height, width = rgba.shape[:2]
+    raw = b"".join(b"\0" + rgba[y].tobytes() for y in range(height))
+
+    def chunk(tag: bytes, payload: bytes) -> bytes:
+        return struct.pack(">I", len(payload)) + tag + payload + struct.pack(">I", zlib.crc32(tag + payload))
+
+    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0))
+    png += chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b"")
+    Path(path).write_bytes(png)
+
+
+def output_rgba(res: dict, raw: bytes, w: int, h: int, implemented: bool) -> np.ndarray:
+    """RGBA8 for a PNG: the stored bytes of an 8-bit colour image rendered by real passes,
+    else the probe's value visualisation."""
+    channel_order = {"r8g8b8a8": [0, 1, 2, 3], "b8g8r8a8": [2, 1, 0, 3]}
+    head, _, kind = res["format"].lower().rpartition("_")
+    if implemented and head in channel_order and kind in ("srgb", "unorm"):
+        rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4)[..., channel_order[head]].copy()
+        rgba[..., 3] = 255
+        return rgba
+    return image_to_rgba8(res, raw, w, h)
+
+
+def first_output_image(plan: dict) -> dict | None:
+    """The plan's first output image (what ``rgraph run --out`` writes), or None."""
+    return next((r for r in plan["resources"] if r["lifetime"] == "output" and r["kind"] == "image"), None)
+
+
+def write_output_png(plan: dict, data: dict[tuple, bytes], path: Path) -> None:
+    """Write the plan's first output image from read-back bytes (``read_back``) as a PNG."""
+    from rgraph.probe.semantics import mip_extent
+
+    res = first_output_image(plan)
+    if res is None:
+        raise ValueError("the plan has no output image")
+    w, h = mip_extent(res, 0)
+    implemented = any(p.get("impl") for p in plan["passes"])
+    write_png(Path(path), output_rgba(res, data[(res["name"], 0, 0)], w, h, implemented))

@@ -1,0 +1,68 @@
+"""Command buffers: one per batch of the lowered recording and frame-in-flight set, recorded once.
+
+Per pass: a debug label, a start timestamp, the pass's lowered barrier calls, its commands
+(``ImplPass.record``), its lowered releases, an end timestamp. Nothing here decides a
+barrier (``rgraph.vk.lower``); ``rgraph.vk.record`` builds the structs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rgraph.vk.debug_names import name_object
+from rgraph.vk.loader import vk
+from rgraph.vk.record import barrier_batches
+from rgraph.vk.record_context import RecordContext
+from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT, pool
+
+
+def record(ex: Any) -> None:
+    v = vk()
+    dev = ex.device
+    recording = ex.recording
+    plan_passes = ex.plan["passes"]
+    ex.command_buffers = []
+    for s in range(FRAMES_IN_FLIGHT):
+        per_batch = []
+        for bi, batch in enumerate(recording.batches):
+            cb = v.vkAllocateCommandBuffers(dev.handle, v.VkCommandBufferAllocateInfo(
+                commandPool=pool(ex, dev.families[batch.queue], s), level=v.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+                commandBufferCount=1))[0]
+            names = [plan_passes[i]["name"] for i in batch.passes]
+            label = (f"pass {names[0]} (set {s})" if len(names) == 1 else f"batch {bi} (set {s}): " + ",".join(names))
+            name_object(dev, cb, v.VK_OBJECT_TYPE_COMMAND_BUFFER, label)
+            per_batch.append(cb)
+            v.vkBeginCommandBuffer(cb, v.VkCommandBufferBeginInfo())
+            ctx = RecordContext(dev, cb)
+            timestamps = dev.timestamp_valid_bits.get(batch.queue, 0) > 0
+            for i in batch.passes:
+                lowered = recording.passes[i]
+                ex.log.context = f"recording pass {lowered.name}"
+                label_begin(dev, cb, f"pass {lowered.name}")
+                if timestamps:
+                    v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, ex.query_pools[s], 2 * i)
+                for barriers in barrier_batches(ex.resources, s, lowered.before):
+                    ex.barrier_batches.append(barriers)
+                    v.vkCmdPipelineBarrier2(cb, barriers.dependency)
+                ex.passes[i].record(ctx, s)
+                for releases in barrier_batches(ex.resources, s, lowered.after):
+                    ex.barrier_batches.append(releases)
+                    v.vkCmdPipelineBarrier2(cb, releases.dependency)
+                if timestamps:
+                    v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, ex.query_pools[s], 2 * i + 1)
+                label_begin(dev, cb, None)
+            v.vkEndCommandBuffer(cb)
+        ex.command_buffers.append(per_batch)
+
+
+def label_begin(device: Any, cb: Any, text: str | None) -> None:
+    """Begin a debug label (``text``), or end the open one (None)."""
+    v = vk()
+    if text is None:
+        fn = device.fn("vkCmdEndDebugUtilsLabelEXT")
+        if fn:
+            fn(cb)
+        return
+    fn = device.fn("vkCmdBeginDebugUtilsLabelEXT")
+    if fn:
+        fn(cb, v.VkDebugUtilsLabelEXT(pLabelName=text, color=[0.0, 0.0, 0.0, 0.0]))

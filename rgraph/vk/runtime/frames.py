@@ -1,0 +1,158 @@
+"""The frame loop: fence pacing, timestamp reads, per-frame host updates, prebuilt submits."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.loader import vk
+from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
+
+#: Vulkan calls bracketed in ``run_frames`` marks before the submits, in order.
+FRAME_CALLS = ("vkWaitForFences", "vkGetQueryPoolResults", "vkResetFences", "vkResetQueryPool")
+
+
+def marks_per_frame(submit_calls: int) -> int:
+    """Marks ``run_frames`` takes per frame: the start, then a pair per Vulkan call."""
+    return 1 + 2 * (len(FRAME_CALLS) + submit_calls)
+
+
+def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[str, Any]:
+    """Submit ``frames`` frames (continuing the executor's frame count); per-pass GPU medians
+    from timestamps.
+
+    ``marks`` (if given) gets time.perf_counter() readings, ``marks_per_frame(calls)`` per
+    frame (calls in ``FRAME_CALLS`` order): the frame's start, then a (before, after) pair around each
+    Vulkan call - the fence wait (time blocked on the GPU), the timestamp read, the fence
+    reset, the query reset, each vkQueueSubmit2 - with the per-frame updates (scene and
+    pass ``update`` hooks) and semaphore values between them. A call a frame skips (no
+    timestamps yet) still gets its pair, an empty interval. benchmarks/frame_cpu.py splits
+    a frame into blocked, Vulkan calls and Python from them.
+
+    The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
+    wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
+    timeline values, and one vkQueueSubmit2 per call of ``submit_calls``.
+    """
+    import numpy as np
+
+    v = vk()
+    lib, ffi = v.lib, v.ffi
+    dev = ex.device
+    log = ex.log
+    validate = ex.instance.validate
+    n = len(ex.plan["passes"])
+    handle = dev.handle
+    fence_counts = [len(f) for f in ex.fences]
+    fence_arrays = ex.fence_arrays
+    pools = ex.query_pools
+    timestamps = n > 0 and all(dev.timestamp_valid_bits.get(p["queue"], 0) > 0 for p in ex.plan["passes"])
+    query_buffer = ffi.new("uint64_t[]", max(2 * n, 1))
+    query_view = np.frombuffer(ffi.buffer(query_buffer), dtype=np.uint64)
+    rows = np.zeros((frames, 2 * n), dtype=np.uint64)
+    collected = 0
+    query_flags = v.VK_QUERY_RESULT_64_BIT
+    cpu_s = np.zeros(frames)
+    submitted = [False] * FRAMES_IN_FLIGHT
+    scene, updaters = ex.scene_gpu, ex.updaters
+    wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
+    get_queries, reset_queries = lib.vkGetQueryPoolResults, lib.vkResetQueryPool
+    timeout = 10**11
+    perf = time.perf_counter
+    timed = marks is not None
+    mark = marks.append if marks is not None else None
+    base = ex.frames_done
+    for local in range(frames):
+        frame = base + local
+        s = frame % FRAMES_IN_FLIGHT
+        t0 = perf()
+        if timed:
+            mark(t0)
+        log.context = f"frame {frame}"  # also a hook: tests/vk/test_soak.py samples RSS on it
+        fenced = fence_counts[s] > 0
+        if timed:
+            mark(perf())
+        if fenced:
+            check_result(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
+        if timed:
+            mark(perf())
+            mark(perf())
+        if fenced and submitted[s] and timestamps:
+            read = get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0
+            if timed:
+                mark(perf())
+            if read:
+                rows[collected] = query_view
+                collected += 1
+        elif timed:
+            mark(perf())
+        if timed:
+            mark(perf())
+        if fenced:
+            check_result(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
+        if timed:
+            mark(perf())
+            mark(perf())
+        if fenced and timestamps:
+            reset_queries(handle, pools[s], 0, 2 * n)
+        if timed:
+            mark(perf())
+        if scene is not None:
+            scene.update(frame, s)
+        for p in updaters:
+            p.update(frame, s)
+        for slot, offset in ex.value_slots[s]:
+            slot.value = frame + offset
+        for call in ex.submit_calls[s]:
+            if validate:
+                log.context = f"frame {frame} {call.context}"
+            if timed:
+                mark(perf())
+            check_result(submit2(call.queue, call.count, call.infos, call.fence), "vkQueueSubmit2")
+            if timed:
+                mark(perf())
+        submitted[s] = True
+        cpu_s[local] = perf() - t0
+    ex.frames_done = base + frames
+    log.context = "finishing"
+    for s in range(FRAMES_IN_FLIGHT):
+        if submitted[s] and fence_counts[s]:
+            check_result(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
+            if timestamps and get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
+                rows[collected] = query_view
+                collected += 1
+    return timings(ex, rows[:collected], frames, cpu_s)
+
+
+def timings(ex: Any, rows: Any, frames: int, cpu_s: Any) -> dict[str, Any]:
+    """Medians (ms) from timestamp rows (per frame: start, end of each pass)."""
+    import numpy as np
+
+    period = ex.device.timestamp_period_ns / 1e6
+    per_pass: dict[str, float | None] = {p["name"]: None for p in ex.plan["passes"]}
+    total = None
+    if len(rows):
+        stamps = rows.astype(np.float64)
+        starts, ends = stamps[:, 0::2], stamps[:, 1::2]
+        for i, p in enumerate(ex.plan["passes"]):
+            per_pass[p["name"]] = float(np.median(ends[:, i] - starts[:, i])) * period
+        total = float(np.median(ends.max(axis=1) - starts.min(axis=1))) * period
+    from rgraph.vk.pass_intervals import pass_intervals
+
+    return {"passes": per_pass, "total_ms": total, "frames": frames,
+            "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None,
+            "intervals": pass_intervals(ex.plan, rows, period)}
+
+
+def check_result(result: int, call: str) -> None:
+    if result != 0:
+        raise ExecutionError(f"{call} failed: {names_of_result(result)}")
+
+
+def names_of_result(result: int) -> str:
+    v = vk()
+    for name in dir(v):
+        if name.startswith("VK_") and not name.startswith("VK_STRUCTURE") and getattr(v, name) == result and (
+                name.startswith("VK_ERROR_") or name in ("VK_TIMEOUT", "VK_NOT_READY", "VK_INCOMPLETE")):
+            return name
+    return f"VkResult {result}"

@@ -1,0 +1,73 @@
+"""Setup: resources, pass implementations, query pools and command pools of one executor."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.impl_pass import ImplPass, overrides_update
+from rgraph.vk.loader import vk
+from rgraph.vk.resources import ResourceSet
+
+FRAMES_IN_FLIGHT = 2
+
+
+def create(ex: Any) -> None:
+    """Resources, initial contents, frame 0's releases, pipelines, query pools, then recording."""
+    from rgraph.vk.runtime import commands, one_time, submits
+
+    v = vk()
+    dev = ex.device
+    for p in ex.plan["passes"]:
+        if p.get("device", 0) != 0:
+            raise ExecutionError(f"pass {p['name']!r}: multi-device plans are not supported")
+    ex.log.context = "creating resources"
+    ex.resources = ResourceSet(dev, ex.plan, FRAMES_IN_FLIGHT)
+    ex.log.context = "initialising persistent resources"
+    one_time.init_shared(ex)
+    if any(r["kind"] == "accel" for r in ex.plan["resources"]):
+        from rgraph.vk.accel import AccelSet
+
+        ex.log.context = "building persistent acceleration structures"
+        ex.accels = AccelSet(dev, ex.plan, ex.resources, lambda queue, rec: one_time.submit_once(ex, queue, rec))
+    one_time.release_for_first_frame(ex)
+    for p in ex.plan["passes"]:
+        ex.log.context = f"creating pipelines of pass {p['name']}"
+        ex.passes.append(ImplPass(dev, ex.plan, p, ex.resources, sets=FRAMES_IN_FLIGHT,
+                                  scene=lambda: scene(ex), samplers=ex.samplers, accels=ex.accels))
+    ex.updaters = [p for p in ex.passes if overrides_update(p)]
+    n = len(ex.plan["passes"])
+    for _ in range(FRAMES_IN_FLIGHT):
+        ex.query_pools.append(v.vkCreateQueryPool(dev.handle, v.VkQueryPoolCreateInfo(
+            queryType=v.VK_QUERY_TYPE_TIMESTAMP, queryCount=max(2 * n, 2)), None))
+        # reset from the host (hostQueryReset): vkCmdResetQueryPool is not allowed on a
+        # transfer-only queue family, and one host call per frame replaces one per pass
+        v.vkResetQueryPool(dev.handle, ex.query_pools[-1], 0, max(2 * n, 2))
+    ex.log.context = "recording"
+    commands.record(ex)
+    submits.build(ex)
+
+
+def scene(ex: Any) -> Any:
+    """The scene's geometry on the device (``rgraph.vk.scene_gpu``), built on first use."""
+    if ex.scene_gpu is None:
+        from rgraph.vk.runtime.one_time import submit_once
+        from rgraph.vk.scene_gpu import SceneGPU
+
+        context = ex.log.context
+        ex.log.context = "uploading the scene"
+        ex.scene_gpu = SceneGPU(ex.device, ex.plan, FRAMES_IN_FLIGHT,
+                                lambda queue, record: submit_once(ex, queue, record))
+        ex.log.context = context
+    return ex.scene_gpu
+
+
+def pool(ex: Any, family: int, set_index: int) -> Any:
+    """The command pool of ``family`` for frame-in-flight set ``set_index`` (FRAMES_IN_FLIGHT:
+    one-time work), created on first use."""
+    v = vk()
+    key = (family, set_index)
+    if key not in ex.pools:
+        ex.pools[key] = v.vkCreateCommandPool(ex.device.handle, v.VkCommandPoolCreateInfo(
+            queueFamilyIndex=family), None)
+    return ex.pools[key]

@@ -87,7 +87,7 @@ def size_accels(c: Compilation) -> Compilation:
     from rgraph.compiler.accel import size_accels as size
 
     if not any(r.kind == "accel" for r in c.spec.resources.values()):
-        return c
+        return replace(c)
     spec = replace(c.spec, resources=dict(c.spec.resources))
     return replace(c, spec=spec, passes=tuple(size(spec, list(c.passes), c.provider)))
 

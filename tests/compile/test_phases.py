@@ -21,7 +21,8 @@ def _start(tmp_path, seed: int, passes: int) -> Compilation:
 
 
 def test_the_phases_in_order():
-    assert [name for name, _ in PHASES] == ["cull", "schedule", "measure", "place", "synchronize", "emit"]
+    assert [name for name, _ in PHASES] == ["cull", "schedule", "size_accels", "measure", "place",
+                                             "synchronize", "emit"]
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -49,3 +50,19 @@ def test_schedule_is_the_lexicographic_topological_order(tmp_path, seed):
     order = nx.get_node_attributes(graph, "order")
     topo = list(nx.lexicographical_topological_sort(graph, key=order.__getitem__))
     assert topo == [p.name for p in c.passes] == [p.name for p in c.plan.passes]
+
+
+def test_size_accels_makes_a_new_spec_and_leaves_the_input_one(tmp_path):
+    """Accels are sized into a new Spec (with the build scratch); the specialized one is kept."""
+    from locations import TESTS
+
+    spec = frontend(TESTS / "data" / "rt" / "rt_probe.yaml", size=(32, 32)).spec
+    before = copy.deepcopy(spec)
+    c = run_phases(Compilation(spec, "aliased", ProfileMemoryRequirements.named("lavapipe"), "lavapipe"))
+    assert spec == before
+    sized = [r for r in c.spec.resources.values() if r.kind == "accel" and r.accel is not None]
+    assert sized and all(r.accel is None for r in spec.resources.values() if r.kind == "accel")
+    scratch = [r for r in c.spec.resources.values() if r.scratch_of is not None]
+    assert {r.scratch_of for r in scratch} <= {r.name for r in sized} and scratch
+    assert {r.name for r in scratch} <= {r.name for r in c.plan.resources}
+    assert all(r.accel is not None for r in c.plan.resources if r.kind == "accel")

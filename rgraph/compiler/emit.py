@@ -60,6 +60,15 @@ def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
     return MappingProxyType(dict(sorted(mapping.items())))
 
 
+def _frozen_json(value: Any) -> Any:
+    """A JSON value read-only, objects in their order, lists as tuples (as the loader reads it)."""
+    if isinstance(value, Mapping):
+        return MappingProxyType({k: _frozen_json(v) for k, v in value.items()})
+    if isinstance(value, list | tuple):
+        return tuple(_frozen_json(v) for v in value)
+    return value
+
+
 def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
     resources, passes, sync = c.spec.resources, c.passes, c.sync
     assert sync is not None
@@ -100,7 +109,7 @@ def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
             initial=_end_state(lifetime, sync.initial.get(name)), final=_end_state(lifetime, sync.final.get(name)),
             extent=tuple(res.extent) if image else None, mips=res.mips if image else None,
             layers=res.layers if image else None, samples=res.samples if image else None,
-            accel=res.accel.as_plan() if res.accel is not None else None, scratch_of=res.scratch_of,
+            accel=_frozen_json(res.accel.as_plan()) if res.accel is not None else None, scratch_of=res.scratch_of,
         ))
     return tuple(out)
 

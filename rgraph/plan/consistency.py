@@ -42,17 +42,27 @@ def _word(value: str, words: tuple[str, ...] | frozenset[str], where: str, what:
         yield where, f"unknown {what} {value!r} (expected one of {', '.join(sorted(words))})"
 
 
+#: usages the compiler adds to plans, never written in a graph file (an accel build's scratch:
+#: ``rgraph.compiler.accel``)
+PLAN_ONLY_USAGES = ("accel_scratch",)
+
+
 def _vocabulary(plan: Plan) -> Iterator[Problem]:
     """Pass kinds, usages and formats are the closed vocabularies of FORMAT.md."""
-    from rgraph.spec.vocabulary import PASS_KINDS, USAGES
+    from rgraph.spec.vocabulary import PASS_KINDS
+    from rgraph.spec.vocabulary import USAGES as GRAPH_USAGES
 
+    from rgraph.memory_requirements import ACCEL_BUFFER_USAGES
+
+    usages = (*GRAPH_USAGES, *PLAN_ONLY_USAGES)
+    resource_usages = (*usages, *sorted(ACCEL_BUFFER_USAGES - set(usages)))  # + trace_indirect (a device address)
     for i, p in enumerate(plan.passes):
         yield from _word(p.kind, PASS_KINDS, f"passes[{i}].kind", "pass kind")
         for j, a in enumerate(p.accesses):
-            yield from _word(a.usage, USAGES, f"passes[{i}].accesses[{j}].usage", "usage")
+            yield from _word(a.usage, usages, f"passes[{i}].accesses[{j}].usage", "usage")
     for i, r in enumerate(plan.resources):
         for j, u in enumerate(r.usages):
-            yield from _word(u, USAGES, f"resources[{i}].usages[{j}]", "usage")
+            yield from _word(u, resource_usages, f"resources[{i}].usages[{j}]", "usage")
         if r.format is not None and not _known_format(r.format):
             yield f"resources[{i}].format", f"unknown format {r.format!r} (VkFormat without VK_FORMAT_)"
         elif r.format is None and r.is_image:

@@ -174,3 +174,21 @@ def test_compiled_and_naive_plans_load_and_round_trip(tmp_path, seed, policy):
         text = rplan.dump(p)
         assert rplan.load(text) == p
         assert rplan.dump(rplan.load(text)) == text
+
+
+@pytest.mark.parametrize("graph, options", [
+    (TESTS / "data" / "rt" / "rt_probe.yaml", {}),  # a build pass with the compiler's accel_scratch access
+    ("rt_hybrid", {"scene_path": TESTS.parent / "graphs" / "scenes" / "rt_living_room.yaml", "camera": 1}),
+], ids=["rt_probe", "rt_hybrid_camera"])
+def test_ray_tracing_plans_round_trip(graph, options):
+    """Accel layouts, scratch buffers, trace_indirect and --camera survive the typed model."""
+    from rgraph.compiler.pipeline import compile_graph_plan
+
+    plan = compile_graph_plan(graph, size=(32, 32), **options)
+    text = rplan.dump(plan)
+    again = rplan.load(text)
+    assert again == plan and rplan.dump(again) == text
+    doc = json.loads(text)
+    accels = [r for r in doc["resources"] if r["kind"] == "accel"]
+    assert accels and all("blas" in r["accel"] and "tlas" in r["accel"] for r in accels)
+    assert doc.get("camera", 0) == options.get("camera", 0)

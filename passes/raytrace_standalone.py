@@ -92,6 +92,7 @@ class RayTracingImpl(PassImpl):
     the sky (binding 6), the pass's own images from binding 7, the TLAS (set 1)."""
 
     raygen = "rt/standalone.rgen"
+    defines: dict[str, object] = {}
 
     def __init__(self, setup: Any, images: list[Binding]) -> None:
         super().__init__(setup)
@@ -135,7 +136,7 @@ class RayTracingImpl(PassImpl):
         from rgraph.vk.shaders import compile_shader, find_shader
 
         def spirv(path: str) -> bytes:
-            return compile_shader(find_shader(path)).spirv
+            return compile_shader(find_shader(path), defines=self.defines).spirv
 
         return create_rt_pipeline(self.setup.device, {
             "raygen": [spirv(self.raygen)], "miss": [spirv("rt/miss.rmiss"), spirv("rt/shadow.rmiss")],

@@ -14,7 +14,7 @@ from rgraph.resources import builtin_passes
 from rgraph.vk.errors import VulkanUnavailable
 
 builtin_passes()
-from rgraph.passes.raytrace_hybrid import needs_secondary_rays  # noqa: E402
+from rgraph.passes.raytrace_hybrid import decode_visibility, instance_materials, needs_secondary_rays, prim_bits  # noqa: E402,E501
 
 SCENE = ROOT / "graphs" / "scenes" / "rt_tiny.yaml"
 
@@ -38,16 +38,19 @@ def psnr(a, b) -> float:
 
 @pytest.mark.vulkan
 def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels():
-    _plan, hybrid = _run("rt_hybrid", 20, extra=("ray_args", "gbuf_material"))
+    _plan, hybrid = _run("rt_hybrid", 20, extra=("ray_args", "visibility"))
     _plan, alone = _run("rt_standalone", 20)
     a, b = alone["color"][..., :3].astype(np.float64), hybrid["color"][..., :3].astype(np.float64)
     assert np.isfinite(b).all()
     assert psnr(a, b) >= 45
     from rgraph.scene.build import load_scene_data
 
-    mask = needs_secondary_rays(load_scene_data(SCENE, (20, 20)).materials)
-    ids = hybrid["gbuf_material"][..., 0].astype(int)
-    expected = int(sum(mask[i - 1] for i in ids.ravel() if i > 0))
+    data = load_scene_data(SCENE, (20, 20))
+    mask = needs_secondary_rays(data.materials)[instance_materials(data)]
+    ids = hybrid["visibility"][..., 0]
+    instance, _prim = decode_visibility(ids, prim_bits(data))
+    assert (instance < len(mask)).all()
+    expected = int(mask[instance[instance >= 0]].sum())
     traced = int(np.frombuffer(hybrid["ray_args"].tobytes()[:4], dtype=np.uint32)[0])
     assert 0 < traced == expected < ids.size
 

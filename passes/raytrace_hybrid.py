@@ -113,19 +113,18 @@ class Classify(PassImpl):
         rec.dispatch(-(-self.extent[0] // 8), -(-self.extent[1] // 8))
 
 
-def _defines(setup: Any) -> dict[str, object]:
-    from rgraph.scene.build import load_scene_data
+class VisibilityImpl(RayTracingImpl):
+    """Ray tracing passes reading the visibility buffer (its id layout is a shader define)."""
 
-    data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
-    return {"PRIM_BITS": prim_bits(data)}
+    def shader_defines(self) -> dict[str, object]:
+        return {"PRIM_BITS": prim_bits(self.data)}
 
 
 @register("rt_hybrid_shade")
-class HybridShade(RayTracingImpl):
+class HybridShade(VisibilityImpl):
     raygen = "rt/hybrid_shade.rgen"
 
     def __init__(self, setup: Any) -> None:
-        self.defines = _defines(setup)
         super().__init__(setup, [Binding(7, "storage_image", "color"), *GBUFFER])
         self.extent = setup.extent_of("color")
         self.push = frame_constants(self.data, self.extent, max_depth_of(setup))
@@ -137,11 +136,10 @@ class HybridShade(RayTracingImpl):
 
 
 @register("rt_hybrid_secondary")
-class HybridSecondary(RayTracingImpl):
+class HybridSecondary(VisibilityImpl):
     raygen = "rt/hybrid_secondary.rgen"
 
     def __init__(self, setup: Any) -> None:
-        self.defines = _defines(setup)
         super().__init__(setup, [Binding(7, "storage_image", "color"), *GBUFFER,
                                  Binding(11, "storage_image", "ray_list")])
         self.push = frame_constants(self.data, setup.extent_of("color"), max_depth_of(setup))

@@ -92,7 +92,6 @@ class RayTracingImpl(PassImpl):
     the sky (binding 6), the pass's own images from binding 7, the TLAS (set 1)."""
 
     raygen = "rt/standalone.rgen"
-    defines: dict[str, object] = {}
 
     def __init__(self, setup: Any, images: list[Binding]) -> None:
         super().__init__(setup)
@@ -131,12 +130,16 @@ class RayTracingImpl(PassImpl):
             descriptorPool=pool, descriptorSetCount=setup.sets, pSetLayouts=[layout] * setup.sets))
         return layout, list(sets)
 
+    def shader_defines(self) -> dict[str, object]:
+        """Defines of the pipeline's shaders (``self.data`` is loaded)."""
+        return {}
+
     def _pipeline(self) -> Any:
         from rgraph.vk.rt_pipeline import create_rt_pipeline
         from rgraph.vk.shaders import compile_shader, find_shader
 
         def spirv(path: str) -> bytes:
-            return compile_shader(find_shader(path), defines=self.defines).spirv
+            return compile_shader(find_shader(path), defines=self.shader_defines()).spirv
 
         return create_rt_pipeline(self.setup.device, {
             "raygen": [spirv(self.raygen)], "miss": [spirv("rt/miss.rmiss"), spirv("rt/shadow.rmiss")],

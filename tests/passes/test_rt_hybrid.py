@@ -95,3 +95,20 @@ def test_hybrid_agrees_at_grazing_angles_inside_a_thin_box(tmp_path, size):
     _plan, alone = _run("rt_standalone", size, scene=scene)
     a, b = alone["color"][..., :3].astype(np.float64), hybrid["color"][..., :3].astype(np.float64)
     assert psnr(a, b) >= 45
+
+
+def test_visibility_ids_round_trip_and_oversized_scenes_are_refused():
+    from types import SimpleNamespace as NS
+
+    def scene(tris, instances):
+        return NS(meshes=[NS(data=NS(triangle_count=t), positions=[0] * n, material=k)
+                          for k, (t, n) in enumerate(zip(tris, instances))])
+
+    data = scene([12, 131072], [2, 3])
+    bits = prim_bits(data)
+    assert bits == 17 and list(instance_materials(data)) == [0, 0, 1, 1, 1]
+    ids = np.array([0, ((4 << bits) | 131071) + 1, 1], dtype=np.uint32)
+    inst, prim = decode_visibility(ids, bits)
+    assert inst.tolist() == [-1, 4, 0] and prim.tolist() == [-1, 131071, 0]
+    with pytest.raises(ValueError, match="32-bit visibility id"):
+        prim_bits(scene([1 << 20], [1 << 12]))

@@ -64,6 +64,8 @@ class GBuffer(PassImpl):
 
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
+        if "geometryShader" not in setup.device.enabled_features:  # gl_PrimitiveID in the fragment shader
+            raise ValueError(f"pass {setup.name!r}: the visibility buffer needs the geometryShader feature")
         self.scene = setup.scene
         # no culling: ray tracing sees both faces of every triangle
         self.pipeline = setup.graphics_pipeline(

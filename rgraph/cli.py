@@ -37,9 +37,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from rgraph.spec.paths import allow_outside
+
     args = build_parser().parse_args(argv)
     try:
-        return int(args.func(args) or 0)
+        with allow_outside(bool(getattr(args, "allow_include_outside", False))):
+            return int(args.func(args) or 0)
     except RGraphError as err:
         for diagnostic in err.diagnostics:
             print(diagnostic, file=sys.stderr)

@@ -32,6 +32,13 @@ def add_graph_arguments(parser: argparse.ArgumentParser, *, size_default: str = 
     parser.add_argument("--scene", help="scene file (default: the graph's own 'scene:', else every feature present)")
     parser.add_argument("-p", "--param", action="append", metavar="NAME=VALUE", help="override a graph param")
     parser.add_argument("--size", default=size_default, help=f"output size WxH (default {size_default})")
+    add_outside_argument(parser)
+
+
+def add_outside_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--allow-include-outside", action="store_true",
+                        help="let includes, the graph's 'scene:' and a plan's scene_source name files outside "
+                             "the graph's (or plan's) folder tree")
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:

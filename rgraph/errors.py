@@ -25,8 +25,12 @@ def escape(text: str) -> str:
 
 
 def quote(value: object, limit: int = QUOTE_LIMIT) -> str:
-    """``'value'`` for a message: escaped (one line, no terminal escapes) and cut to ``limit``."""
-    text = value if isinstance(value, str) else repr(value)
+    """``'value'`` for a message: escaped (one line, no terminal escapes) and cut to ``limit``;
+    a non-string as its (cut) repr, without quotes."""
+    if not isinstance(value, str):
+        text = repr(value) if not isinstance(value, int) or value.bit_length() < 4000 else "a huge integer"
+        return escape(text if len(text) <= limit else text[:limit] + "...")
+    text = value
     if len(text) <= limit:
         return f"'{escape(text)}'"
     return f"'{escape(text[:limit])}...' ({len(text):,} characters)"

@@ -13,6 +13,7 @@ from pathlib import Path
 # C0/C1 controls, DEL, lone surrogates, bidi overrides: never reach the terminal verbatim
 _UNSAFE = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u202a-\u202e\u2066-\u2069]")
 QUOTE_LIMIT = 60
+MESSAGE_LIMIT = 2000
 
 
 def escape(text: str) -> str:
@@ -64,7 +65,8 @@ class Diagnostic:
     message: str
 
     def __str__(self) -> str:
-        return escape(f"{self.location}: error: {self.message}{self.location.include_chain()}")
+        message = self.message if len(self.message) <= MESSAGE_LIMIT else self.message[:MESSAGE_LIMIT] + "..."
+        return escape(f"{self.location}: error: {message}{self.location.include_chain()}")
 
 
 @dataclass

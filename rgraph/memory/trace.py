@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from rgraph.errors import RGraphError
+from rgraph.errors import RGraphError, quote
 from rgraph.memory.model import Block
 
 REQUIRED_COLUMNS = ("id", "lower", "upper", "size")
@@ -26,7 +26,7 @@ def read_trace(path: str | Path, memory_class: str = DEFAULT_CLASS) -> list[Bloc
     for column in REQUIRED_COLUMNS:
         if column not in header:
             raise RGraphError.in_file(
-                path, f"header lacks column {column!r} (expected 'id,lower,upper,size[,alignment]')"
+                path, f"header lacks column {quote(column)} (expected 'id,lower,upper,size[,alignment]')"
             )
     index = {name: k for k, name in enumerate(header)}
     blocks: list[Block] = []
@@ -48,7 +48,7 @@ def read_trace(path: str | Path, memory_class: str = DEFAULT_CLASS) -> list[Bloc
                 value = int(raw)
             except ValueError:
                 raise RGraphError.in_file(
-                    path, f"{column} must be an integer, got {raw!r}", line_no, starts[k]
+                    path, f"{column} must be an integer, got {quote(raw)}", line_no, starts[k]
                 ) from None
             if value < minimum:
                 raise RGraphError.in_file(
@@ -61,7 +61,7 @@ def read_trace(path: str | Path, memory_class: str = DEFAULT_CLASS) -> list[Bloc
             raise RGraphError.in_file(path, "empty id", line_no, starts[index["id"]])
         if name in seen:
             raise RGraphError.in_file(
-                path, f"duplicate id {name!r} (first on line {seen[name]})", line_no, starts[index["id"]]
+                path, f"duplicate id {quote(name)} (first on line {seen[name]})", line_no, starts[index["id"]]
             )
         seen[name] = line_no
         lower = number("lower", 0)

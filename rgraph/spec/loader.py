@@ -16,8 +16,8 @@ from pydantic import ValidationError
 from rgraph.errors import Location, RGraphError, quote
 from rgraph.spec.models import GraphFile, Pass
 from rgraph.spec.models import Resource as ResourceModel
-from rgraph.spec.pydantic_errors import translate
 from rgraph.spec.paths import referenced
+from rgraph.spec.pydantic_errors import translate
 from rgraph.spec.yaml_source import SourceMap, load_yaml
 
 FORMAT_VERSION = 1

@@ -147,6 +147,8 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
             if any(p in ("int", "float") for p in err["loc"]) and "str" in branches:
                 expected = "a number or a '${...}' expression" if "float" in branches else "an integer or a '${...}' expression"
             msg = f"expected {expected} for '{_field_name(loc)}', got {describe(value)}"
+        elif kind == "value_error":
+            msg = str(err.get("ctx", {}).get("error", err["msg"]))
         elif kind in ("too_short", "too_long"):
             msg = f"'{_field_name(loc)}': {err['msg'].lower()}"
         else:

@@ -17,7 +17,7 @@ MAX_VALUE = 2**62  # sizes, times and alignments: 64-bit arithmetic with room to
 
 def read_trace(path: str | Path, memory_class: str = DEFAULT_CLASS) -> list[Block]:
     """Blocks of a MiniMalloc trace: ``end = upper - 1``; alignment 1 unless a column says."""
-    from rgraph.spec.yaml_source import read_text
+    from rgraph.files import read_text
 
     path = Path(path)
     text = read_text(path, str(path), "a CSV trace", MAX_TRACE_BYTES)

@@ -9,8 +9,6 @@ with the line and column where they occur; the limits on size, depth and aliases
 
 from __future__ import annotations
 
-import os
-import stat
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -19,9 +17,8 @@ from ruamel.yaml import YAML
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from rgraph.errors import Location, RGraphError, escape
+from rgraph.files import read_text
 from rgraph.spec.yaml_events import EventBuilder, PathKey, check_flow_depth
-
-MAX_BYTES = 4 * 1024 * 1024  # a 16,000-pass graph is 2.2 MB
 
 
 @dataclass
@@ -59,50 +56,6 @@ class SourceMap:
 
     def error(self, path: PathKey, message: str, *, at_key: bool = False) -> RGraphError:
         return RGraphError.at(self.key(path) if at_key else self.value(path), message)
-
-
-def read_text(path: Path, display: str, what: str = "a YAML file", limit: int = MAX_BYTES) -> str:
-    """Read ``path`` as UTF-8, reporting the line and column of the first bad byte.
-
-    Only regular files are read (not devices, FIFOs or sockets: ``/dev/zero`` never ends and a
-    FIFO blocks), and never more than ``limit`` bytes."""
-    data = read_bytes(path, display, what, limit)
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        before = data[: exc.start]
-        line = before.count(b"\n") + 1
-        col = len(before) - (before.rfind(b"\n") + 1) + 1
-        raise RGraphError.in_file(
-            display, f"file is not valid UTF-8 (byte 0x{data[exc.start]:02x})", line, col
-        ) from None
-
-
-def read_bytes(path: Path, display: str, what: str, limit: int) -> bytes:
-    """The bytes of the regular file ``path`` (at most ``limit``), or a located error."""
-    try:
-        info = os.stat(path)
-        if stat.S_ISDIR(info.st_mode):
-            raise RGraphError.in_file(display, f"is a directory, expected {what}")
-        if not stat.S_ISREG(info.st_mode):
-            raise RGraphError.in_file(display, f"is not a regular file (a device, FIFO or socket), expected {what}")
-        if info.st_size > limit:
-            raise RGraphError.in_file(display, f"file is larger than {_size(limit)}")
-        with open(path, "rb") as handle:
-            data = handle.read(limit + 1)
-    except FileNotFoundError:
-        raise RGraphError.in_file(display, "no such file") from None
-    except ValueError:  # a NUL byte in the name
-        raise RGraphError.in_file(display, "file name contains a NUL byte") from None
-    except OSError as exc:
-        raise RGraphError.in_file(display, f"cannot read: {exc.strerror or exc}") from None
-    if len(data) > limit:
-        raise RGraphError.in_file(display, f"file is larger than {_size(limit)}")
-    return data
-
-
-def _size(limit: int) -> str:
-    return f"{limit // (1024 * 1024)} MiB" if limit >= 1024 * 1024 else f"{limit:,} bytes"
 
 
 def load_yaml(path: Path, display: str | None = None) -> tuple[Any, SourceMap]:

@@ -80,6 +80,7 @@ class Access:
 class SemaphoreOp:
     queue: int
     value: int
+    stages: int = vocab.ALL_STAGES  # a wait's second synchronization scope (a signal's first)
 
 
 @dataclass(slots=True)
@@ -346,12 +347,14 @@ def read_plan(raw: Any) -> Plan:
             position=position,
         )
 
-    def semaphore(value: Any, path: list[PathPart]) -> SemaphoreOp:
+    def semaphore(value: Any, path: list[PathPart], scope: str = vocab.SCOPE_SECOND) -> SemaphoreOp:
         raw_s = _obj(value, path)
-        _names(_get(raw_s, "stages", path, []), path + ["stages"], vocab.KNOWN_STAGE_NAMES, "stage")
+        names = _names(_get(raw_s, "stages", path, []), path + ["stages"], vocab.KNOWN_STAGE_NAMES, "stage")
         value_int = _int(_get(raw_s, "value", path), path + ["value"])
         assert value_int is not None
-        return SemaphoreOp(queue=reader.queue(_get(raw_s, "queue", path), path + ["queue"]), value=value_int)
+        stages = vocab.stage_mask(names, scope) if names else vocab.ALL_STAGES  # none given: ALL_COMMANDS
+        return SemaphoreOp(queue=reader.queue(_get(raw_s, "queue", path), path + ["queue"]), value=value_int,
+                           stages=stages)
 
     for i, raw_p in enumerate(raw_passes):
         at: list[PathPart] = ["passes", i]
@@ -392,7 +395,7 @@ def read_plan(raw: Any) -> Plan:
                       for k, b in enumerate(_list(_get(p, "releases", at, []), at + ["releases"]))],
             waits=[semaphore(w, at + ["waits", k])
                    for k, w in enumerate(_list(_get(p, "waits", at, []), at + ["waits"]))],
-            signals=[semaphore(s, at + ["signals", k])
+            signals=[semaphore(s, at + ["signals", k], vocab.SCOPE_FIRST)
                      for k, s in enumerate(_list(_get(p, "signals", at, []), at + ["signals"]))],
         ))
 

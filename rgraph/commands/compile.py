@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from rgraph.commands.common import add_compile_arguments, add_graph_arguments, compile_from_args
+from rgraph.commands.outputs import check_output_file, write_output
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -20,9 +20,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from rgraph.plan import dumps
 
+    if args.output:
+        check_output_file(args.output, "-o")
     text = dumps(compile_from_args(args))
     if args.output:
-        Path(args.output).write_text(text)
+        write_output(args.output, text, "-o")
         print(f"wrote {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(text)

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
+from rgraph.commands.outputs import check_output_file, check_pass_params, frame_count, write_output
 from rgraph.errors import RGraphError
 
 
@@ -16,7 +17,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_graph_arguments(parser, size_default="640x360")
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
-    parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
+    parser.add_argument("--frames", type=frame_count, default=1, help="frames to run (default 1)")
     parser.add_argument("--validate", action="store_true",
                         help="Khronos validation + synchronization validation; exit 1 on any message")
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
@@ -68,8 +69,12 @@ def run(args: argparse.Namespace) -> int:
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
     from rgraph.vk.executor import execute_plan
 
+    for flag, target in (("--out", args.out), ("--timings", args.timings)):
+        if target is not None:
+            check_output_file(target, flag)
     try:
         plan = _load_plan(args)
+        check_pass_params(plan, parse_params(args.param))
         result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
                               check_data=args.check_data, out_png=args.out, verbose=True)
     except (VulkanUnavailable, ExecutionError) as exc:
@@ -82,8 +87,8 @@ def run(args: argparse.Namespace) -> int:
     for entry in plan.get("culled", []):
         print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
     if args.timings:
-        args.timings.write_text(json.dumps({"device": result.device_name, **result.timings}, indent=1,
-                                           sort_keys=True) + "\n")
+        write_output(args.timings, json.dumps({"device": result.device_name, **result.timings}, indent=1,
+                                              sort_keys=True) + "\n", "--timings")
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)

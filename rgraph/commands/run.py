@@ -47,6 +47,15 @@ def _load_plan(args: argparse.Namespace) -> dict:
                               size=parse_size(args.size), policy=args.policy, sync=args.sync)
 
 
+def _params_view(args: argparse.Namespace) -> dict:
+    """The passes' impls and params as a plan would carry them, without touching a device."""
+    from rgraph.compiler.pipeline import frontend
+
+    spec = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size)).spec
+    return {"source": str(spec.source) if getattr(spec, "source", None) else args.graph, "params": dict(spec.params),
+            "passes": [{"name": p.name, "impl": p.impl, "params": dict(p.params)} for p in spec.passes]}
+
+
 def _print_table(plan: dict, timings: dict) -> None:
     from rich.console import Console
     from rich.table import Table
@@ -72,6 +81,8 @@ def run(args: argparse.Namespace) -> int:
     for flag, target in (("--out", args.out), ("--timings", args.timings)):
         if target is not None:
             check_output_file(target, flag)
+    if not Path(args.graph).suffix == ".json":  # params first: compiling for the device opens it
+        check_pass_params(_params_view(args), parse_params(args.param))
     try:
         plan = _load_plan(args)
         check_pass_params(plan, parse_params(args.param))

@@ -12,6 +12,8 @@ from pathlib import Path
 
 # C0/C1 controls, DEL, lone surrogates, bidi overrides: never reach the terminal verbatim
 _UNSAFE = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff\u202a-\u202e\u2066-\u2069]")
+# what no rgraph file may contain in its text (tab and newline are fine): terminal escapes and the like
+CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u202a-\u202e\u2066-\u2069\ud800-\udfff]")
 QUOTE_LIMIT = 60
 MESSAGE_LIMIT = 2000
 

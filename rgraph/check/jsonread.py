@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 from typing import Any
 
-from rgraph.errors import RGraphError
+from rgraph.errors import CONTROL, RGraphError, quote
 from rgraph.files import read_text
 
 MAX_PLAN_BYTES = 256 * 1024 * 1024
@@ -61,8 +61,24 @@ def decode_json(text: str, file: str) -> Any:
     def parse_constant(literal: str) -> float:
         raise refuse(f"'{literal}' is not JSON (numbers must be finite)", literal)
 
+    def check(item: Any) -> None:
+        if isinstance(item, str) and CONTROL.search(item):
+            raise refuse(f"text {quote(item)} contains a control character or a lone surrogate",
+                         json.dumps(item)[1:-1])
+        if isinstance(item, list):
+            for sub in item:
+                if not isinstance(sub, dict):
+                    check(sub)
+
+    def checked_pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        for key, value in pairs:
+            check(key)
+            check(value)
+        return dict(pairs)
+
     try:
-        return json.loads(text, parse_int=parse_int, parse_float=parse_float, parse_constant=parse_constant)
+        return json.loads(text, parse_int=parse_int, parse_float=parse_float, parse_constant=parse_constant,
+                          object_pairs_hook=checked_pairs)
     except json.JSONDecodeError as exc:
         raise RGraphError.in_file(file, f"invalid JSON: {exc.msg}", exc.lineno, exc.colno) from None
     except RecursionError:  # unreachable after the depth check; kept as a last guard

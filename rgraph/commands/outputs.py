@@ -32,11 +32,18 @@ def frame_count(text: str) -> int:
     return value
 
 
+def output_path(text: str) -> Path:
+    """argparse type for an output file: a name ending in '/' names a folder, not a file."""
+    if not text or text.endswith(("/", os.sep)):
+        raise argparse.ArgumentTypeError(f"expected a file name, got {quote(text)}")
+    return Path(text)
+
+
 def check_output_file(path: str | Path, flag: str) -> None:
     """Refuse an output path that cannot be written, without creating or truncating it."""
     text = str(path)
     where = f"{COMMAND_LINE}"
-    if not text or "\x00" in text:
+    if not text or "\x00" in text or text.endswith("/"):
         raise RGraphError.in_file(where, f"{flag}: {quote(text)} is not a file name")
     p = Path(text)
     try:

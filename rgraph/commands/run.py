@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
-from rgraph.commands.outputs import check_output_file, check_pass_params, frame_count, write_output
+from rgraph.commands.outputs import check_output_file, check_pass_params, frame_count, output_path, write_output
 from rgraph.errors import RGraphError
 
 
@@ -22,8 +22,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="Khronos validation + synchronization validation; exit 1 on any message")
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
-    parser.add_argument("--out", type=Path, help="write the first output image as PNG")
-    parser.add_argument("--timings", type=Path, help="write per-pass GPU times (median ms) as JSON")
+    parser.add_argument("--out", type=output_path, help="write the first output image as PNG")
+    parser.add_argument("--timings", type=output_path, help="write per-pass GPU times (median ms) as JSON")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.set_defaults(func=run)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
+from rgraph.errors import escape, quote
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -19,9 +20,9 @@ def run(args: argparse.Namespace) -> int:
 
     front = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size))
     culling = cull(front.spec)
-    scene = f" with scene '{front.scene.name}'" if front.scene else ""
+    scene = f" with scene {quote(front.scene.name)}" if front.scene else ""
     print(
-        f"{front.source.path}: ok: graph '{front.spec.name}'{scene}: {len(culling.passes)} passes run, "
+        f"{escape(str(front.source.path))}: ok: graph {quote(front.spec.name)}{scene}: {len(culling.passes)} passes run, "
         f"{len(culling.culled)} culled, {len(front.spec.resources)} resources"
     )
     return 0

@@ -17,13 +17,14 @@ from typing import Any
 
 from ruamel.yaml import events as ev
 
-from rgraph.errors import Location, RGraphError, quote
+from rgraph.errors import CONTROL, Location, RGraphError, quote
 
 PathKey = tuple[str | int, ...]
 
 MAX_DEPTH = 64
 MAX_NODES = 500_000
 MAX_ALIAS_NODES = 100_000
+MAX_KEYS = 20_000  # per mapping: a 16,000-pass graph has 16,000 (parsing costs ~10-50 us a value)
 MAX_INT_BITS = 64
 
 _NULL = frozenset(("", "~", "null", "Null", "NULL"))
@@ -204,11 +205,12 @@ class EventBuilder:
             raise RGraphError.at(loc, "YAML merge keys ('<<') are not supported")
         self._count(event)
         key = event.value
-        if _SURROGATE.search(key):
-            raise RGraphError.at(loc, f"key {quote(key)} contains a lone surrogate (not valid Unicode text)")
+        check_text(key, loc)
         if key in parent.seen:
             first = parent.seen[key]
             raise RGraphError.at(loc, f"duplicate key {quote(key)} (first defined at line {first.line})")
+        if len(parent.seen) >= MAX_KEYS:
+            raise RGraphError.at(loc, f"more than {MAX_KEYS:,} keys in one mapping")
         parent.seen[key] = loc
         parent.key = key
         self.keys.append(((*parent.path, key), loc))
@@ -242,10 +244,18 @@ class EventBuilder:
         return anchor.value
 
 
-def scalar_value(text: str, style: str | None, loc: Location) -> Any:
-    """The core-schema value of one scalar: quoted and block scalars are strings."""
+def check_text(text: str, loc: Location) -> None:
+    """Refuse lone surrogates and control characters (other than tab and newline) in any text."""
     if _SURROGATE.search(text):
         raise RGraphError.at(loc, f"text {quote(text)} contains a lone surrogate (not valid Unicode text)")
+    bad = CONTROL.search(text)
+    if bad:
+        raise RGraphError.at(loc, f"text {quote(text)} contains the control character U+{ord(bad.group()):04X}")
+
+
+def scalar_value(text: str, style: str | None, loc: Location) -> Any:
+    """The core-schema value of one scalar: quoted and block scalars are strings."""
+    check_text(text, loc)
     if style is not None:
         return text
     if text in _NULL:

@@ -58,6 +58,8 @@ class Location:
         while at is not None and len(sites) < 64:
             sites.append(f"included from {at}")
             at = at.via
+        if len(sites) > 4:
+            sites = [*sites[:3], f"... ({len(sites) - 4} more)", sites[-1]]
         return f" ({', '.join(sites)})" if sites else ""
 
 

@@ -8,7 +8,13 @@ import sys
 from pathlib import Path
 
 from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
-from rgraph.commands.outputs import check_output_file, check_pass_params, frame_count, output_path, write_output
+from rgraph.commands.outputs import (
+    check_output_file,
+    check_pass_params,
+    frame_count,
+    output_path,
+    write_output,
+)
 from rgraph.errors import RGraphError
 
 

@@ -42,6 +42,9 @@ def _load_plan(args: argparse.Namespace) -> dict:
         plan, _ = load_plan_file(path)
         if plan.get("format") != "rgraph-plan/1":
             raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
+        from rgraph.spec.paths import check_plan_scene
+
+        check_plan_scene(plan, path)
         if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
             from rgraph.compiler.pipeline import apply_sync_mode
 

@@ -67,3 +67,28 @@ def referenced(base: Path, root: Path, name: str, loc: Location, what: str, owne
             loc, f"{what} {quote(name)} lies outside the {owner}'s folder {quote(str(root))} "
                  f"(pass --allow-include-outside to allow it)")
     return path
+
+
+def check_plan_scene(plan: dict, plan_path: Path) -> None:
+    """A plan's ``scene_source`` must lie inside the plan's folder tree or the bundled graphs
+    (where ``rgraph compile`` of a bundled graph points it), unless outside files are allowed."""
+    from rgraph.resources import graphs_dir
+
+    source = plan.get("scene_source")
+    if source is None:
+        return
+    loc = Location(str(plan_path))
+    if not isinstance(source, str):
+        raise RGraphError.at(loc, f"scene_source must be a file name or null, got {quote(source)}")
+    check_name(source, loc, "scene_source")
+    if outside_allowed():
+        return
+    try:
+        resolved = Path(source).resolve()
+        inside = any(resolved.is_relative_to(root.resolve()) for root in (plan_path.parent, graphs_dir()))
+    except (OSError, RuntimeError) as exc:
+        raise RGraphError.at(loc, f"cannot resolve scene_source {quote(source)}: {exc}") from None
+    if not inside:
+        raise RGraphError.at(loc, f"scene_source {quote(source)} lies outside the plan's folder "
+                                  f"{quote(str(plan_path.parent))} and the bundled graphs "
+                                  f"(pass --allow-include-outside to allow it)")

@@ -89,3 +89,24 @@ def test_validate_ok_line_escapes_names(tmp_path: Path, capsys) -> None:
     path.write_text("rgraph: 1\nname: \"a\u202eb\"\n")
     assert main(["validate", str(path)]) == 2  # a bidi override is refused where it is written
     assert "control character U+202E" in capsys.readouterr().err
+
+
+def test_a_plans_scene_source_stays_inside_its_folder_or_the_bundled_graphs(tmp_path: Path, capsys) -> None:
+    import json
+
+    from rgraph.compiler.pipeline import compile_graph
+    from rgraph.spec.paths import allow_outside, check_plan_scene
+
+    plan = compile_graph("surgery", size=(16, 16))
+    check_plan_scene(plan, tmp_path / "p.json")  # the bundled scene
+    (tmp_path / "s.yaml").write_text("scene: 1\n")
+    check_plan_scene({**plan, "scene_source": str(tmp_path / "s.yaml")}, tmp_path / "p.json")
+    evil = {**plan, "scene_source": "/etc/hostname"}
+    with pytest.raises(RGraphError, match="lies outside the plan's folder"):
+        check_plan_scene(evil, tmp_path / "p.json")
+    with allow_outside():
+        check_plan_scene(evil, tmp_path / "p.json")
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps(evil))
+    assert main(["run", str(path)]) == 2
+    assert "scene_source '/etc/hostname' lies outside" in capsys.readouterr().err

@@ -7,6 +7,7 @@ is refused before it is opened; the size is checked before and while reading.
 from __future__ import annotations
 
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -57,3 +58,24 @@ def read_bytes(path: Path, display: str, what: str, limit: int) -> bytes:
 
 def _size(limit: int) -> str:
     return f"{limit // (1024 * 1024)} MiB" if limit >= 1024 * 1024 else f"{limit:,} bytes"
+
+
+def line_col(text: str, offset: int) -> tuple[int, int]:
+    """1-based line and column of character ``offset`` of ``text``."""
+    return text.count("\n", 0, offset) + 1, offset - (text.rfind("\n", 0, offset) + 1) + 1
+
+
+def check_bracket_depth(text: str, file: str, limit: int, tokens: re.Pattern[str], what: str) -> None:
+    """Refuse ``[``/``{`` nested deeper than ``limit`` (``tokens`` matches brackets and the quoted
+    strings to skip), at the bracket that goes too deep -- before a recursive parser sees them."""
+    if text.count("[") + text.count("{") <= limit:
+        return
+    depth = 0
+    for match in tokens.finditer(text):
+        token = match.group()
+        if token in "[{":
+            depth += 1
+            if depth > limit:
+                raise RGraphError.in_file(file, f"{what} nested deeper than {limit} levels", *line_col(text, match.start()))
+        elif token in "]}":
+            depth = max(0, depth - 1)

@@ -14,38 +14,20 @@ from pathlib import Path
 from typing import Any
 
 from rgraph.errors import CONTROL, RGraphError, quote
-from rgraph.files import read_text
+from rgraph.files import check_bracket_depth, line_col, read_text
 
 MAX_PLAN_BYTES = 256 * 1024 * 1024
 MAX_DEPTH = 64
 _TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"|[\[\]{}]')
 
 
-def _line_col(text: str, offset: int) -> tuple[int, int]:
-    return text.count("\n", 0, offset) + 1, offset - (text.rfind("\n", 0, offset) + 1) + 1
-
-
-def _check_depth(text: str, file: str) -> None:
-    if text.count("[") + text.count("{") <= MAX_DEPTH:
-        return
-    depth = 0
-    for match in _TOKEN.finditer(text):
-        token = match.group()
-        if token in "[{":
-            depth += 1
-            if depth > MAX_DEPTH:
-                raise RGraphError.in_file(file, f"JSON nested deeper than {MAX_DEPTH} levels", *_line_col(text, match.start()))
-        elif token in "]}":
-            depth -= 1
-
-
 def decode_json(text: str, file: str) -> Any:
     """``json.loads(text)`` within the limits above; located ``RGraphError`` otherwise."""
-    _check_depth(text, file)
+    check_bracket_depth(text, file, MAX_DEPTH, _TOKEN, "JSON")
 
     def refuse(message: str, literal: str) -> RGraphError:
         offset = text.find(literal)
-        return RGraphError.in_file(file, message, *_line_col(text, max(offset, 0)))
+        return RGraphError.in_file(file, message, *line_col(text, max(offset, 0)))
 
     def parse_int(literal: str) -> int:
         if len(literal.lstrip("-")) > 19 or not -(2**63) <= int(literal) < 2**64:

@@ -18,6 +18,7 @@ from typing import Any
 from ruamel.yaml import events as ev
 
 from rgraph.errors import CONTROL, Location, RGraphError, quote
+from rgraph.files import check_bracket_depth
 
 PathKey = tuple[str | int, ...]
 
@@ -45,20 +46,7 @@ _FLOW_TOKEN = re.compile(r"\"(?:[^\"\\]|\\.)*\"|'(?:[^']|'')*'|[\[\]{}]")
 def check_flow_depth(text: str, file: str) -> None:
     """Refuse flow collections nested deeper than :data:`MAX_DEPTH` before ruamel scans them
     (its scanner is quadratic in the flow depth). Quoted strings are skipped."""
-    if text.count("[") + text.count("{") <= MAX_DEPTH:
-        return
-    depth = 0
-    for match in _FLOW_TOKEN.finditer(text):
-        token = match.group()
-        if token in "[{":
-            depth += 1
-            if depth > MAX_DEPTH:
-                start = match.start()
-                line = text.count("\n", 0, start) + 1
-                col = start - (text.rfind("\n", 0, start) + 1) + 1
-                raise RGraphError.at(Location(file, line, col), f"values nested deeper than {MAX_DEPTH} levels")
-        elif token in "]}":
-            depth = max(0, depth - 1)
+    check_bracket_depth(text, file, MAX_DEPTH, _FLOW_TOKEN, "values")
 
 
 @dataclass

@@ -140,13 +140,22 @@ class Replay:
                 reach |= chains.reach(cls)
         return reach
 
+    def _cross_visible(self, rec: Rec, q: int) -> tuple[int, int]:
+        """(stages, accesses) that barriers on ``q`` chained after semaphores made ``rec`` visible to."""
+        stages = access = 0
+        for xq, vis_stages, vis_access in rec.xvis:
+            if xq == q:
+                stages |= vis_stages
+                access |= vis_access
+        return stages, access
+
     def covered(self, rec: Rec, q: int) -> bool:
         """Ordered before (and visible to) every stage of everything now on ``q`` through semaphores."""
         return self.semaphore_reach(rec, q) == vocab.ALL_STAGES
 
     def exec_after(self, rec: Rec, stages: int, q: int) -> bool:
         """Is a command on ``q`` in all of ``stages`` ordered after ``rec``?"""
-        through = self.semaphore_reach(rec, q)
+        through = self.semaphore_reach(rec, q) | self._cross_visible(rec, q)[0]
         if stages & ~through == 0:
             return True
         if rec.queue != q or rec.cls < 0:
@@ -160,7 +169,15 @@ class Replay:
         if not stages:
             return 0
         if rec.queue != q:
-            return stages
+            missing = 0
+            for stage in vocab.bits(stages):
+                got = 0
+                for xq, vis_stages, vis_access in rec.xvis:
+                    if xq == q and vis_stages & stage:
+                        got |= vis_access
+                if access & ~got:
+                    missing |= stage
+            return missing
         missing = 0
         for stage in vocab.bits(stages):
             got = 0
@@ -438,7 +455,8 @@ class Replay:
                             f"of {p.label}", ((b.dst.stages, b.dst.access),))
                 return replace(st, owner=q, release=None, layout=b.dst.layout, writes=(trans,), reads=(),
                                touched=True), out
-            return replace(st, owner=q, release=None, touched=True), out
+            return replace(st, owner=q, release=None, touched=True,
+                           writes=self._make_available(b, st.writes, q, pairs)), out
 
         if image and b.src.layout != vocab.UNDEFINED and b.src.layout != st.layout:
             out.append((hz.LAYOUT_MISMATCH, f"the barrier expects {b.src.layout} but the cells are in {st.layout}"))
@@ -481,13 +499,21 @@ class Replay:
 
     def _make_available(self, b: Barrier, writes: tuple[Rec, ...], q: int,
                         pairs: BarrierStages) -> tuple[Rec, ...]:
-        """Apply the memory dependency of a non-transition barrier to the cell's last write."""
+        """Apply the memory dependency of a non-transition barrier to the cell's last write.
+
+        A write from another queue that semaphores order before the barrier (an acquire, or a
+        barrier whose source stages meet the waits' stages) becomes visible on this queue in the
+        barrier's destination scope too (``Rec.xvis``)."""
         if not writes:
             return writes
         chains = self.chains[q]
         out = []
         changed = False
         for w in writes:
+            if w.queue != q and not self.covered(w, q) and self._through_semaphores(w, b, q):
+                out.append(replace(w, xvis=w.xvis + ((q, b.dst.stages, b.dst.access),)))
+                changed = True
+                continue
             if w.queue != q or self.covered(w, q) or not self.barrier_takes_write(w, b, q):
                 out.append(w)
                 continue

@@ -53,13 +53,17 @@ def check_name(name: str, loc: Location, what: str) -> None:
 
 
 def referenced(base: Path, root: Path, name: str, loc: Location, what: str, owner: str = "graph") -> Path:
-    """``base / name`` after :func:`check_name`, refused when it leaves ``root``'s folder tree."""
+    """``base / name`` after :func:`check_name`, refused when it leaves ``root``'s folder tree
+    (the bundled graphs and scenes are always allowed: they ship with rgraph)."""
     check_name(name, loc, what)
     path = base / name
     if outside_allowed():
         return path
+    from rgraph.resources import graphs_dir
+
     try:
-        inside = path.resolve().is_relative_to(root.resolve())
+        resolved = path.resolve()
+        inside = any(resolved.is_relative_to(top.resolve()) for top in (root, graphs_dir()))
     except (OSError, RuntimeError) as exc:
         raise RGraphError.at(loc, f"cannot resolve {what} {quote(name)}: {exc}") from None
     if not inside:

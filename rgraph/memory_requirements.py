@@ -28,6 +28,8 @@ Requirements = tuple[int, int, int]  # (size, alignment, memory_type_bits)
 Sample = tuple[int, int, int, int, int, int, int, int, int]
 
 PROFILES_DIR = Path(__file__).parent / "profiles"
+#: Buffer usages whose rules live in a profile's ``accel`` section (they need device addresses).
+ACCEL_BUFFER_USAGES = frozenset({"accel_storage", "accel_scratch", "trace_indirect"})
 
 
 def align_up(value: int, alignment: int) -> int:
@@ -187,7 +189,40 @@ class ProfileMemoryRequirements:
             size = predict_image(rule, entry["block_bytes"], entry["block_extent"], ext, mips, layers, samples)
         return size, int(entry["alignment"]), int(entry["memory_type_bits"])
 
+    def _accel_section(self) -> dict[str, Any]:
+        section = self.profile.get("accel")
+        if section is None:
+            raise self._error(f"device profile {self.name!r} has no acceleration-structure sizes (capture it with "
+                              "`rgraph device-profile` on a device with VK_KHR_acceleration_structure)")
+        return section
+
+    def accel_sizes(self, level: str, count: int, max_vertex: int, update: bool) -> tuple[int, int, int]:
+        from rgraph.accel_profile import predict
+
+        try:
+            return predict(self._accel_section(), level, count, max_vertex, update, self.name)
+        except RGraphError as err:
+            raise self._error(err.first.message) from None
+
+    def accel_scratch_alignment(self) -> int:
+        return int(self._accel_section()["scratch_alignment"])
+
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
+        accel = sorted(set(usage_names) & ACCEL_BUFFER_USAGES)
+        if accel:
+            rules = self._accel_section()["buffer"]
+            missing = [u for u in accel if u not in rules]
+            if missing:
+                raise self._error(f"device profile {self.name!r}: no buffer rule for usage {', '.join(missing)}")
+            picked = [rules[u] for u in accel]
+            rest = [u for u in usage_names if u not in ACCEL_BUFFER_USAGES]
+            size_align = max(r["size_align"] for r in picked)
+            align = max(r["alignment"] for r in picked)
+            if rest:
+                other, other_align, _ = self.buffer(size, rest)
+                return max(align_up(max(int(size), 1), size_align), other), max(align, other_align), \
+                    int(picked[0]["memory_type_bits"])
+            return align_up(max(int(size), 1), size_align), align, int(picked[0]["memory_type_bits"])
         rule = self.profile["buffer"]
         usage_names = sorted({"storage_rw" if u.startswith("storage_") else u for u in usage_names})
         unknown = sorted(set(usage_names) - set(rule["alignment_by_usage"]))

@@ -155,6 +155,10 @@ def build_plan(
         }
         if res.is_image:
             entry.update({"extent": list(res.extent), "mips": res.mips, "layers": res.layers, "samples": res.samples})
+        if res.accel is not None:
+            entry["accel"] = res.accel.as_plan()
+        if res.scratch_of is not None:
+            entry["scratch_of"] = res.scratch_of
         plan_resources.append(entry)
     stats = placement.stats
     kept_resources = set(reqs)

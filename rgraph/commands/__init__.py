@@ -13,4 +13,5 @@ COMMAND_MODULES = [
     "device_profile",
     "graphs",
     "schema",
+    "completion",
 ]

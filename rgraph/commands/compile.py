@@ -14,6 +14,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_graph_arguments(parser)
     add_compile_arguments(parser)
     parser.add_argument("-o", "--output", help="plan file to write (default: stdout)")
+    parser.add_argument("--json", action="store_true",
+                        help="print a JSON summary (docs/cli-json.md); the plan goes to -o or into its 'plan' key")
     parser.set_defaults(func=run)
 
 
@@ -22,10 +24,29 @@ def run(args: argparse.Namespace) -> int:
 
     if args.output:
         check_output_file(args.output, "-o")
-    text = dumps(compile_from_args(args))
+    plan = compile_from_args(args)
+    text = dumps(plan)
+    if args.json:
+        return _json(args, plan, text)
     if args.output:
         write_output(args.output, text, "-o")
         print(f"wrote {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(text)
+    return 0
+
+
+def _json(args: argparse.Namespace, plan: dict, text: str) -> int:
+    from rgraph.commands.jsonout import document, emit
+    from rgraph.report.summary import counted_barriers
+
+    if args.output:
+        write_output(args.output, text, "-o")
+    barriers, releases = counted_barriers(plan)
+    body = {"file": plan.get("source"), "graph": plan.get("graph"), "output": args.output,
+            "passes": [p["name"] for p in plan["passes"]], "culled": plan.get("culled") or [],
+            "barriers": barriers, "releases": releases, "stats": plan.get("stats") or {}}
+    if not args.output:
+        body["plan"] = plan
+    emit(document("compile", True, **body))
     return 0

@@ -36,7 +36,11 @@ def run(args: argparse.Namespace) -> int:
         return 1
     device = None
     try:
-        device = create_device(instance, args.device)
+        from rgraph.vk.device import choose_physical_device, list_physical_devices
+        from rgraph.vk.rt_device import supported
+
+        physical = choose_physical_device(list_physical_devices(instance), args.device)
+        device = create_device(instance, args.device, ray_tracing=supported(physical.handle))
         name = args.name or ("lavapipe" if "llvmpipe" in device.name else device.name.split()[0].lower())
         profile = capture_profile(device, name, fmts)
     except VulkanUnavailable as exc:

@@ -20,7 +20,7 @@ from rgraph.errors import RGraphError
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("mutate", help="mutate every barrier of a compiled graph and report which oracle "
                                            "catches each mutant")
-    add_graph_arguments(parser, size_default="64x64")
+    add_graph_arguments(parser)
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     parser.add_argument("--oracles", default="check,syncval,data",
                         help="comma-separated subset of check,syncval,data (default: all three)")
@@ -102,6 +102,22 @@ def print_report(report, out=sys.stdout) -> None:
                   f"{report.seconds:.1f} s")
 
 
+def _without_crashing_layer(plan: dict, oracles: list[str]) -> list[str]:
+    """``oracles`` without syncval when the installed layer cannot create the plan's ray
+    tracing pipelines (rgraph.vk.probe_rt.refuse_layer_for_ray_tracing); says so on stderr."""
+    if "syncval" not in oracles:
+        return oracles
+    from rgraph.vk.errors import ExecutionError
+    from rgraph.vk.probe_rt import refuse_layer_for_ray_tracing
+
+    try:
+        refuse_layer_for_ray_tracing(plan)
+    except ExecutionError as exc:
+        print(f"rgraph: note: syncval oracle off: {str(exc).removeprefix('--validate: ')}", file=sys.stderr)
+        return [o for o in oracles if o != "syncval"]
+    return oracles
+
+
 def run(args: argparse.Namespace) -> int:
     from rgraph.mutate import KINDS, ORACLES, mutation_report
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
@@ -119,6 +135,7 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         plan = _compile(args, runtime)
+        oracles = _without_crashing_layer(plan, oracles)
         report = mutation_report(plan, oracles=oracles, kinds=kinds, frames=args.frames,
                                  device_index=args.device, progress=progress)
     except (VulkanUnavailable, ExecutionError) as exc:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
@@ -20,7 +21,7 @@ from rgraph.errors import RGraphError
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
-    add_graph_arguments(parser, size_default="640x360")
+    add_graph_arguments(parser)
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=frame_count, default=1, help="frames to run (default 1)")
@@ -29,8 +30,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
     parser.add_argument("--out", type=output_path, help="write the first output image as PNG")
-    parser.add_argument("--timings", type=output_path, help="write per-pass GPU times (median ms) as JSON")
+    parser.add_argument("--timings", type=output_path,
+                        help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
+    parser.add_argument("--trace", type=output_path, metavar="OUT.json",
+                        help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
+                             "a track per queue, passes as slices, barriers, semaphore waits as flows")
+    parser.add_argument("--heatmap", type=output_path,
+                        help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.add_argument("--json", action="store_true",
+                        help="print the result (timings, validation messages, data check) as JSON (docs/cli-json.md)")
     parser.set_defaults(func=run)
 
 
@@ -53,7 +62,8 @@ def _load_plan(args: argparse.Namespace) -> dict:
     from rgraph.vk.memreq import compile_for_device
 
     return compile_for_device(args.graph, args.device, scene_path=args.scene, params=parse_params(args.param),
-                              size=parse_size(args.size), policy=args.policy, sync=args.sync)
+                              size=parse_size(args.size), policy=args.policy, sync=args.sync,
+                              schedule=args.schedule, camera=args.camera)
 
 
 def _params_view(args: argparse.Namespace) -> dict:
@@ -83,11 +93,46 @@ def _print_table(plan: dict, timings: dict) -> None:
     Console(stderr=True).print(table)
 
 
+def _status(args: argparse.Namespace, result) -> int:
+    failed = (args.validate and result.messages) or result.data_ok is False
+    return 1 if failed else 0
+
+
+def _json(args: argparse.Namespace, plan: dict, result) -> int:
+    from rgraph.commands.jsonout import document, emit
+
+    status = _status(args, result)
+    emit(document(
+        "run", status == 0, graph=plan.get("graph"), device=result.device_name, size=plan.get("size"),
+        frames=args.frames, timings=result.timings, culled=plan.get("culled") or [],
+        validation={"enabled": bool(args.validate), "messages": [str(m) for m in result.messages]},
+        data_check=None if result.data_ok is None else {
+            "ok": bool(result.data_ok), "mismatches": [str(m) for m in result.mismatches],
+            "unpredictable": [str(u) for u in result.unchecked]},
+        out=str(args.out) if args.out else None))
+    return status
+
+
+def _report_clusters(args: argparse.Namespace, outputs: dict) -> None:
+    """Light-list statistics and the heatmap of a clustered graph (rgraph.passes.cluster_report)."""
+    if "cluster_stats" not in outputs and not args.heatmap:
+        return
+    from rgraph.resources import builtin_passes
+
+    cluster_report = importlib.import_module(f"{builtin_passes().__name__}.cluster_report")
+
+    if "cluster_stats" in outputs:
+        print(cluster_report.stats_line(cluster_report.stats_of(outputs["cluster_stats"])), file=sys.stderr)
+    if args.heatmap:
+        print(cluster_report.write_heatmap(args.heatmap, outputs["light_heat"][..., 0]), file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
     from rgraph.vk.executor import execute_plan
 
-    for flag, target in (("--out", args.out), ("--timings", args.timings)):
+    for flag, target in (("--out", args.out), ("--timings", args.timings), ("--trace", args.trace),
+                         ("--heatmap", args.heatmap)):
         if target is not None:
             check_output_file(target, flag)
     if not Path(args.graph).suffix == ".json":  # params first: compiling for the device opens it
@@ -95,20 +140,38 @@ def run(args: argparse.Namespace) -> int:
     try:
         plan = _load_plan(args)
         check_pass_params(plan, parse_params(args.param))
+        outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
+        if args.heatmap and "light_heat" not in outputs:
+            raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' (see graphs/clustered.yaml)")
         result = execute_plan(plan, validate=args.validate, frames=args.frames, device_index=args.device,
-                              check_data=args.check_data, out_png=args.out, verbose=True)
+                              check_data=args.check_data, out_png=args.out, verbose=True,
+                              read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
     except (VulkanUnavailable, ExecutionError) as exc:
+        if args.json:
+            from rgraph.commands.jsonout import diagnostic, document, emit
+            from rgraph.errors import Location
+
+            emit(document("run", False, [diagnostic("error", Location("<device>"), str(exc))]))
+            return 2
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
+    _report_clusters(args, result.outputs)
+    if args.timings:
+        write_output(args.timings, json.dumps({"device": result.device_name, "size": plan.get("size"),
+                                               **result.timings}, indent=1, sort_keys=True) + "\n", "--timings")
+    if args.trace:
+        from rgraph.report.trace import chrome_trace
+
+        trace = chrome_trace(plan, {"device": result.device_name, **result.timings})
+        write_output(args.trace, json.dumps(trace, indent=None, sort_keys=True) + "\n", "--trace")
+    if args.json:
+        return _json(args, plan, result)
     if plan["passes"]:
         _print_table(plan, result.timings)
     else:
         print("rgraph: nothing to execute: every pass was culled", file=sys.stderr)
     for entry in plan.get("culled", []):
         print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
-    if args.timings:
-        write_output(args.timings, json.dumps({"device": result.device_name, **result.timings}, indent=1,
-                                              sort_keys=True) + "\n", "--timings")
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)

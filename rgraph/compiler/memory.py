@@ -40,7 +40,8 @@ class ResourceMemory:
 
 
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
-_SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw"}
+_SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw",
+                     "accel_build": "accel_storage", "accel_read": "accel_storage"}
 
 
 def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
@@ -48,6 +49,8 @@ def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
     for p in passes:
         for a in p.accesses:
             out.setdefault(a.resource, set()).add(a.usage)
+            if a.usage == "indirect" and p.kind == "raytrace":  # vkCmdTraceRaysIndirectKHR: a device address
+                out[a.resource].add("trace_indirect")
     return out
 
 

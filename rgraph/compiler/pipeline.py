@@ -15,18 +15,20 @@ from pathlib import Path
 from typing import Any
 
 from rgraph.compiler import memory
+from rgraph.compiler.accel import size_accels
 from rgraph.compiler.memory import MemoryRequirementsProvider
 from rgraph.compiler.sync import synchronize
+from rgraph.defaults import DEFAULT_SIZE  # re-exported: the one default everywhere
 from rgraph.errors import RGraphError
 from rgraph.ir.cull import cull
+from rgraph.ir.schedule import DEFAULT_SCHEDULE, schedule_passes
 from rgraph.plan import build_plan
-from rgraph.resources import resolve_graph
+from rgraph.resources import resolve_graph, resolve_scene
 from rgraph.spec.loader import GraphSource, load_graph
 from rgraph.spec.pydantic_errors import did_you_mean
 from rgraph.spec.scene import ALL_PRESENT, Scene, load_scene
 from rgraph.spec.specialize import Spec, resolve_params, specialize
 
-DEFAULT_SIZE = (1920, 1080)
 DEFAULT_POLICY = "aliased"
 DEFAULT_PROFILE = "lavapipe"
 
@@ -42,7 +44,7 @@ class Frontend:
 
 def load_scene_for(source: GraphSource, scene_path: str | Path | None) -> Scene | None:
     if scene_path is not None:
-        return load_scene(scene_path)
+        return load_scene(resolve_scene(scene_path))
     if source.default_scene is not None:
         if not source.default_scene.is_file():
             assert source.default_scene_loc is not None
@@ -72,6 +74,7 @@ def compile_spec(
     policy: str = DEFAULT_POLICY,
     memory_provider: MemoryRequirementsProvider | None = None,
     profile_name: str | None = None,
+    schedule: str = DEFAULT_SCHEDULE,
 ) -> dict[str, Any]:
     """Spec -> plan dict (the part benchmarked by benchmarks/compile_scaling.py)."""
     # The compiler allocates many small acyclic objects; the cyclic collector would rescan
@@ -79,20 +82,21 @@ def compile_spec(
     enabled = gc.isenabled()
     gc.disable()
     try:
-        return _compile_spec(spec, policy, memory_provider, profile_name)
+        return _compile_spec(spec, policy, memory_provider, profile_name, schedule)
     finally:
         if enabled:
             gc.enable()
 
 
-def _compile_spec(spec, policy, memory_provider, profile_name) -> dict[str, Any]:
+def _compile_spec(spec, policy, memory_provider, profile_name, schedule=DEFAULT_SCHEDULE) -> dict[str, Any]:
     culling = cull(spec)
-    passes = culling.passes  # schedule: declaration order minus culled passes
+    passes = schedule_passes(culling.passes, schedule)  # default: declaration order minus culled passes
     if memory_provider is None:
         from rgraph.memory_requirements import ProfileMemoryRequirements
 
         memory_provider = ProfileMemoryRequirements.named(DEFAULT_PROFILE)
         profile_name = profile_name or DEFAULT_PROFILE
+    passes = size_accels(spec, passes, memory_provider)
     used = memory.usages_by_resource(passes)
     spans = memory.lifetimes(passes)
     reqs = memory.requirements(spec.resources, used, spec.outputs, memory_provider)
@@ -109,10 +113,13 @@ def _compile_spec(spec, policy, memory_provider, profile_name) -> dict[str, Any]
     }
     culled_bytes = {r: v[0] for r, v in memory.requirements(spec.resources, culled_used, spec.outputs, memory_provider).items()}
     sync = synchronize(passes, spec.resources, aliases)
-    return build_plan(
+    plan = build_plan(
         spec, culling, passes, sync, placement, reqs, classes, spans, used, profile_name or "device",
         culled_bytes
     )
+    if schedule != DEFAULT_SCHEDULE:
+        plan["stats"]["schedule"] = schedule  # absent = declaration order
+    return plan
 
 
 def add_outputs(spec: Spec, names: Sequence[str]) -> None:
@@ -136,6 +143,8 @@ def compile_graph(
     profile: str | None = None,
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
+    schedule: str = DEFAULT_SCHEDULE,
+    camera: int = 0,
 ) -> dict[str, Any]:
     """Compile a graph file (or bundled graph name) into a plan dict.
 
@@ -154,8 +163,24 @@ def compile_graph(
         provider = ProfileMemoryRequirements.named(profile)
         profile_name = provider.name
     chosen = policy or front.source.memory_policy or DEFAULT_POLICY
-    plan = compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name)
+    plan = compile_spec(front.spec, policy=chosen, memory_provider=provider, profile_name=profile_name,
+                        schedule=schedule)
+    if camera:
+        plan["camera"] = check_camera(front.scene, camera)
     return apply_sync_mode(plan, sync)
+
+
+def check_camera(scene: Scene | None, camera: int) -> int:
+    """``--camera N`` against the scene's presets (FORMAT.md 7); the plan records it."""
+    from rgraph.scene.build import pick_camera
+
+    if scene is None:
+        raise RGraphError.in_file("<command line>", f"--camera {camera}: the graph has no scene")
+    try:
+        pick_camera(scene.model, camera)
+    except ValueError as exc:
+        raise RGraphError.in_file("<command line>", f"--camera: {exc}") from None
+    return camera
 
 
 SYNC_MODES = ("normal", "naive")

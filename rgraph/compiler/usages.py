@@ -62,12 +62,15 @@ _TABLE: dict[str, tuple[tuple[str, ...] | None, tuple[str, ...], str | None]] = 
     # ALL_TRANSFER rather than COPY: validation layer 1.3.239 misreports the narrower stages.
     "transfer_src": (("ALL_TRANSFER",), ("TRANSFER_READ",), "TRANSFER_SRC_OPTIMAL"),
     "transfer_dst": (("ALL_TRANSFER",), ("TRANSFER_WRITE",), "TRANSFER_DST_OPTIMAL"),
-    "accel_build": (
+    # a build writes the structure (a refit also reads it: ``refit=True``)
+    "accel_build": (("ACCELERATION_STRUCTURE_BUILD_KHR",), ("ACCELERATION_STRUCTURE_WRITE_KHR",), None),
+    "accel_read": (None, ("ACCELERATION_STRUCTURE_READ_KHR",), None),
+    # the build's scratch buffer (added by the compiler to each build pass, never in a graph file)
+    "accel_scratch": (
         ("ACCELERATION_STRUCTURE_BUILD_KHR",),
         ("ACCELERATION_STRUCTURE_READ_KHR", "ACCELERATION_STRUCTURE_WRITE_KHR"),
         None,
     ),
-    "accel_read": (None, ("ACCELERATION_STRUCTURE_READ_KHR",), None),
 }
 
 WRITE_ACCESS = frozenset(
@@ -101,9 +104,12 @@ def sync_of(
     is_image: bool = True,
     depth_format: bool = False,
     stencil_format: bool = False,
+    refit: bool = False,
 ) -> Sync:
     """Stages, access and layout of one usage in a pass of ``pass_kind``."""
     stages, access, layout = _TABLE[usage]
+    if refit and usage == "accel_build":
+        access = (*access, "ACCELERATION_STRUCTURE_READ_KHR")
     if stages is None:
         if explicit_stages:
             stages = tuple(EXPLICIT_STAGE_NAMES[s] for s in explicit_stages)

@@ -142,3 +142,29 @@ def analyze(plan_pass: dict, resources: dict[str, dict]) -> PassProbe:
 
 def modulus_of(resources: dict[str, dict], name: str) -> int | None:
     return modulus(resources[name])
+
+
+# ----------------------------------------------------------------- ray tracing (FORMAT.md 5)
+#: Accel values live in instance custom indices (24 bits; the probe's second instance adds 1).
+ACCEL_MODULUS = 1 << 23
+#: What the probe's miss shader returns.
+MISS_VALUE = 90
+
+
+def accel_value(plan: dict, name: str) -> int:
+    """The value the probe's build of accel ``name`` stores: its first instance's custom index
+    (the second one's is one more). Persistent/imported accels hold their initial value."""
+    from rgraph.probe.values import initial_value
+
+    res = next(r for r in plan["resources"] if r["name"] == name)
+    if res["lifetime"] in ("persistent", "imported"):
+        return initial_value(name, ACCEL_MODULUS)
+    first = next(p["index"] for p in plan["passes"]
+                 if any(a["resource"] == name and a["usage"] == "accel_build" for a in p["accesses"]))
+    return seed(first, 64) % ACCEL_MODULUS
+
+
+def trace_value(value: int) -> int:
+    """What the probe's rays return for an accel holding ``value``: a ray hitting instance 0
+    (value + 1), one hitting instance 1 (value + 2), one missing (MISS_VALUE)."""
+    return 2 * value + 3 + MISS_VALUE

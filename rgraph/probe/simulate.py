@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from rgraph.probe.semantics import analyze, subresources
+from rgraph.probe.semantics import accel_value, analyze, subresources, trace_value
 from rgraph.probe.values import UINT32, codec, initial_value, modulus
 
 Key = tuple[str, int | None, int | None]  # (resource, mip, layer); buffers: (name, None, None)
@@ -71,6 +71,14 @@ class Simulation:
                 total = None
             else:
                 total = (total + value * len(read.stages)) & UINT32
+        if p["kind"] == "raytrace":  # the probe's rays against each accel read
+            for a in accesses:
+                if a["usage"] == "accel_read":
+                    value = self._get(a["resource"], None)
+                    total = None if value is None or total is None else (total + trace_value(value)) & UINT32
+        for a in accesses:
+            if a["usage"] == "accel_build":
+                self._set(a["resource"], None, accel_value(self.plan, a["resource"]))
         for write in probe.writes:
             m = modulus(self.resources[write.resource])
             for sub in write.subs:
@@ -88,7 +96,7 @@ class Simulation:
 
 
 def all_keys(resource: dict) -> list[Key]:
-    if resource["kind"] == "buffer":
+    if resource["kind"] in ("buffer", "accel"):
         return [(resource["name"], None, None)]
     return [(resource["name"], m, layer) for m in range(resource["mips"]) for layer in range(resource["layers"])]
 

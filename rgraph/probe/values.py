@@ -15,6 +15,7 @@ import numpy as np
 from rgraph import formats
 
 HEADER_WORDS = 16  # indirect-capable buffers: words [0:4] draw, [4:9] indexed draw, [12:15] dispatch
+INDIRECT_MIN_BYTES = 4 * (HEADER_WORDS + 1)  # the header plus one value word: what the probe needs
 BUFFER_MODULUS = 1 << 30
 UINT32 = 0xFFFFFFFF
 
@@ -146,5 +147,9 @@ def header_words(plan_size: tuple[int, int]) -> list[int]:
 def modulus(resource: dict) -> int | None:
     if resource["kind"] == "buffer":
         return BUFFER_MODULUS
+    if resource["kind"] == "accel":
+        from rgraph.probe.semantics import ACCEL_MODULUS
+
+        return ACCEL_MODULUS
     c = codec(resource["format"])
     return c.modulus if c else None

@@ -14,6 +14,7 @@ import numpy as np
 
 from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
 from rgraph.scene.deform import FRAME_SECONDS, Deformer
+from rgraph.scene.generate import expand_lights
 from rgraph.scene.shapes import MeshData, make_shape
 from rgraph.spec.scene import Material, SceneFile, load_scene
 
@@ -66,6 +67,8 @@ class SceneLightData:
     intensity: float
     radius: float
     shadow_layer: int  # -1 without a shadow map
+    cos_inner: float = 1.0  # spot lights: cosines of the cone's inner (full) and outer (zero) half-angles
+    cos_outer: float = 0.0
 
 
 @dataclass
@@ -168,8 +171,23 @@ def _instance_positions(mesh) -> np.ndarray:
     return base + np.asarray(offs, dtype=np.float64).reshape(-1, 3)
 
 
-def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str | None = None) -> SceneData:
-    """Geometry and tables of a scene file for an output of ``extent`` (w, h)."""
+def pick_camera(model: SceneFile, camera: int) -> SceneFile:
+    """``model`` seen from its camera preset ``camera`` (FORMAT.md 7: index into ``cameras``;
+    0 is ``camera`` when there is no list)."""
+    if not model.cameras:
+        if camera != 0:
+            raise ValueError(f"camera {camera}: the scene has no 'cameras' list (only camera 0)")
+        return model
+    if not 0 <= camera < len(model.cameras):
+        raise ValueError(f"camera {camera} out of range: the scene has {len(model.cameras)} cameras")
+    return model.model_copy(update={"camera": model.cameras[camera]})
+
+
+def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str | None = None,
+                camera: int = 0) -> SceneData:
+    """Geometry and tables of a scene file for an output of ``extent`` (w, h), seen from camera
+    preset ``camera``."""
+    model = pick_camera(model, camera)
     material_names = list(model.materials)
     materials = [model.materials[n] for n in material_names]
     meshes, draw = [], 0
@@ -184,7 +202,7 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
         draw += mesh.instances
         meshes.append(mesh)
     lights, layer = [], 0
-    for li in model.lights:
+    for li in expand_lights(model.lights):
         kind = LIGHT_TYPES[li.type]
         direction = _vec(li.direction if li.direction is not None else (0, -1, 0))
         norm = np.linalg.norm(direction)
@@ -194,8 +212,10 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
             if layer >= MAX_SHADOW_LIGHTS:
                 raise ValueError(f"at most {MAX_SHADOW_LIGHTS} shadow-casting lights are supported")
             shadow, layer = layer, layer + 1
+        cos_inner, cos_outer = (float(np.cos(np.radians(a))) for a in li.cone)
         lights.append(SceneLightData(kind, _vec(li.position if li.position is not None else (0, 0, 0)), direction,
-                                     _vec(li.color) * li.intensity, float(li.intensity), float(li.radius), shadow))
+                                     _vec(li.color) * li.intensity, float(li.intensity), float(li.radius), shadow,
+                                     cos_inner, cos_outer))
     pool = {**BUILTIN_DECALS, **model.materials, **model.decal_materials}
     decals = [DecalData(_vec(d.position), _vec(d.size), tuple(d.rotation), pool[d.material]) for d in model.decals]
     corners = (np.concatenate([m.world_corners() for m in meshes]) if meshes
@@ -204,6 +224,6 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
                      decals, corners)
 
 
-def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64)) -> SceneData:
+def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64), camera: int = 0) -> SceneData:
     scene = load_scene(path)
-    return build_scene(scene.model, extent, scene.name)
+    return build_scene(scene.model, extent, scene.name, camera)

@@ -49,8 +49,12 @@ class BufferResource(_Strict):
 
 
 class AccelResource(_Strict):
+    """Acceleration structures (FORMAT.md 5): a BLAS per mesh and one TLAS over the instances;
+    sized by the device's build-size query, never by a formula."""
+
     kind: Literal["accel"]
-    bytes: IntExpr = 1 << 20
+    geometry: Literal["scene", "probe"] = Field(
+        "scene", description="The scene's meshes, or the probe's known test geometry.")
     lifetime: Lifetime = "transient"
     description: str | None = None
 
@@ -79,10 +83,16 @@ UsageValue = Annotated[
 
 
 class Pass(_Strict):
+    for_: dict[str, list[IntExpr]] | None = Field(
+        None, alias="for",
+        description="Repeat this pass: {VAR: [first, stop]} (half-open, values may be expressions); "
+                    "${VAR} may appear in the pass name and in its reads/writes keys.")
     kind: PassKind
     impl: str | None = Field(None, description="A registered implementation; omitted -> the probe.")
     queue: QueueName = "graphics"
     requires: list[SceneFeature] = Field(default_factory=list)
+    requires_any: list[SceneFeature] = Field(
+        default_factory=list, description="The pass is removed when the scene has none of these features.")
     side_effects: bool = False
     reads: dict[str, UsageValue] = Field(default_factory=dict)
     writes: dict[str, UsageValue] = Field(default_factory=dict)

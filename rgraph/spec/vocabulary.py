@@ -76,7 +76,7 @@ USAGE_PASS_KINDS: dict[str, frozenset[str]] = {
     "index": frozenset({"raster"}),
     "transfer_src": frozenset({"transfer"}),
     "transfer_dst": frozenset({"transfer"}),
-    "accel_build": frozenset({"compute", "transfer", "raytrace"}),
+    "accel_build": frozenset({"compute"}),
     "sampled": frozenset({"raster", "compute", "raytrace"}),
     "storage_read": frozenset({"raster", "compute", "raytrace"}),
     "storage_write": frozenset({"raster", "compute", "raytrace"}),

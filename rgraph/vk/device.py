@@ -160,8 +160,11 @@ def _query_features(handle: Any) -> tuple[Any, Any, Any, Any]:
     return f2, f12, f13, f2.features
 
 
-def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True) -> Device:
-    """Choose a physical device, check required features, create the queues."""
+def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True,
+                  ray_tracing: bool = False, rt_pipelines: bool = False) -> Device:
+    """Choose a physical device, check required features, create the queues. ``ray_tracing``
+    enables acceleration structures, ray tracing pipelines and buffer device addresses
+    (``rgraph.vk.rt_device``)."""
     v = vk()
     physical = choose_physical_device(list_physical_devices(instance), device_index)
     if physical.api_version < (1, 3, 0):
@@ -187,11 +190,18 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         pNext=e13, timelineSemaphore=v.VK_TRUE, separateDepthStencilLayouts=v.VK_TRUE,
         hostQueryReset=v.VK_TRUE,  # timestamp queries are reset from the host (transfer queues cannot)
         shaderOutputLayer=v.VK_TRUE if f12.shaderOutputLayer else v.VK_FALSE,  # gl_Layer in vertex shaders
+        bufferDeviceAddress=v.VK_TRUE if ray_tracing else v.VK_FALSE,
     )
-    enabled = v.VkPhysicalDeviceFeatures2(pNext=e12, features=core_features)
+    extensions: list[str] = []
+    head: Any = e12
+    if ray_tracing:
+        from rgraph.vk import rt_device
+
+        head, extensions = rt_device.chain(physical.handle, physical.name, e12, bind2=rt_pipelines)
+    enabled = v.VkPhysicalDeviceFeatures2(pNext=head, features=core_features)
     info = v.VkDeviceCreateInfo(
         pNext=enabled, queueCreateInfoCount=len(queue_infos), pQueueCreateInfos=queue_infos,
-        enabledExtensionCount=0, ppEnabledExtensionNames=[],
+        enabledExtensionCount=len(extensions), ppEnabledExtensionNames=extensions,
     )
     handle = v.vkCreateDevice(physical.handle, info, None)
     queues_by_family = {fam: v.vkGetDeviceQueue(handle, fam, 0) for fam in distinct}
@@ -201,11 +211,13 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         queues={q: queues_by_family[f] for q, f in plan_families.items()},
         properties=props, memory_properties=v.vkGetPhysicalDeviceMemoryProperties(physical.handle),
         enabled_features=enabled_core | set(REQUIRED_12) | set(REQUIRED_13)
-        | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set()),
+        | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set())
+        | ({"bufferDeviceAddress", "accelerationStructure", "rayTracingPipeline"} if ray_tracing else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},
         capabilities={q: _capabilities(families[f].queueFlags) for q, f in plan_families.items()},
     )
+    device.__dict__["extensions"] = tuple(extensions)
     return device
 
 

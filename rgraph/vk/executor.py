@@ -19,6 +19,7 @@ from rgraph.probe.simulate import simulate
 from rgraph.probe.values import codec, initial_value, modulus
 from rgraph.stages import CAPABILITIES, fit_to_queue
 from rgraph.vk import names
+from rgraph.vk.accel import AccelSet
 from rgraph.vk.after_reads import src_additions
 from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
@@ -28,6 +29,7 @@ from rgraph.vk.layer_races import avoid_layer_races, touched_resources
 from rgraph.vk.loader import vk
 from rgraph.vk.packed_ranges import partial_handoffs
 from rgraph.vk.probe import ProbePass, fill_bytes, image_copy_regions
+from rgraph.vk.probe_rt import needs_ray_tracing, probe_pass, refuse_layer_for_ray_tracing
 from rgraph.vk.readback import Mismatch, compare_buffer, compare_image, image_to_rgba8, write_png
 from rgraph.vk.record import BarrierBatch, RecordContext, build_barriers
 from rgraph.vk.resources import HostBuffer, ResourceSet
@@ -104,9 +106,12 @@ class Executor:
         self.scene_gpu: Any = None
         self.samplers: dict[str, Any] = {}
         self.updaters: list[ImplPass] = []
+        if validate:
+            refuse_layer_for_ray_tracing(plan)
         self.instance: Instance = create_instance(validate)
         self.device: Device | None = None
         self.resources: ResourceSet | None = None
+        self.accels: AccelSet | None = None
         self.passes: list[ProbePass | ImplPass] = []
         self.pools: dict[tuple[int, int], Any] = {}
         self.query_pools: list[Any] = []
@@ -120,7 +125,9 @@ class Executor:
         self.batches: list[Batch] = []
         self.barrier_batches: list[BarrierBatch] = []
         try:
-            self.device = create_device(self.instance, device_index, verbose=verbose)
+            self.device = create_device(self.instance, device_index, verbose=verbose,
+                                        ray_tracing=needs_ray_tracing(plan),
+                                        rt_pipelines=any(p["kind"] == "raytrace" for p in plan["passes"]))
             self._setup()
         except BaseException:
             self.close()
@@ -146,6 +153,9 @@ class Executor:
             maxLod=1000.0), None)
         self.log.context = "initialising persistent resources"
         self._init_shared()
+        if any(r["kind"] == "accel" for r in self.plan["resources"]):
+            self.log.context = "building persistent acceleration structures"
+            self.accels = AccelSet(dev, self.plan, self.resources, self._one_time)
         self._release_for_first_frame()
         self.log.context = "creating pipelines"
         for p in self.plan["passes"]:
@@ -153,8 +163,9 @@ class Executor:
             if p.get("impl"):
                 self.passes.append(ImplPass(dev, self.plan, p, self.resources, sets=FRAMES_IN_FLIGHT,
                                             scene=self._scene, samplers=self.samplers))
+                self.passes[-1].setup.accels = self.accels  # rgraph.vk.accel.AccelSet (impl accel_build)
             else:
-                self.passes.append(ProbePass(dev, self.plan, p, self.resources, self.sampler))
+                self.passes.append(probe_pass(dev, self.plan, p, self.resources, self.sampler, self.accels))
         self.updaters = [p for p in self.passes if isinstance(p, ImplPass) and _overrides_update(p)]
         n = len(self.plan["passes"])
         for _ in range(FRAMES_IN_FLIGHT):
@@ -211,6 +222,8 @@ class Executor:
         by_queue: dict[str, list] = {}
         handoffs: dict[str, list] = {}  # final queue -> images initialised on graphics
         for r in self.resources.shared():
+            if r.plan["kind"] == "accel":  # built by rgraph.vk.accel.AccelSet
+                continue
             queue = r.plan["final"]["queue"]
             if _needs_graphics_copy(r, self.device, queue):
                 handoffs.setdefault(queue, []).append(r)
@@ -546,8 +559,11 @@ class Executor:
             for i, p in enumerate(self.plan["passes"]):
                 per_pass[p["name"]] = float(np.median(ends[:, i] - starts[:, i])) * period
             total = float(np.median(ends.max(axis=1) - starts.min(axis=1))) * period
+        from rgraph.vk.pass_intervals import pass_intervals
+
         return {"passes": per_pass, "total_ms": total, "frames": frames,
-                "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None}
+                "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None,
+                "intervals": pass_intervals(self.plan, rows, period)}
 
     # ----------------------------------------------------------------- readback
     def read_back(self, frames: int) -> dict[tuple, bytes]:
@@ -556,7 +572,7 @@ class Executor:
         s = (frames - 1) % FRAMES_IN_FLIGHT
         out: dict[tuple, bytes] = {}
         wanted = [r for r in self.plan["resources"] if r["lifetime"] in ("output", "persistent", "imported")
-                  and r.get("first") is not None]
+                  and r.get("first") is not None and r["kind"] != "accel"]  # accels: checked through traces
         by_queue: dict[str, list[dict]] = {}
         for res in wanted:
             by_queue.setdefault(res["final"]["queue"], []).append(res)
@@ -643,6 +659,9 @@ class Executor:
             if self.sampler is not None:
                 v.vkDestroySampler(dev.handle, self.sampler, None)
                 self.sampler = None
+            if self.accels is not None:
+                self.accels.destroy()
+                self.accels = None
             if self.resources is not None:
                 self.resources.destroy()
                 self.resources = None

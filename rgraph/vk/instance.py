@@ -172,3 +172,13 @@ def create_instance(validate: bool, app_name: str = "rgraph") -> Instance:
         instance.messenger = create(handle, messenger_info, None)
         instance._callback = callback
     return instance
+
+
+def validation_layer_version() -> tuple[int, int, int] | None:
+    """The installed Khronos validation layer's spec version, or None."""
+    v = vk()
+    for p in v.vkEnumerateInstanceLayerProperties():
+        if p.layerName == VALIDATION_LAYER:
+            s = p.specVersion
+            return (s >> 22, (s >> 12) & 0x3FF, s & 0xFFF)
+    return None

@@ -54,6 +54,24 @@ class DeviceMemoryRequirements:
         req = out.memoryRequirements
         return int(req.size), int(req.alignment), int(req.memoryTypeBits)
 
+    def accel_sizes(self, level: str, count: int, max_vertex: int, update: bool) -> tuple[int, int, int]:
+        from rgraph.vk import accel_sizes
+
+        self._require_rt()
+        return accel_sizes.query(self.device, level, count, max_vertex, update=update)
+
+    def accel_scratch_alignment(self) -> int:
+        from rgraph.vk.rt_device import properties
+
+        self._require_rt()
+        return properties(self.device.physical.handle).min_scratch_offset_alignment
+
+    def _require_rt(self) -> None:
+        if "accelerationStructure" not in self.device.enabled_features:
+            from rgraph.errors import RGraphError
+
+            raise RGraphError.in_file("<device>", f"{self.device.name} was opened without acceleration structures")
+
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
         v = vk()
         info = buffer_create_info(size, usage_names)
@@ -68,12 +86,14 @@ class DeviceMemoryRequirements:
 def live_requirements(device_index: int | None = None) -> Iterator[tuple[DeviceMemoryRequirements, Device]]:
     """The memory-requirements provider of the live device that ``execute_plan(...,
     device_index=device_index)`` will use, and that device; both destroyed on exit."""
-    from rgraph.vk.device import create_device
+    from rgraph.vk.device import choose_physical_device, create_device, list_physical_devices
     from rgraph.vk.instance import create_instance
+    from rgraph.vk.rt_device import supported
 
     instance = create_instance(validate=False)
     try:
-        device = create_device(instance, device_index, verbose=False)
+        physical = choose_physical_device(list_physical_devices(instance), device_index)
+        device = create_device(instance, device_index, verbose=False, ray_tracing=supported(physical.handle))
         try:
             yield DeviceMemoryRequirements(device), device
         finally:

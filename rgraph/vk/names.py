@@ -25,7 +25,16 @@ _BUFFER_USAGE = {
     "uniform": "UNIFORM_BUFFER", "vertex": "VERTEX_BUFFER", "index": "INDEX_BUFFER",
     "indirect": "INDIRECT_BUFFER", "storage_read": "STORAGE_BUFFER", "storage_write": "STORAGE_BUFFER",
     "storage_rw": "STORAGE_BUFFER", "transfer_src": "TRANSFER_SRC", "transfer_dst": "TRANSFER_DST",
+    "accel_storage": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
+    "accel_build": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
+    "accel_read": "ACCELERATION_STRUCTURE_STORAGE_BIT_KHR|0x20000",
+    "accel_scratch": "STORAGE_BUFFER|0x20000",
+    "trace_indirect": "INDIRECT_BUFFER|0x20000",
 }
+SHADER_DEVICE_ADDRESS = 0x20000  # VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT (core 1.2)
+MEMORY_ALLOCATE_DEVICE_ADDRESS = 0x2  # VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
+#: Buffer usages whose memory must be allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT.
+DEVICE_ADDRESS_USAGES = frozenset({"accel_storage", "accel_build", "accel_read", "accel_scratch", "trace_indirect"})
 
 
 def _const(name: str) -> int:
@@ -35,18 +44,26 @@ def _const(name: str) -> int:
         raise ExecutionError(f"unknown Vulkan name {name}") from None
 
 
+def _bit_name(prefix: str, name: str) -> str:
+    """``RAY_TRACING_SHADER_KHR`` -> ``..._RAY_TRACING_SHADER_BIT_KHR`` (vendor suffix after BIT)."""
+    for suffix in ("_KHR", "_EXT", "_NV"):
+        if name.endswith(suffix):
+            return f"{prefix}{name[:-len(suffix)]}_BIT{suffix}"
+    return f"{prefix}{name}_BIT"
+
+
 @cache
 def stage(name: str) -> int:
     if name == "NONE":
         return 0
-    return _const(f"VK_PIPELINE_STAGE_2_{name}_BIT")
+    return _const(_bit_name("VK_PIPELINE_STAGE_2_", name))
 
 
 @cache
 def access(name: str) -> int:
     if name == "NONE":
         return 0
-    return _const(f"VK_ACCESS_2_{name}_BIT")
+    return _const(_bit_name("VK_ACCESS_2_", name))
 
 
 @cache
@@ -92,7 +109,11 @@ def buffer_usage(usages: Iterable[str]) -> int:
     for u in set(usages) | set(RUNTIME_USAGES):
         if u not in _BUFFER_USAGE:
             raise ExecutionError(f"usage {u!r} does not apply to buffers")
-        out |= _const(f"VK_BUFFER_USAGE_{_BUFFER_USAGE[u]}_BIT")
+        for bit in _BUFFER_USAGE[u].split("|"):
+            if bit.startswith("0x"):  # the binding lacks VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT
+                out |= int(bit, 16)
+            else:
+                out |= _const(f"VK_BUFFER_USAGE_{bit}" if bit.endswith("_KHR") else f"VK_BUFFER_USAGE_{bit}_BIT")
     return out
 
 

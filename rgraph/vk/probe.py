@@ -109,8 +109,12 @@ class ProbePass:
         if plan_pass["kind"] == "transfer":
             self._prepare_transfer()
         else:
-            self.shaders = generate(plan_pass, self.res_plan, self.plan_size)
-            self._prepare_pipeline()
+            self._prepare_shaders()
+
+    def _prepare_shaders(self) -> None:
+        """Shaders and pipeline of a compute or raster pass (ray tracing: ``rgraph.vk.probe_rt``)."""
+        self.shaders = generate(self.p, self.res_plan, self.plan_size)
+        self._prepare_pipeline()
 
     # ------------------------------------------------------------------ setup
     def _own(self, destroy: str, handle: Any) -> Any:
@@ -137,17 +141,9 @@ class ProbePass:
                                                    pBindings=layout_bindings or None), None))
         self.layout = self._own("vkDestroyPipelineLayout", v.vkCreatePipelineLayout(
             dev, v.VkPipelineLayoutCreateInfo(setLayoutCount=1, pSetLayouts=[self.set_layout]), None))
-        sets = self.resources.sets
         if sh.bindings:
-            counts: dict[int, int] = {}
-            for b in sh.bindings:
-                counts[kinds[b.kind]] = counts.get(kinds[b.kind], 0) + sets
-            sizes = [v.VkDescriptorPoolSize(type=t, descriptorCount=n) for t, n in counts.items()]
-            self.pool = self._own("vkDestroyDescriptorPool", v.vkCreateDescriptorPool(
-                dev, v.VkDescriptorPoolCreateInfo(maxSets=sets, poolSizeCount=len(sizes), pPoolSizes=sizes), None))
-            self.sets = v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
-                descriptorPool=self.pool, descriptorSetCount=sets, pSetLayouts=[self.set_layout] * sets))
-            for s in range(sets):
+            self._allocate_sets([kinds[b.kind] for b in sh.bindings])
+            for s in range(self.resources.sets):
                 self._write_descriptors(s, kinds)
         modules = {stage: self._own("vkDestroyShaderModule", _module(self.device, compile_glsl(src, stage)))
                    for stage, src in sh.sources.items()}
@@ -158,6 +154,20 @@ class ProbePass:
                 dev, None, 1, [v.VkComputePipelineCreateInfo(stage=stage, layout=self.layout)], None)[0])
             return
         self._prepare_raster(modules)
+
+    def _allocate_sets(self, types: list[int]) -> None:
+        """A pool and one descriptor set of ``self.set_layout`` per frame-in-flight set."""
+        v = vk()
+        sets = self.resources.sets
+        counts: dict[int, int] = {}
+        for t in types:
+            counts[t] = counts.get(t, 0) + sets
+        sizes = [v.VkDescriptorPoolSize(type=t, descriptorCount=n) for t, n in counts.items()]
+        self.pool = self._own("vkDestroyDescriptorPool", v.vkCreateDescriptorPool(
+            self.device.handle, v.VkDescriptorPoolCreateInfo(maxSets=sets, poolSizeCount=len(sizes), pPoolSizes=sizes),
+            None))
+        self.sets = v.vkAllocateDescriptorSets(self.device.handle, v.VkDescriptorSetAllocateInfo(
+            descriptorPool=self.pool, descriptorSetCount=sets, pSetLayouts=[self.set_layout] * sets))
 
     def _write_descriptors(self, set_index: int, kinds: dict[str, int]) -> None:
         v = vk()

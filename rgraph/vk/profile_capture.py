@@ -189,7 +189,13 @@ def capture_profile(device: Device, name: str, format_names: list[str] | None = 
             rejected[info.vk_name] = "no rule of the supported family predicts every sample; samples only"
         format_entries[info.vk_name] = entry
     api = props.apiVersion
+    extra: dict[str, Any] = {}
+    if "accelerationStructure" in device.enabled_features:
+        from rgraph.vk.accel_capture import capture_accel
+
+        extra["accel"] = capture_accel(device)
     return {
+        **extra,
         "format": "rgraph-device-profile/1",
         "name": name,
         "device": device.name,

@@ -15,6 +15,7 @@ from rgraph.vk import names
 from rgraph.vk.device import Device
 from rgraph.vk.loader import vk
 from rgraph.vk.resources import ResourceSet
+from rgraph.vk.rt_record import RayTracingCommands
 
 
 def _aspect_for_layout(format_name: str, layout: str) -> int:
@@ -257,7 +258,7 @@ def _dependency(resources: ResourceSet, set_index: int, specs: list[BarrierSpec]
     return BarrierBatch(dep, [images, buffers, memory], len(images) + len(buffers) + len(memory))
 
 
-class RecordContext:
+class RecordContext(RayTracingCommands):
     """Commands a pass implementation may record. Deliberately no barriers."""
 
     def __init__(self, device: Device, command_buffer: Any) -> None:
@@ -283,7 +284,13 @@ class RecordContext:
         """Bind a ``rgraph.vk.passkit.Pipeline`` and descriptor sets from ``first_set``."""
         v = vk()
         v.vkCmdBindPipeline(self._cb, pipeline.bind_point, pipeline.pipeline)
-        if descriptor_sets:
+        if descriptor_sets and pipeline.bind_point == v.VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR:
+            from rgraph.vk.rt_device import bind_descriptor_sets
+            from rgraph.vk.rt_pipeline import all_rt_stages
+
+            bind_descriptor_sets(self._device, self._cb, pipeline.layout, all_rt_stages(), list(descriptor_sets),
+                                 first_set)
+        elif descriptor_sets:
             v.vkCmdBindDescriptorSets(self._cb, pipeline.bind_point, pipeline.layout, first_set,
                                       len(descriptor_sets), list(descriptor_sets), 0, None)
 
@@ -348,6 +355,3 @@ class RecordContext:
 
     def copy_image_to_buffer(self, src: Any, src_layout: int, dst: Any, regions: list[Any]) -> None:
         vk().vkCmdCopyImageToBuffer(self._cb, src, src_layout, dst, len(regions), regions)
-
-    def trace_rays(self, *args: Any) -> None:
-        raise NotImplementedError("ray tracing passes are not supported by the runtime yet")

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph.vk import names
+from rgraph.vk.debug_names import name_object, resource_name
 from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
@@ -110,7 +111,7 @@ class ResourceSet:
             info = image_create_info(res["format"], res["extent"], res["mips"], res["layers"], res["samples"],
                                      res["usages"], alias=alias)
             return v.vkCreateImage(self.device.handle, info, None)
-        if res["kind"] == "buffer":
+        if res["kind"] in ("buffer", "accel"):  # an accel: the buffer its structures live in
             info = buffer_create_info(res["size_bytes"] or res["bytes"], res["usages"])
             return v.vkCreateBuffer(self.device.handle, info, None)
         raise ExecutionError(f"resource {res['name']!r}: kind {res['kind']!r} is not supported by the runtime")
@@ -140,6 +141,8 @@ class ResourceSet:
                         continue
                     handle = self._create_object(res, alias=res["name"] in aliased)
                     r = Resource(res, handle, set_index)
+                    name_object(self.device, handle, v.VK_OBJECT_TYPE_IMAGE if r.is_image else v.VK_OBJECT_TYPE_BUFFER,
+                                resource_name(res, set_index, copies))
                     if r.is_image:
                         req = v.vkGetImageMemoryRequirements(dev, handle)
                     else:
@@ -156,9 +159,14 @@ class ResourceSet:
                 if bits == 0:
                     raise ExecutionError(f"heap {heap_id}: its resources share no memory type")
                 index = memory_type(self.device, bits, v.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)
-                memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(allocationSize=int(heap["bytes"]),
+                flags = (v.VkMemoryAllocateFlagsInfo(flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
+                         if any(set(r["usages"]) & names.DEVICE_ADDRESS_USAGES for r in residents) else None)
+                memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(pNext=flags, allocationSize=int(heap["bytes"]),
                                                                         memoryTypeIndex=index), None)
                 self.memories.append(memory)
+                name_object(self.device, memory, v.VK_OBJECT_TYPE_DEVICE_MEMORY,
+                            f"heap {heap_id} ({heap.get('memory_class') or '?'})"
+                            + (f" (frame set {set_index})" if copies > 1 else ""))
                 for r in created:
                     offset = int(r.plan["offset"])
                     if r.is_image:
@@ -197,6 +205,8 @@ class ResourceSet:
                     baseArrayLayer=layers[0], layerCount=layers[1] - layers[0]),
             )
             r.views[key] = v.vkCreateImageView(self.device.handle, info, None)
+            name_object(self.device, r.views[key], v.VK_OBJECT_TYPE_IMAGE_VIEW,
+                        f"{r.plan['name']} view mips {mips[0]}:{mips[1]} layers {layers[0]}:{layers[1]}")
         return r.views[key]
 
     def destroy(self) -> None:

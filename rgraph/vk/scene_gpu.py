@@ -60,7 +60,7 @@ class SceneGPU:
         self.sets = sets
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
         try:
-            self.data: SceneData = load_scene_data(source, self.extent)
+            self.data: SceneData = load_scene_data(source, self.extent, int(plan.get("camera", 0)))
         except (OSError, ValueError) as exc:
             raise ExecutionError(f"scene {source}: {exc}") from None
         self._device_buffers: list[_DeviceBuffer] = []

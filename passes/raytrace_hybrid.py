@@ -1,0 +1,121 @@
+"""Hybrid rendering (graphs/rt_hybrid.yaml): a thin raster G-buffer, then ray tracing only
+where it is needed. Same lighting model and materials as ``rt_standalone``
+(``passes.rt_model``); the first surface comes from the G-buffer instead of a camera ray.
+
+- ``rt_gbuffer`` (raster): ``depth`` (d32, reversed-Z), ``gbuf_normal`` (rg16_snorm,
+  octahedral), ``gbuf_material`` (r8_uint, material + 1; 0 = nothing);
+- ``rt_reset_rays`` (compute): ``ray_args`` = (0, 1, 1), the indirect trace arguments;
+- ``rt_classify`` (compute): pixels whose material reflects or refracts are appended to
+  ``ray_list`` (packed y << 16 | x), ``ray_args[0]`` counts them;
+- ``rt_hybrid_shade`` (raytrace, every pixel): the opaque part of the first surface (Phong +
+  shadow rays) or the sky cube map;
+- ``rt_hybrid_secondary`` (raytrace, ``trace_rays_indirect`` over the compacted list): the
+  reflection/refraction ray trees of those pixels, added to the colour (storage_rw).
+"""
+
+from __future__ import annotations
+
+import struct
+from typing import Any
+
+import numpy as np
+
+from rgraph.impl import PassImpl, register
+from rgraph.vk.passkit import Binding
+
+from .raytrace_standalone import RayTracingImpl, frame_constants, max_depth_of
+from .rt_model import material_of
+from .scene_passes import SCENE_FRONT_FACE
+
+GBUFFER = (Binding(8, "sampled", "depth", sampler="nearest"), Binding(9, "sampled", "gbuf_normal", sampler="nearest"),
+           Binding(10, "sampled", "gbuf_material", sampler="nearest"))
+
+
+def needs_secondary_rays(materials) -> np.ndarray:
+    """Per material: 1 when it reflects or refracts (the classification mask)."""
+    return np.array([int(material_of(m).kr > 0 or material_of(m).kt > 0) for m in materials] or [0], dtype=np.uint32)
+
+
+@register("rt_gbuffer")
+class GBuffer(PassImpl):
+    clear_values = {"depth": 0.0, "gbuf_normal": (0.0, 0.0, 0.0, 0.0), "gbuf_material": (0.0, 0.0, 0.0, 0.0)}
+    attachment_load = {"depth": "clear", "gbuf_normal": "clear", "gbuf_material": "clear"}
+
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup)
+        self.scene = setup.scene
+        # no culling: ray tracing sees both faces of every triangle
+        self.pipeline = setup.graphics_pipeline(
+            "rt/gbuffer.vert", "rt/gbuffer.frag", [self.scene.set_layout], vertex_input=self.scene.vertex_input,
+            cull="NONE", front_face=SCENE_FRONT_FACE, depth_test=True, depth_write=True,
+            depth_compare="GREATER_OR_EQUAL")
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set)])
+        self.scene.draw(rec, frame_set)
+
+
+@register("rt_reset_rays")
+class ResetRays(PassImpl):
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup)
+        self.sets = setup.descriptors([Binding(0, "storage_buffer", "ray_args")])
+        self.pipeline = setup.compute_pipeline("rt/reset_rays.comp", [self.sets.layout])
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.dispatch(1, 1)
+
+
+@register("rt_classify")
+class Classify(PassImpl):
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup)
+        from rgraph.scene.build import load_scene_data
+
+        data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
+        mask = needs_secondary_rays(data.materials).tobytes()
+        flags = setup.host_buffer(len(mask), "storage")
+        flags.write(mask)
+        self.sets = setup.descriptors([
+            Binding(0, "sampled", "gbuf_material", sampler="nearest"), Binding(1, "storage_buffer", "ray_args"),
+            Binding(2, "storage_image", "ray_list"), Binding(3, "storage_buffer", buffers=((flags.handle, flags.size),))])
+        self.pipeline = setup.compute_pipeline("rt/classify.comp", [self.sets.layout], push_constant_bytes=8)
+        self.extent = setup.extent_of("gbuf_material")
+        self.push = struct.pack("<2I", *self.extent)
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(-(-self.extent[0] // 8), -(-self.extent[1] // 8))
+
+
+@register("rt_hybrid_shade")
+class HybridShade(RayTracingImpl):
+    raygen = "rt/hybrid_shade.rgen"
+
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup, [Binding(7, "storage_image", "color"), *GBUFFER])
+        self.extent = setup.extent_of("color")
+        self.push = frame_constants(self.data, self.extent, max_depth_of(setup))
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        self._bind(rec, frame_set)
+        rec.push(self.pipeline, self.push)
+        rec.trace_rays(self.pipeline, *self.extent)
+
+
+@register("rt_hybrid_secondary")
+class HybridSecondary(RayTracingImpl):
+    raygen = "rt/hybrid_secondary.rgen"
+
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup, [Binding(7, "storage_image", "color"), *GBUFFER,
+                                 Binding(11, "storage_image", "ray_list")])
+        self.push = frame_constants(self.data, setup.extent_of("color"), max_depth_of(setup))
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        self._bind(rec, frame_set)
+        rec.push(self.pipeline, self.push)
+        args, _size = self.setup.buffer("ray_args", frame_set)
+        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(args))

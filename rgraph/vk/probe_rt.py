@@ -1,0 +1,137 @@
+"""The probe in passes that touch acceleration structures (FORMAT.md 5).
+
+- A compute pass with ``accel_build`` accesses runs the compute probe for its other accesses,
+  then builds (or refits) each accel it writes from the probe geometry.
+- A raytrace pass runs a ray tracing pipeline whose raygen shader is the compute probe plus
+  real rays against each accel it reads (``rgraph.vk.probe_rt_glsl``).
+Ray queries are never used.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rgraph.vk.accel import AccelSet
+from rgraph.vk.device import Device
+from rgraph.vk.errors import ExecutionError
+from rgraph.vk.loader import vk
+from rgraph.vk.probe import ProbePass, compile_glsl
+from rgraph.vk.probe_rt_glsl import generate_rt
+from rgraph.vk.record import RecordContext
+from rgraph.vk.resources import ResourceSet
+from rgraph.vk.rt_pipeline import all_rt_stages, create_rt_pipeline
+
+
+def needs_ray_tracing(plan: dict) -> bool:
+    """Whether a plan has accels or raytrace passes (the device then enables ray tracing)."""
+    return (any(r["kind"] == "accel" for r in plan["resources"])
+            or any(p["kind"] == "raytrace" for p in plan["passes"]))
+
+
+#: The newest Khronos validation layer known to crash inside vkCreateRayTracingPipelinesKHR
+#: (Debian's 1.3.239 on lavapipe: even a raygen-only pipeline; core checks off, it crashes at bind).
+CRASHING_LAYER = (1, 3, 239)
+
+
+def refuse_layer_for_ray_tracing(plan: dict) -> None:
+    """Refuse ``--validate`` for plans with raytrace passes when the layer would crash."""
+    from rgraph.vk.instance import validation_layer_version
+
+    if not any(p["kind"] == "raytrace" for p in plan["passes"]):
+        return
+    version = validation_layer_version()
+    if version is not None and version <= CRASHING_LAYER:
+        raise ExecutionError(
+            f"--validate: the installed Khronos validation layer {'.'.join(map(str, version))} crashes inside "
+            "vkCreateRayTracingPipelinesKHR; run raytrace passes without --validate (the data check and "
+            "`rgraph check` cover them; the layer tracks no ray tracing hazards anyway)")
+
+
+def probe_pass(device: Device, plan: dict, plan_pass: dict, resources: ResourceSet, sampler: Any,
+               accels: AccelSet | None) -> ProbePass:
+    """The probe implementation of ``plan_pass``, ray tracing aware."""
+    if plan_pass["kind"] == "raytrace":
+        return RayTraceProbePass(device, plan, plan_pass, resources, sampler, accels)
+    if any(a["usage"] == "accel_build" for a in plan_pass["accesses"]):
+        return AccelBuildProbePass(device, plan, plan_pass, resources, sampler, accels)
+    if any(a["usage"] == "accel_read" for a in plan_pass["accesses"]):
+        raise ExecutionError(f"pass {plan_pass['name']!r}: the probe reads accels in raytrace passes only "
+                             "(no ray queries)")
+    return ProbePass(device, plan, plan_pass, resources, sampler)
+
+
+class AccelBuildProbePass(ProbePass):
+    def __init__(self, device, plan, plan_pass, resources, sampler, accels: AccelSet | None) -> None:
+        super().__init__(device, plan, plan_pass, resources, sampler)
+        assert accels is not None
+        self.accels = accels
+        self.builds = [a["resource"] for a in plan_pass["accesses"] if a["usage"] == "accel_build"]
+
+    def record(self, ctx: RecordContext, set_index: int) -> None:
+        super().record(ctx, set_index)
+        for name in self.builds:
+            ctx.build_accel(self.accels, name, set_index)
+
+
+class RayTraceProbePass(ProbePass):
+    def __init__(self, device, plan, plan_pass, resources, sampler, accels: AccelSet | None) -> None:
+        self.accels = accels
+        super().__init__(device, plan, plan_pass, resources, sampler)
+
+    def _prepare_shaders(self) -> None:
+        self.rt = generate_rt(self.p, self.res_plan, self.plan_size)
+        if self.rt.accel_bindings and self.accels is None:
+            raise ExecutionError(f"pass {self.p['name']!r}: reads an accel the plan does not build")
+        self.shaders = self.rt.base
+        self._prepare_rt()
+
+    def _prepare_rt(self) -> None:
+        v = vk()
+        dev = self.device.handle
+        kinds = {"sampled": v.VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                 "storage_image": v.VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+                 "storage_buffer": v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                 "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+        accel_type = v.VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR
+        bindings = [(b.binding, kinds[b.kind]) for b in self.shaders.bindings]
+        bindings += [(b, accel_type) for b, _ in self.rt.accel_bindings]
+        layout_bindings = [v.VkDescriptorSetLayoutBinding(binding=b, descriptorType=t, descriptorCount=1,
+                                                          stageFlags=all_rt_stages()) for b, t in bindings]
+        self.set_layout = self._own("vkDestroyDescriptorSetLayout", v.vkCreateDescriptorSetLayout(
+            dev, v.VkDescriptorSetLayoutCreateInfo(bindingCount=len(layout_bindings),
+                                                   pBindings=layout_bindings or None), None))
+        if bindings:
+            self._allocate_sets([t for _, t in bindings])
+            for s in range(self.resources.sets):
+                self._write_descriptors(s, kinds)
+                self._write_accels(s)
+        spirv = {"raygen": [compile_glsl(self.rt.raygen, "rgen")], "miss": [compile_glsl(self.rt.miss, "rmiss")],
+                 "closest_hit": [compile_glsl(self.rt.closest_hit, "rchit")]}
+        self.pipeline = create_rt_pipeline(self.device, spirv, [self.set_layout])
+
+    def _write_accels(self, set_index: int) -> None:
+        v = vk()
+        for binding, access in self.rt.accel_bindings:
+            name = self.p["accesses"][access]["resource"]
+            handles = v.ffi.new("VkAccelerationStructureKHR[1]", [self.accels.tlas(name, set_index)])
+            info = v.VkWriteDescriptorSetAccelerationStructureKHR(accelerationStructureCount=1,
+                                                                  pAccelerationStructures=handles)
+            write = v.VkWriteDescriptorSet(pNext=info, dstSet=self.sets[set_index], dstBinding=binding,
+                                           descriptorCount=1,
+                                           descriptorType=v.VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR)
+            v.vkUpdateDescriptorSets(self.device.handle, 1, [write], 0, None)
+
+    def record(self, ctx: RecordContext, set_index: int) -> None:
+        ctx.bind(self.pipeline, [self.sets[set_index]] if self.sets else [])
+        indirect = [self._resource(i, set_index) for i in self.shaders.indirect_accesses]
+        if len(indirect) > 1:
+            raise ExecutionError(f"pass {self.p['name']!r}: the probe traces through one indirect buffer")
+        if indirect:  # the header's dispatch words (gx, gy, 1): the raygen loop covers the domain
+            ctx.trace_rays_indirect(self.pipeline, ctx.buffer_address(indirect[0].handle) + 4 * 12)
+        else:
+            w, h = self.shaders.domain
+            ctx.trace_rays(self.pipeline, w, h)
+
+    def destroy(self) -> None:
+        self.pipeline.destroy()
+        super().destroy()

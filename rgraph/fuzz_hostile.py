@@ -28,7 +28,7 @@ from random import Random
 from rgraph.fuzz_cases import GENERATORS, Case
 
 LOCATED = re.compile(r"^.+:\d+:\d+: error: \S")
-ARGPARSE = re.compile(r"^rgraph: error: \S")
+ARGPARSE = re.compile(r"^rgraph( [\w-]+)?: error: \S")
 UNSAFE = re.compile("[\x00-\x08\x0b-\x1f\x7f]")
 WALL_S = 20.0
 CPU_S = 15

@@ -49,7 +49,7 @@ def test_frames_are_bounded(graph: Path, capsys, frames: str) -> None:
     with pytest.raises(SystemExit) as info:
         main(["run", str(graph), "--frames", frames])
     assert info.value.code == 2
-    assert "argument --frames: expected an integer in 1..1,000,000" in capsys.readouterr().err
+    assert "error: argument --frames: expected an integer in 1..1,000,000" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("param,message", [

@@ -2,7 +2,7 @@
 each group against a reference setting more accurate than any shipping setting.
 
     PYTHONPATH=. python3 benchmarks/sweeps.py [--size 1920x1080] [--frames 100]
-        [--groups hbao,sss,bloom,shadow,ibl] [--validate] -o DIR
+        [--groups hbao,sss,bloom,shadow,ibl] [--workers N] [--validate] -o DIR
 
 Runs ``rgraph sweep`` (``rgraph.sweep.runner``) once per group into ``DIR/<group>``
 (sweep.csv, sweep.md, Pareto plots, images, error maps), then writes
@@ -75,8 +75,10 @@ def groups(shadow_reference: int) -> dict[str, Group]:
     )}
 
 
-def run_group(group: Group, out: Path, *, size: tuple[int, int], frames: int, validate: bool, progress: bool):
-    """One ``rgraph sweep``: returns (SweepResult, plot paths by knob, metric plotted)."""
+def run_group(group: Group, out: Path, *, size: tuple[int, int], frames: int, validate: bool, progress: bool,
+              executor=None):
+    """One ``rgraph sweep`` (``executor``: its settings in worker processes): returns
+    (SweepResult, plot paths by knob, metric plotted)."""
     from rgraph.sweep import flip
     from rgraph.sweep.runner import SweepRequest, run_sweep
     from rgraph.sweep.settings import parse_assignments, parse_knob
@@ -86,7 +88,7 @@ def run_group(group: Group, out: Path, *, size: tuple[int, int], frames: int, va
                            base=parse_assignments(list(group.base), "-p"),
                            reference=parse_assignments(list(group.reference), "--reference"),
                            size=size, frames=frames, hdr=group.hdr, validate=validate)
-    result = run_sweep(request, out, progress=progress)
+    result = run_sweep(request, out, progress=progress, executor=executor)
     note = flip.missing_note()
     if note and note not in result.notes:
         result.notes.append(note)
@@ -128,7 +130,9 @@ def group_markdown(group: Group, result, plots: dict[str, str], metric: str | No
                                        + [fmt(row.metrics.get(m)) for m in shown]) + " |")
     lines.append("")
     if plots:
-        lines += [f"Pareto plots ({METRIC_TITLES.get(metric or '', metric)} vs frame ms):", ""]
+        lines += [f"Pareto plots ({METRIC_TITLES.get(metric or '', metric)} vs the GPU ms of the passes each knob "
+                  "changes: " + "; ".join(f"`{k}`: {'+'.join(v) or 'frame'}" for k, v in result.knob_passes.items())
+                  + "):", ""]
         lines += [f"![{group.name}: {knob}]({group.name}/{path})" for knob, path in plots.items()] + [""]
     return lines
 
@@ -145,6 +149,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--groups", default="hbao,sss,bloom,shadow,ibl", help="comma-separated subset")
     parser.add_argument("--shadow-reference", type=int, default=8192, help="reference shadow map size (default 8192)")
     parser.add_argument("--validate", action="store_true", help="validation layers on (times not representative)")
+    parser.add_argument("--workers", type=int, metavar="N",
+                        help="every setting in its own worker process, N at a time (rgraph sweep --workers)")
     parser.add_argument("--no-progress", dest="progress", action="store_false")
     parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     args = parser.parse_args(argv)
@@ -157,23 +163,32 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown group(s) {', '.join(unknown)}; known: {', '.join(known)}")
 
     from rgraph.errors import RGraphError
+    from rgraph.sweep.parallel import make_executor
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
+
+    if args.workers is not None and args.workers < 1:
+        parser.error("--workers must be at least 1")
+    executor = make_executor(args.workers)
 
     sections: list[str] = []
     device = "?"
-    messages = 0
+    messages = failures = 0
     start = time.perf_counter()
     for name in chosen:
         group = known[name]
         t0 = time.perf_counter()
         try:
             result, plots, metric = run_group(group, args.out / name, size=size, frames=args.frames,
-                                              validate=args.validate, progress=args.progress and sys.stderr.isatty())
+                                              validate=args.validate, progress=args.progress and sys.stderr.isatty(),
+                                              executor=executor)
         except (RGraphError, ExecutionError, VulkanUnavailable) as exc:
             print(f"sweeps: {name}: error: {exc}", file=sys.stderr)
             return 2
         device = result.device
         messages += len(result.messages())
+        for label, why in result.failures.items():
+            print(f"sweeps: {name}: setting {label} failed: {why}", file=sys.stderr)
+        failures += len(result.failures)
         sections += group_markdown(group, result, plots, metric)
         print(f"sweeps: {name}: {len(result.rows)} settings ({result.renderings} renderings) in "
               f"{time.perf_counter() - t0:.1f} s", file=sys.stderr)
@@ -184,14 +199,15 @@ def main(argv: list[str] | None = None) -> int:
             f"- graph `{GRAPH}` with its scene; each knob moves alone from the graph's defaults; every error is "
             "against the group's reference setting, which is more accurate than any shipping setting "
             "(the truth the knob approximates), not against the knob's highest value",
-            f"- wall time {time.perf_counter() - start:.0f} s" + (f"; {messages} validation message(s)" if args.validate
-                                                                   else ""),
+            f"- wall time {time.perf_counter() - start:.0f} s"
+            + (f" ({executor.description})" if executor else " (one process)")
+            + (f"; {messages} validation message(s)" if args.validate else ""),
             ""]
     args.out.mkdir(parents=True, exist_ok=True)
     path = args.out / "accuracy-vs-time.md"
     path.write_text("\n".join(head + sections) + "\n")
     print(f"sweeps: wrote {path}", file=sys.stderr)
-    return 1 if args.validate and messages else 0
+    return 1 if failures or (args.validate and messages) else 0
 
 
 if __name__ == "__main__":

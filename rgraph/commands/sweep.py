@@ -34,6 +34,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="error shown in the Pareto plots (default: flip, else ssim)")
     parser.add_argument("--validate", action="store_true",
                         help="run every setting under Khronos validation + syncval; exit 1 on any message")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="render the settings in N local worker processes, one process per setting")
+    where.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS",
+                       help="every setting a Ray task in its own worker process (one GPU each on a GPU "
+                            "cluster); ADDRESS of a running cluster, else RAY_ADDRESS or a new local one "
+                            "(pip install 'rgraph[ray]')")
     parser.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     parser.set_defaults(func=run)
@@ -41,6 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from rgraph.sweep import flip
+    from rgraph.sweep.parallel import make_executor
     from rgraph.sweep.runner import SweepRequest, run_sweep
     from rgraph.sweep.settings import parse_assignments, parse_knob
     from rgraph.sweep.writers import plot_metric, write_all
@@ -53,11 +61,21 @@ def run(args: argparse.Namespace) -> int:
         base=parse_params(args.param), reference=parse_assignments(args.reference, "--reference"),
         grid=args.grid, size=parse_size(args.size), frames=args.frames, device=args.device,
         policy=args.policy, hdr=args.hdr, validate=args.validate)
+    if args.workers is not None and args.workers < 1:
+        raise RGraphError.in_file("<command line>", f"--workers must be at least 1, got {args.workers}")
     try:
-        result = run_sweep(request, args.out, progress=args.progress and sys.stderr.isatty())
+        executor = make_executor(args.workers, args.ray, use_ray=args.ray is not None)
+    except ImportError:
+        print("rgraph: error: --ray needs Ray: pip install 'rgraph[ray]'", file=sys.stderr)
+        return 2
+    try:
+        result = run_sweep(request, args.out, progress=args.progress and sys.stderr.isatty(), executor=executor)
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
+    finally:
+        if executor is not None:
+            executor.close()
     note = flip.missing_note()
     if note and note not in result.notes:
         result.notes.append(note)
@@ -70,9 +88,11 @@ def run(args: argparse.Namespace) -> int:
     messages = result.messages()
     for label, message in messages:
         print(f"{label}: {message}", file=sys.stderr)
-    print(f"rgraph: {len(result.rows)} settings ({result.renderings} renderings) on {result.device}; "
+    where = f" in {executor.description}" if executor is not None else ""
+    print(f"rgraph: {len(result.rows)} settings ({result.renderings} renderings) on {result.device}{where}; "
           f"wrote {written['csv']}, {written['md']} and {len(written) - 2} plot(s)", file=sys.stderr)
+    for label, why in result.failures.items():
+        print(f"rgraph: error: setting {label} failed: {why}", file=sys.stderr)
     if args.validate:
         print(f"rgraph: {len(messages)} validation message(s)", file=sys.stderr)
-        return 1 if messages else 0
-    return 0
+    return 1 if result.failures or (args.validate and messages) else 0

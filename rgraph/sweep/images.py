@@ -56,10 +56,19 @@ def display(image: np.ndarray, vk_format: str | None) -> np.ndarray:
     return linear_to_srgb(values) if is_srgb(vk_format) else np.clip(values, 0.0, 1.0)
 
 
-def save_png(path: Path, display_rgb: np.ndarray) -> None:
-    """Write display values in [0, 1] (``H x W x 3``) as an 8-bit PNG."""
+def png_bytes(display_rgb: np.ndarray) -> bytes:
+    """Display values in [0, 1] (``H x W x 3``) as an 8-bit PNG file's bytes."""
+    import io
+
     import matplotlib.image
 
-    path.parent.mkdir(parents=True, exist_ok=True)
     pixels = np.clip(np.rint(np.asarray(display_rgb) * 255.0), 0, 255).astype(np.uint8)
-    matplotlib.image.imsave(path, pixels)
+    buffer = io.BytesIO()
+    matplotlib.image.imsave(buffer, pixels, format="png")
+    return buffer.getvalue()
+
+
+def save_png(path: Path, display_rgb: np.ndarray | bytes) -> None:
+    """Write display values in [0, 1] (``H x W x 3``), or :func:`png_bytes`, as an 8-bit PNG."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(display_rgb if isinstance(display_rgb, bytes) else png_bytes(display_rgb))

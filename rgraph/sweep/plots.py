@@ -1,4 +1,5 @@
-"""Pareto plots (error vs GPU milliseconds, one per knob) and error-map images."""
+"""Pareto plots (error vs GPU milliseconds of the knob's passes, one per knob) and
+error-map images."""
 
 from __future__ import annotations
 
@@ -36,7 +37,8 @@ def _plottable(values: list[float | None]) -> tuple[list[float | None], float | 
 
 
 def pareto_plot(path: Path, *, knob: str, labels: list[str], ms: list[float | None], error: list[float | None],
-                defaults: list[bool], metric: str, title: str, reference_ms: float | None = None) -> bool:
+                defaults: list[bool], metric: str, title: str, reference_ms: float | None = None,
+                xlabel: str = "GPU time per frame (ms, median)") -> bool:
     """Write one knob's plot; False (nothing written) when no point has both coordinates."""
     y, inf_at = _plottable(error)
     points = [(i, t, e) for i, (t, e) in enumerate(zip(ms, y, strict=True)) if t is not None and e is not None]
@@ -69,7 +71,7 @@ def pareto_plot(path: Path, *, knob: str, labels: list[str], ms: list[float | No
         positive = [e for e in ys if e > 0]
         if len(positive) == len(ys) and max(ys) >= 20 * min(ys):
             ax.set_yscale("log")
-        ax.set_xlabel("GPU time per frame (ms, median)")
+        ax.set_xlabel(xlabel)
         better = "lower" if LOWER_IS_BETTER.get(metric, True) else "higher"
         ax.set_ylabel(f"{METRIC_TITLES.get(metric, metric)} vs reference ({better} is better)")
         ax.set_title(title, fontsize=10)

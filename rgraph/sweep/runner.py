@@ -1,22 +1,26 @@
 """Compile and execute every setting of a sweep; time it and compare it with the reference.
 
-Settings with equal resolved params are rendered once. The reference renders first; each
-later rendering is compared, written as PNG and dropped, so memory holds two images.
+Settings with equal resolved params are rendered once, here one after the other (reference
+first) or each in a worker process (``executor``: :mod:`rgraph.sweep.parallel`,
+:mod:`rgraph.sweep.remote`); :mod:`rgraph.sweep.collect` compares and writes every rendering
+as it comes, in any order, and orders the rows as the settings.
 """
 
 from __future__ import annotations
 
-from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgraph.resources import resolve_graph
 from rgraph.spec.loader import load_graph
 from rgraph.sweep import images as image_io
-from rgraph.sweep.compare import Images, compare
+from rgraph.sweep.compare import Images
 from rgraph.sweep.settings import Knob, Setting, expand, numeric_key, params_key, resolved
+
+if TYPE_CHECKING:
+    from rgraph.sweep.parallel import Executor
 
 
 @dataclass
@@ -62,6 +66,9 @@ class SweepResult:
     error_maps: dict[str, list[str]]  # setting label -> PNG paths (relative)
     output_name: str | None  # the LDR image compared
     reference_params: dict[str, Any] = field(default_factory=dict)
+    failures: dict[str, str] = field(default_factory=dict)  # setting label -> why it was not rendered
+    plans: dict[tuple, dict] = field(default_factory=dict)  # params key -> compiled plan
+    knob_passes: dict[str, list[str]] = field(default_factory=dict)  # knob -> passes it changes (affected.py)
 
     @property
     def renderings(self) -> int:
@@ -96,10 +103,10 @@ class _Rendering:
     messages: list[str]
     device: str
     images: Images
-
-
-Compile = Callable[[Setting], dict]
-Progress = Callable[[str], None]
+    notes: list[str] = field(default_factory=list)
+    params_read: dict[str, list[str]] = field(default_factory=dict)  # pass -> params its impl looked up
+    png: bytes | None = None  # the display image as PNG (encoded where it rendered: a worker, in parallel)
+    compared: tuple[dict[str, float | None], list[str]] | None = None  # metrics, when a worker had the reference
 
 
 def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: bool) -> list[str]:
@@ -119,9 +126,15 @@ def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: boo
     return labels
 
 
-def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) -> SweepResult:
-    """Render every setting of ``request``; write images and error maps under ``out_dir``."""
-    from rgraph.sweep import plots  # matplotlib: only when sweeping
+def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
+              executor: Executor | None = None) -> SweepResult:
+    """Render every setting of ``request``; write images and error maps under ``out_dir``.
+
+    ``executor`` (``rgraph.sweep.parallel``): every distinct setting in its own worker
+    process, compiled and rendered there; a setting that fails twice is reported in
+    ``SweepResult.failures`` and its row left empty. Without one, every setting renders here,
+    one after the other, and the first failure raises."""
+    from rgraph.sweep.collect import Collector
 
     source = load_graph(resolve_graph(request.graph))
     settings = expand(source, request.knobs, base=request.base, reference=request.reference, grid=request.grid)
@@ -129,53 +142,20 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True) ->
     distinct: dict[tuple, Setting] = {}
     for s in settings:
         distinct.setdefault(params_key(resolved_params[s.label]), s)
-    plans = _compile_all(request, list(distinct.values()))
-    extremes = set(extreme_labels(settings, request.knobs, request.grid))
-    notes: list[str] = []
-    renderings: dict[tuple, _Rendering] = {}
-    rows: list[Row] = []
-    error_maps: dict[str, list[str]] = {}
-    uses = Counter(params_key(resolved_params[s.label]) for s in settings)
-    reference_key = params_key(resolved_params["reference"])
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with _progress_bar(progress, len(distinct)) as step:
-        reference: _Rendering | None = None
-        for s in settings:
-            key = params_key(resolved_params[s.label])
-            if key not in renderings:
-                step(s.label)
-                renderings[key] = _render(request, plans[key], notes)
-            rendering = renderings[key]
-            if reference is None:
-                reference = rendering
-            values, more = compare(reference.images, rendering.images)
-            notes.extend(n for n in (f"{s.label}: {m}" for m in more) if n not in notes)
-            image = None
-            if rendering.images.ldr is not None:
-                image = f"images/{s.slug}.png"
-                image_io.save_png(out_dir / image, rendering.images.ldr)
-            if s.label in extremes and reference.images.ldr is not None and rendering.images.ldr is not None \
-                    and reference.images.ldr.shape == rendering.images.ldr.shape:
-                error_maps[s.label] = plots.write_error_maps(out_dir, s.slug, reference.images.ldr,
-                                                             rendering.images.ldr)
-            rows.append(Row(s, resolved_params[s.label], rendering.pass_ms, rendering.total_ms, values,
-                            rendering.messages, image, list(renderings).index(key)))
-            uses[key] -= 1
-            if uses[key] == 0 and key != reference_key:
-                rendering.images = Images(None, None)  # compared and written: free the pixels
-    first_plan = plans[reference_key]
-    pass_names: list[str] = []
-    for plan in plans.values():
-        pass_names += [p["name"] for p in plan["passes"] if p["name"] not in pass_names]
-    order = {p["name"]: i for i, p in enumerate(first_plan["passes"])}
-    pass_names.sort(key=lambda n: order.get(n, len(order)))
-    outputs = image_io.output_image_resources(first_plan)
-    return SweepResult(
-        request=request, graph_name=first_plan["graph"], scene=first_plan.get("scene"),
-        device=next(iter(renderings.values())).device, defaults=resolved_params["default"], rows=rows,
-        pass_names=pass_names, notes=notes, error_maps=error_maps,
-        output_name=outputs[0]["name"] if outputs else None, reference_params=resolved_params["reference"],
-    )
+    collector = Collector(request, settings, resolved_params, out_dir)
+    with _progress_bar(progress, len(distinct)) as bar:
+        if executor is None:
+            plans = _compile_all(request, list(distinct.values()))
+            for key, s in distinct.items():
+                bar.step(s.label)
+                collector.add(key, _render(request, plans[key]))
+        else:
+            from rgraph.sweep.remote import jobs, render_job
+
+            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images)):
+                collector.add(outcome.key, outcome.value, outcome.error)
+                bar.finished(distinct[outcome.key].label + ("" if outcome.ok else " (failed)"))
+    return collector.result()
 
 
 def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, dict]:
@@ -194,7 +174,7 @@ def _compile_all(request: SweepRequest, settings: list[Setting]) -> dict[tuple, 
     return plans
 
 
-def _render(request: SweepRequest, plan: dict, notes: list[str]) -> _Rendering:
+def _render(request: SweepRequest, plan: dict) -> _Rendering:
     from rgraph.vk.executor import execute_plan
 
     result = execute_plan(plan, validate=request.validate, frames=request.frames, device_index=request.device,
@@ -202,29 +182,30 @@ def _render(request: SweepRequest, plan: dict, notes: list[str]) -> _Rendering:
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None
+    notes: list[str] = []
     if outputs and outputs[0]["name"] in arrays:
         ldr = image_io.display(arrays[outputs[0]["name"]], outputs[0]["format"])
     if request.hdr and request.hdr in arrays:
         hdr = image_io.rgb(arrays[request.hdr])
     elif request.hdr:
-        note = f"HDR metrics not computed: the run gave no float image of '{request.hdr}'"
-        if note not in notes:
-            notes.append(note)
+        notes.append(f"HDR metrics not computed: the run gave no float image of '{request.hdr}'")
     timings = result.timings or {}
     pass_ms = {p["name"]: timings.get("passes", {}).get(p["name"]) for p in plan["passes"]}
     return _Rendering(plan, pass_ms, timings.get("total_ms"), [str(m) for m in result.messages],
-                      result.device_name, Images(ldr, hdr))
+                      result.device_name, Images(ldr, hdr), notes, result.params_read,
+                      None if ldr is None else image_io.png_bytes(ldr))
 
 
 class _progress_bar:
-    """A rich progress bar on stderr (or nothing); calling it names the next rendering."""
+    """A rich progress bar on stderr (or nothing): ``step`` names the next rendering here,
+    ``finished`` counts one that a worker finished."""
 
     def __init__(self, enabled: bool, total: int) -> None:
         self.enabled, self.total = enabled, total
         self.bar: Any = None
         self.task: Any = None
 
-    def __enter__(self) -> Progress:
+    def __enter__(self) -> _progress_bar:
         if self.enabled:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -233,7 +214,12 @@ class _progress_bar:
                                 TextColumn("{task.description}"), console=Console(stderr=True))
             self.bar.start()
             self.task = self.bar.add_task("", total=self.total)
-        return self.step
+        return self
+
+    def finished(self, label: str) -> None:
+        """A rendering finished elsewhere (a worker): advance by one."""
+        if self.bar is not None:
+            self.bar.update(self.task, advance=1, description=label)
 
     def step(self, label: str) -> None:
         if self.bar is not None:

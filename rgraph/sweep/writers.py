@@ -1,4 +1,5 @@
-"""A sweep's results as ``sweep.csv``, ``sweep.md`` and one Pareto plot per knob."""
+"""A sweep's results as ``sweep.csv``, ``sweep.md`` and one Pareto plot per knob (error
+against the GPU time of the passes the knob changes: :mod:`rgraph.sweep.affected`)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from rgraph.sweep.affected import passes_ms
 from rgraph.sweep.compare import HDR_METRICS, METRICS
 from rgraph.sweep.plots import METRIC_TITLES, pareto_plot
 from rgraph.sweep.runner import Row, SweepResult
@@ -66,8 +68,23 @@ def plot_metric(result: SweepResult, wanted: str | None = None) -> str | None:
     return None
 
 
+def knob_axis(result: SweepResult, knob: str) -> tuple[list[str], str]:
+    """The passes a knob's plot times and its axis label (the whole frame when the knob
+    changes no pass)."""
+    passes = result.knob_passes.get(knob, [])
+    if not passes:
+        return [], "GPU time per frame (ms, median)"
+    return passes, f"GPU time of {'+'.join(passes)} (ms, median)"
+
+
+def row_ms(row: Row, passes: list[str]) -> float | None:
+    """The row's GPU ms of ``passes`` (its frame's when none)."""
+    return passes_ms(row.pass_ms, passes) if passes else row.total_ms
+
+
 def write_plots(result: SweepResult, out_dir: Path, metric: str | None) -> dict[str, str]:
-    """One Pareto plot per knob: knob -> PNG path relative to ``out_dir``."""
+    """One Pareto plot per knob, against the GPU time of the passes it changes: knob -> PNG
+    path relative to ``out_dir``."""
     if metric is None:
         return {}
     reference = next((r for r in result.rows if r.setting.role == "reference"), None)
@@ -75,13 +92,14 @@ def write_plots(result: SweepResult, out_dir: Path, metric: str | None) -> dict[
     frames = result.request.frames
     for knob in knob_names(result):
         rows = result.rows_for_knob(knob)
+        passes, xlabel = knob_axis(result, knob)
         rel = f"pareto_{knob}.png"
         ok = pareto_plot(
             out_dir / rel, knob=knob, labels=[fmt(r.params.get(knob)) for r in rows],
-            ms=[r.total_ms for r in rows], error=[r.metrics.get(metric) for r in rows],
+            ms=[row_ms(r, passes) for r in rows], error=[r.metrics.get(metric) for r in rows],
             defaults=[r.params.get(knob) == result.defaults.get(knob) for r in rows], metric=metric,
             title=f"{result.graph_name}: {knob} ({result.device}, median of {frames} frames)",
-            reference_ms=reference.total_ms if reference else None)
+            reference_ms=row_ms(reference, passes) if reference else None, xlabel=xlabel)
         if ok:
             written[knob] = rel
     return written
@@ -119,8 +137,12 @@ def markdown(result: SweepResult, plots: dict[str, str], metric: str | None) -> 
     header = ["pass"] + [r.setting.label for r in result.rows]
     body = [[p] + [fmt(r.pass_ms.get(p)) for r in result.rows] for p in result.pass_names]
     lines += _table(header, body, 1) + [""]
+    if result.knob_passes:
+        lines += ["## Passes each knob changes (the time axis of its plot)", ""]
+        lines += [f"- `{k}`: " + (", ".join(f"`{p}`" for p in v) if v else "none found (plotted against the frame)")
+                  for k, v in result.knob_passes.items()] + [""]
     if plots:
-        lines += [f"## Pareto plots ({METRIC_TITLES.get(metric or '', metric)} vs ms)", ""]
+        lines += [f"## Pareto plots ({METRIC_TITLES.get(metric or '', metric)} vs GPU ms of the knob's passes)", ""]
         lines += [f"![{knob}]({path})" for knob, path in plots.items()] + [""]
     if result.error_maps:
         lines += ["## Error maps (lowest and highest value of each knob)", ""]

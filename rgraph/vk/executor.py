@@ -57,6 +57,8 @@ class RunResult:
     # read-back outputs as shader-visible values: images (h, w, c) float32 (layers > 1: (layers, h, w, c),
     # mip 0), buffers uint8; present when asked for (read_outputs) or when checking data
     outputs: dict[str, Any] = field(default_factory=dict)
+    # pass name -> the params its implementation looked up (rgraph.vk.passkit.PassParams)
+    params_read: dict[str, list[str]] = field(default_factory=dict)
 
 
 @dataclass
@@ -878,9 +880,10 @@ def execute_plan(plan: dict, *, validate: bool = False, frames: int = 1, device_
                 w, h = mip_extent(res, 0)
                 write_png(Path(out_png), _png_rgba(res, data[(res["name"], 0, 0)], w, h, bool(implemented)))
     finally:
+        params_read = {p.setup.name: sorted(p.setup.params.read) for p in executor.passes if isinstance(p, ImplPass)}
         messages = executor.close()
     return RunResult(list(messages), timings, data_ok, executor.device.name if executor.device else "?",
-                     mismatches, unchecked, outputs)
+                     mismatches, unchecked, outputs, params_read)
 
 
 def _png_rgba(res: dict, raw: bytes, w: int, h: int, implemented: bool) -> Any:

@@ -76,6 +76,28 @@ _BLENDS = {
 }
 
 
+class PassParams(dict):
+    """A pass's params (the graph's, then its own); remembers the names looked up, so a sweep
+    knows which passes a knob reaches (``RunResult.params_read``)."""
+
+    def __init__(self, values: dict[str, Any]) -> None:
+        super().__init__(values)
+        self.read: set[str] = set()
+
+    def __getitem__(self, name: str) -> Any:
+        self.read.add(name)
+        return super().__getitem__(name)
+
+    def get(self, name: str, default: Any = None) -> Any:
+        self.read.add(name)
+        return super().get(name, default)
+
+    def __contains__(self, name: object) -> bool:
+        if isinstance(name, str):
+            self.read.add(name)
+        return super().__contains__(name)
+
+
 class PassSetup:
     """Everything an implementation may use to prepare itself; see ``rgraph.impl``."""
 
@@ -93,7 +115,7 @@ class PassSetup:
         self.size: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
         self.extent: tuple[int, int] = extent or self.size
         self.layers = layers  # framebuffer layers of a raster pass (layered attachments)
-        self.params: dict[str, Any] = {**plan.get("params", {}), **plan_pass.get("params", {})}
+        self.params = PassParams({**plan.get("params", {}), **plan_pass.get("params", {})})
         self.features: dict[str, Any] = dict(plan.get("features", {}))
         self._scene = scene
         self._samplers = samplers if samplers is not None else {}

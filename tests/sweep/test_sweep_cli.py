@@ -3,30 +3,16 @@ its knob (a supersampled zone plate), the bundled surgery graph, and bad input."
 
 from __future__ import annotations
 
-import csv
 import math
 
 import pytest
 import sweep_fixtures.passes as zoneplate  # registers the fixture's pass implementations
+from sweep_helpers import rows as _rows
+from sweep_helpers import sweep as _sweep
 
-from rgraph.cli import main
 from rgraph.sweep import flip
 
 pytestmark = pytest.mark.vulkan
-
-
-def _sweep(argv):
-    from rgraph.vk.errors import VulkanUnavailable
-
-    try:
-        return main(["sweep", *argv])
-    except VulkanUnavailable as exc:  # pragma: no cover - environment without Vulkan
-        pytest.skip(str(exc))
-
-
-def _rows(out):
-    with (out / "sweep.csv").open() as f:
-        return {r["setting"]: r for r in csv.DictReader(f)}
 
 
 def test_zoneplate_sweep_measures_real_error(tmp_path, capsys):

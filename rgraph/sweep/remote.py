@@ -1,0 +1,160 @@
+"""One sweep setting rendered in a worker process (``--workers``, ``--ray``).
+
+The parent sends a :class:`RenderJob` per distinct setting; the worker compiles the setting
+with its own device's memory requirements and renders it exactly as the one-process sweep
+does (``runner._compile_all``, ``runner._render``),
+then hands the rendering (plan, times, messages, images) back; a job made after the
+reference rendered carries the reference's images, and its worker computes the metrics too.
+
+A worker is a fresh interpreter: the job carries the parent's ``sys.path`` and the modules
+that registered the graph's pass implementations there (a user's passes, a test fixture),
+by name and file, and imports them first.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import importlib.util
+import os
+import signal
+import sys
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rgraph.sweep.settings import Setting
+
+#: Test-only fault injection, read by the parent (never from a graph file): ``LABEL@MARKER``
+#: SIGKILLs the worker of setting LABEL once (it creates the file MARKER first; the retry finds
+#: it); ``LABEL`` alone kills every attempt.
+KILL_ENV = "RGRAPH_TEST_KILL_ONCE"
+
+
+@dataclass(frozen=True)
+class RenderJob:
+    request: Any  # rgraph.sweep.runner.SweepRequest
+    setting: Setting
+    sys_path: tuple[str, ...]
+    modules: tuple[tuple[str, str | None], ...]  # (name, file) of modules registering the graph's impls
+    fault: str | None = None
+    reference: Any = None  # the reference's Images once rendered: the worker compares with it
+
+
+def implementation_modules(impls: set[str]) -> tuple[tuple[str, str | None], ...]:
+    """(module, file) of the implementations ``impls`` registered in this process outside
+    rgraph (whose own passes every process loads)."""
+    from rgraph import impl
+
+    modules = {impl._REGISTRY[name].__module__ for name in impls if name in impl._REGISTRY}
+    out = []
+    for name in sorted(modules):
+        if name.startswith("rgraph.") or name in ("__main__", "__mp_main__"):
+            continue
+        out.append((name, getattr(sys.modules.get(name), "__file__", None)))
+    return tuple(out)
+
+
+def _graph_impls(request: Any) -> set[str]:
+    from rgraph.resources import resolve_graph
+    from rgraph.spec.loader import load_graph
+
+    source = load_graph(resolve_graph(request.graph))
+    return {p.model.impl for p in source.passes.values() if getattr(p.model, "impl", None)}
+
+
+def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
+         env: Mapping[str, str] | None = None) -> Iterator[tuple[Any, RenderJob]]:
+    """(params key, job) per distinct setting, in the given order (the reference first).
+    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
+    so its worker computes the metrics too."""
+    env = os.environ if env is None else env
+    fault = env.get(KILL_ENV) or None
+    request = dataclasses.replace(request, graph=_absolute(request.graph), scene=_absolute(request.scene))
+    sys_path = tuple(p for p in sys.path if p)
+    modules = implementation_modules(_graph_impls(request))
+    for key, setting in settings.items():
+        images = reference() if reference is not None and setting.label != "reference" else None
+        yield key, RenderJob(request, setting, sys_path, modules, fault, images)
+
+
+def _absolute(path: str | None) -> str | None:
+    """A file path made absolute (a worker may start elsewhere); names (``surgery``) as given."""
+    return str(Path(path).resolve()) if path and Path(path).is_file() else path
+
+
+def _prepare(job: RenderJob) -> None:
+    for entry in reversed(job.sys_path):
+        if entry not in sys.path and Path(entry).exists():
+            sys.path.insert(0, entry)
+    for module, file in job.modules:
+        if module in sys.modules:
+            continue
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError:
+            if not file:
+                raise
+            spec = importlib.util.spec_from_file_location(module, file)
+            loaded = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+            sys.modules[module] = loaded
+            spec.loader.exec_module(loaded)  # type: ignore[union-attr]
+
+
+def _inject_fault(job: RenderJob) -> None:
+    if not job.fault:
+        return
+    label, sep, marker = job.fault.partition("@")
+    if label != job.setting.label:
+        return
+    if sep:
+        if Path(marker).exists():
+            return
+        Path(marker).write_text(f"killed {label} once (pid {os.getpid()})\n")
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def gpu_device_index(devices: Sequence[Any], gpu: int) -> int | None:
+    """The Vulkan index of the ``gpu``-th GPU (discrete or integrated, in Vulkan's order)."""
+    gpus = [d.index for d in devices if d.device_type in ("discrete", "integrated")]
+    return gpus[gpu] if 0 <= gpu < len(gpus) else None
+
+
+def _device_index(request: Any) -> int | None:
+    """``--device`` when given; in a Ray GPU task, the Vulkan GPU of Ray's GPU id."""
+    from rgraph.sweep.parallel import assigned_gpu
+
+    if request.device is not None:
+        return request.device
+    gpu = assigned_gpu()
+    if gpu is None:
+        return None
+    from rgraph.vk.device import list_physical_devices
+    from rgraph.vk.instance import create_instance
+
+    instance = create_instance(validate=False)
+    try:
+        return gpu_device_index(list_physical_devices(instance), gpu)
+    finally:
+        instance.destroy()
+
+
+def render_job(job: RenderJob) -> Any:
+    """Compile and render one setting (in a worker process): a runner ``_Rendering``."""
+    from rgraph.sweep.runner import _compile_all, _render
+
+    _prepare(job)
+    _inject_fault(job)
+    request = job.request
+    index = _device_index(request)
+    if index != request.device:
+        request = dataclasses.replace(request, device=index)
+    plans = _compile_all(request, [job.setting])
+    (plan,) = plans.values()
+    rendering = _render(request, plan)
+    if job.reference is not None:
+        from rgraph.sweep.compare import compare
+
+        rendering.compared = compare(job.reference, rendering.images)
+    return rendering

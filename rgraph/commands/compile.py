@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from rgraph.commands.common import add_compile_arguments, add_graph_arguments, compile_from_args
+from rgraph.commands.outputs import check_output_file, write_output
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -22,12 +22,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from rgraph.plan import dumps
 
+    if args.output:
+        check_output_file(args.output, "-o")
     plan = compile_from_args(args)
     text = dumps(plan)
     if args.json:
         return _json(args, plan, text)
     if args.output:
-        Path(args.output).write_text(text)
+        write_output(args.output, text, "-o")
         print(f"wrote {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(text)
@@ -39,7 +41,7 @@ def _json(args: argparse.Namespace, plan: dict, text: str) -> int:
     from rgraph.report.summary import counted_barriers
 
     if args.output:
-        Path(args.output).write_text(text)
+        write_output(args.output, text, "-o")
     barriers, releases = counted_barriers(plan)
     body = {"file": plan.get("source"), "graph": plan.get("graph"), "output": args.output,
             "passes": [p["name"] for p in plan["passes"]], "culled": plan.get("culled") or [],

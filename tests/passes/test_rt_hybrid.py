@@ -68,9 +68,9 @@ def test_no_reflective_or_refractive_materials_culls_the_secondary_rays(tmp_path
     assert not full["culled"]
 
 
-# The rt_gallery camera-4 failure in miniature (13.2 dB on the H200): the camera and a point light
-# inside a thin wall box, whose inner faces are seen at grazing angles. A first-surface position
-# rebuilt from raster depth lies a little behind such a face, so its shadow rays hit the face itself.
+# A grazing view: the camera and a point light inside a thin box (the old rt_gallery camera 4),
+# inner faces seen edge-on, a light 5 cm from them. Guards the visibility-buffer reconstruction
+# (hit point, normals, ray offsets) there; the depth-based G-buffer also passed it on lavapipe.
 GRAZING = """scene: 1
 name: rt_grazing
 camera: {position: [0.0, 3.4, 0.5], look_at: [0.0, 0.0, -0.5], fov_y: 70}

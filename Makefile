@@ -20,6 +20,7 @@ test-slow: setup
 	$(PY) -m pytest -q -m slow --timeout 3600
 
 fuzz: setup
+	$(PY) -m rgraph.fuzz_hostile --cases $(or $(HOSTILE_CASES),3000) --seed $(or $(SEED),1)
 	RGRAPH_FUZZ_EXAMPLES=500 $(PY) -m pytest -q -m slow -k fuzz --timeout 7200
 
 lint: setup

@@ -10,7 +10,7 @@ side at reduction factor f, at most 28), ``bloom.sigma`` (radius/2, HDR pixels),
 
 from __future__ import annotations
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
@@ -37,6 +37,10 @@ def _groups(extent: tuple[int, int]) -> tuple[int, int]:
 @register("bloom_bright")
 class BloomBright(PassImpl):
     """Reads its sampled source (``hdr``), writes its storage image (``bloom_a``) at reduced size."""
+    param_schema = {
+        "bloom.threshold": Param(float, 0, 65504), "bloom.knee": Param(float, 0, 65504),
+        "bloom.clamp": Param(float, 0, 65504), "bloom.scale": Param(float, 1 / 64, 1),
+    }
 
     def __init__(self, setup):
         super().__init__(setup)
@@ -65,6 +69,10 @@ class BloomBright(PassImpl):
 class BloomBlur(PassImpl):
     """One separable Gaussian pass from its sampled source to its storage image (same size);
     radius and sigma given in HDR pixels, divided by the reduction factor along its axis."""
+    param_schema = {
+        "bloom.direction": Param(str, choices=("h", "v")), "bloom.sigma": Param(float, 1e-3, 1024),
+        "bloom.radius": Param(float, 0, 1024), "bloom.scale": Param(float, 1 / 64, 1),
+    }
 
     def __init__(self, setup):
         super().__init__(setup)
@@ -98,6 +106,7 @@ class BloomBlur(PassImpl):
 @register("bloom_combine")
 class BloomCombine(PassImpl):
     """Adds ``bloom.intensity`` times its sampled bloom image (bilinear) to its blended attachment."""
+    param_schema = {"bloom.intensity": Param(float, 0, 1e3), "bloom.scale": Param(float, 1 / 64, 1)}
 
     def __init__(self, setup):
         super().__init__(setup)

@@ -23,7 +23,7 @@ triangles). NumPy reference of the shading: passes/forward_ref.py.
 
 from __future__ import annotations
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, PassSetup
 
@@ -53,6 +53,10 @@ def ao_combine_mode(setup: PassSetup) -> int:
 @register("forward_pbr")
 class ForwardPBR(PassImpl):
     """See the module docstring."""
+    param_schema = {
+        "forward.ao_combine": Param(int, choices=(0, 1, 2)), "shadow.pcf_taps": Param(int, 1, 64),
+        "forward.ibl_intensity": Param(float, 0, 1e3), "depth_prepass.cull": Param(str, choices=("back", "front", "none")),
+    }
 
     clear_values = {"diffuse": (0.0, 0.0, 0.0, 0.0), "specular": (0.0, 0.0, 0.0, 0.0),
                     "normal_sss": (0.5, 0.5, 0.5, 0.0)}

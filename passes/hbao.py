@@ -20,11 +20,18 @@ What each computes, exactly: ``passes/hbao_ref.py``.
 
 from __future__ import annotations
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.passkit import Binding, pack
 
 from .hbao_ref import HBAOSettings, quarter_extent
 from .screenspace_ref import screen_camera
+
+HBAO_PARAMS = {
+    "hbao.directions": Param(int, 1, 64), "hbao.steps": Param(int, 1, 64),
+    "hbao.radius": Param(float, 1e-6, 1e6), "hbao.angle_bias": Param(float, 0, 1.5),
+    "hbao.strength": Param(float, 0, 100), "hbao.max_radius_px": Param(float, 1, 16384),
+    "hbao.upsample_sharpness": Param(float, 0, 1e4), "hbao.scale": Param(float, 1 / 64, 1),
+}
 
 
 def _groups(extent: tuple[int, int]) -> tuple[int, int]:
@@ -55,6 +62,7 @@ def _proj(setup) -> bytes:
 @register("hbao_downsample")
 class HBAODownsample(PassImpl):
     """Nearest-surface (max reversed-Z) depth of each k x k block (a copy at k = 1)."""
+    param_schema = HBAO_PARAMS
 
     def __init__(self, setup):
         super().__init__(setup)
@@ -74,6 +82,7 @@ class HBAODownsample(PassImpl):
 @register("hbao")
 class HBAO(PassImpl):
     """Horizon-based AO at the working resolution."""
+    param_schema = HBAO_PARAMS
 
     def __init__(self, setup):
         super().__init__(setup)
@@ -96,6 +105,7 @@ class HBAO(PassImpl):
 @register("hbao_upsample")
 class HBAOUpsample(PassImpl):
     """Depth-aware (joint bilateral) upsample of the working-res AO to full resolution."""
+    param_schema = HBAO_PARAMS
 
     def __init__(self, setup):
         super().__init__(setup)

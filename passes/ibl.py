@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import struct
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import Binding, PassSetup, pack
 
@@ -53,6 +53,7 @@ class _BuildOnce:
 @register("ibl_brdf_lut")
 class BrdfLut(PassImpl):
     """Split-sum BRDF LUT (Karis 2013, Smith height-correlated visibility) into ``brdf_lut``."""
+    param_schema = {"ibl.static": Param(bool), "ibl.samples": Param(int, 1, 65536)}
 
     def __init__(self, setup: PassSetup) -> None:
         super().__init__(setup)
@@ -73,6 +74,7 @@ class BrdfLut(PassImpl):
 @register("ibl_prefilter")
 class Prefilter(PassImpl):
     """GGX-prefiltered procedural environment into every mip of ``env_map``."""
+    param_schema = {"ibl.static": Param(bool), "ibl.samples": Param(int, 1, 65536)}
 
     def __init__(self, setup: PassSetup) -> None:
         super().__init__(setup)

@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.mesh_pool import MIB, AllocationLimitError, MeshPool, PoolBuffer
 from rgraph.vk.passkit import VertexInput
@@ -221,6 +221,13 @@ class _Wobble:
 @register("mesh_lines")
 class MeshLines(PassImpl):
     """See the module docstring."""
+    param_schema = {
+        "alloc.block_mib": Param(int, choices=(0, 4, 16, 64, 256)), "alloc.meshes": Param(int, 0, 1 << 20),
+        "alloc.segments": Param(int, 0, 1 << 20), "alloc.deformable_fraction": Param(float, -1, 1),
+        "alloc.load_factor": Param(float, 1, 64), "alloc.dynamic_memory": Param(str, choices=("host", "device_local")),
+        "alloc.max_allocations": Param(int, 0, 1 << 32), "alloc.over_limit": Param(str, choices=("error", "try")),
+        "alloc.report": Param(str, output=True),
+    }
 
     clear_values: ClassVar[dict[str, Any]] = {"color": (0.02, 0.02, 0.03, 1.0), "depth": 0.0}
     #: The figures of the most recent instance (the benchmark reads them in-process).

@@ -130,12 +130,16 @@ class RayTracingImpl(PassImpl):
             descriptorPool=pool, descriptorSetCount=setup.sets, pSetLayouts=[layout] * setup.sets))
         return layout, list(sets)
 
+    def shader_defines(self) -> dict[str, object]:
+        """Defines of the pipeline's shaders (``self.data`` is loaded)."""
+        return {}
+
     def _pipeline(self) -> Any:
         from rgraph.vk.rt_pipeline import create_rt_pipeline
         from rgraph.vk.shaders import compile_shader, find_shader
 
         def spirv(path: str) -> bytes:
-            return compile_shader(find_shader(path)).spirv
+            return compile_shader(find_shader(path), defines=self.shader_defines()).spirv
 
         return create_rt_pipeline(self.setup.device, {
             "raygen": [spirv(self.raygen)], "miss": [spirv("rt/miss.rmiss"), spirv("rt/shadow.rmiss")],

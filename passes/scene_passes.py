@@ -8,7 +8,7 @@ reversed-Z infinite projection, reversed orthographic shadow depth). NumPy refer
 
 from __future__ import annotations
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
@@ -25,6 +25,7 @@ class DepthPrepass(PassImpl):
     """Writes ``depth`` (d32_sfloat): reversed-Z (clear 0, GREATER_OR_EQUAL), infinite far plane,
     invariant positions from ``scene_clip_position`` (forward matches them bit for bit).
     Param ``depth_prepass.cull`` (``back`` default, or ``none``)."""
+    param_schema = {"depth_prepass.cull": Param(str, choices=("back", "front", "none"))}
 
     clear_values = {"depth": 0.0}
     attachment_load = {"depth": "clear"}
@@ -49,6 +50,7 @@ class ShadowMap(PassImpl):
     one pipeline for every layer, the layer by push constant and ``gl_Layer`` in the vertex
     shader (Vulkan 1.2 ``shaderOutputLayer``). Reversed orthographic depth (clear 0, 1 nearest
     the light), depth bias ``shadow.bias_constant``/``shadow.bias_slope``."""
+    param_schema = {"shadow.bias_constant": Param(float, -1e6, 1e6), "shadow.bias_slope": Param(float, -1e6, 1e6)}
 
     clear_values = {"shadow_maps": 0.0}
     attachment_load = {"shadow_maps": "clear"}

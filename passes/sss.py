@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.passkit import Binding
 
 from .screenspace_ref import screen_camera
@@ -41,6 +41,11 @@ def direction_of(setup) -> str:
 class SSSBlur(PassImpl):
     """One direction of the separable SSS blur (or, with ``sss.kernel=2d``, the whole 2D blur
     in the ``h`` pass and a copy in the ``v`` pass), written to the pass's colour attachment."""
+    param_schema = {
+        "sss.samples": Param(int, choices=(11, 17, 25)), "sss.kernel": Param(str, choices=("separable", "2d")),
+        "sss.width": Param(float, 0, 1e3), "sss.follow_depth": Param(float, 0, 1e3),
+        "sss.direction": Param(str, choices=("h", "v")),
+    }
 
     def __init__(self, setup):
         super().__init__(setup)

@@ -6,7 +6,7 @@ Params: ``tonemap.exposure`` (2.0), ``tonemap.white`` (11.2). Reference and hard
 
 from __future__ import annotations
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
@@ -16,6 +16,7 @@ from .tonemap_ref import X_CAP, hable
 @register("tonemap_filmic")
 class TonemapFilmic(PassImpl):
     """Reads ``hdr`` (sampled), writes ``color`` (an sRGB attachment encodes the linear result)."""
+    param_schema = {"tonemap.exposure": Param(float, 0, 1e6), "tonemap.white": Param(float, 1e-6, 1e6)}
 
     attachment_load = {"color": "dont_care"}  # every pixel is written
 

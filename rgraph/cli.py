@@ -51,12 +51,15 @@ def subcommand_parser(parser: argparse.ArgumentParser, name: str) -> argparse.Ar
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from rgraph.spec.paths import allow_outside
+
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
     if extra:
         (subcommand_parser(parser, args.command) or parser).error(f"unrecognized arguments: {' '.join(extra)}")
     try:
-        return int(args.func(args) or 0)
+        with allow_outside(bool(getattr(args, "allow_include_outside", False))):
+            return int(args.func(args) or 0)
     except RGraphError as err:
         if getattr(args, "json", None) is True:  # --json: the diagnostics as a document on stdout
             from rgraph.commands.jsonout import document, emit, error_objects

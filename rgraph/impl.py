@@ -18,10 +18,14 @@ point group (each entry point names a module to import). Nothing here imports Vu
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
 from typing import Any, ClassVar, TypeVar
+
+from rgraph.errors import quote
 
 _REGISTRY: dict[str, type[PassImpl]] = {}
 _LOADED = False
@@ -30,8 +34,60 @@ _FAILED: dict[str, Exception] = {}  # module -> why it could not be imported
 T = TypeVar("T", bound="type[PassImpl]")
 
 
+@dataclass(frozen=True)
+class Param:
+    """The declared type and range of one param an implementation reads (``param_schema``).
+
+    ``kind`` is ``int``, ``float``, ``bool`` or ``str``; numbers lie in ``[low, high]``;
+    ``choices`` (if any) lists every valid value. ``output``: the value is a file the pass
+    writes, which only the user may name (``-p`` on the command line), never a graph file.
+    Checked before the device opens.
+    """
+
+    kind: type = float
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[Any, ...] = ()
+    output: bool = False
+
+    def problem(self, value: Any) -> str | None:
+        """Why ``value`` is not valid, or None."""
+        if self.kind is bool:
+            ok = isinstance(value, bool) or (isinstance(value, int | float) and value in (0, 1))
+            return None if ok else f"must be true or false (or 0/1), got {_shown(value)}"
+        if self.kind is str:
+            if not isinstance(value, str):
+                return f"must be a string, got {_shown(value)}"
+        elif self.kind is int:
+            if isinstance(value, bool) or not isinstance(value, int | float) or value != value // 1:
+                return f"must be an integer{self._range()}, got {_shown(value)}"
+        elif isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            return f"must be a finite number{self._range()}, got {_shown(value)}"
+        if self.choices and value not in self.choices:
+            return f"must be one of {', '.join(str(c) for c in self.choices)}, got {_shown(value)}"
+        if self.low is not None and value < self.low or self.high is not None and value > self.high:
+            return f"must be{self._range()}, got {_shown(value)}"
+        return None
+
+    def _range(self) -> str:
+        if self.low is not None and self.high is not None:
+            return f" in {self.low:g}..{self.high:g}"
+        if self.low is not None:
+            return f" >= {self.low:g}"
+        if self.high is not None:
+            return f" <= {self.high:g}"
+        return ""
+
+
+def _shown(value: Any) -> str:
+    return quote(value)
+
+
 class PassImpl:
     """Base class of pass implementations (see the module docstring).
+
+    ``param_schema`` (name -> :class:`Param`) declares the params the implementation reads;
+    :func:`param_problems` checks a plan's values against it before anything runs.
 
     Class attributes a raster implementation may set:
 
@@ -47,6 +103,7 @@ class PassImpl:
     attachment_load: ClassVar[dict[str, str]] = {}
     clear_values: ClassVar[dict[str, Any]] = {}
     owns_render_pass: ClassVar[bool] = False
+    param_schema: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, setup: Any) -> None:
         self.setup = setup
@@ -108,3 +165,34 @@ def lookup(name: str) -> type[PassImpl]:
 def names() -> list[str]:
     load_implementations()
     return sorted(_REGISTRY)
+
+
+def param_problems(plan: Mapping[str, Any], user_params: Mapping[str, Any] | None = None) -> list[tuple[str, str]]:
+    """(param name, message) for every param value of ``plan`` that an implementation's
+    ``param_schema`` refuses; the values a pass sees are the plan's merged with its own.
+    With ``user_params`` (what the user gave on the command line), an ``output`` param set to
+    anything else is refused too."""
+    found: list[tuple[str, str]] = []
+    seen: set[tuple[str, str]] = set()
+    shared = plan.get("params") or {}
+    for p in plan.get("passes", []):
+        impl = p.get("impl")
+        if not impl:
+            continue
+        try:
+            cls = lookup(impl)
+        except KeyError:
+            continue  # the executor reports unknown implementations itself
+        values = {**shared, **(p.get("params") or {})}
+        for name, spec in cls.param_schema.items():
+            if name not in values:
+                continue
+            problem = spec.problem(values[name])
+            if problem is None and spec.output and user_params is not None and values[name] not in ("", None):
+                if str(user_params.get(name, "")) != str(values[name]):
+                    problem = (f"names an output file ({quote(values[name])}) but was not given on the command "
+                               f"line: files are written only where the user says (-p {name}=PATH)")
+            if problem is not None and (name, problem) not in seen:
+                seen.add((name, problem))
+                found.append((name, f"param '{name}' (read by pass '{p.get('name')}', impl '{impl}') {problem}"))
+    return found

@@ -14,7 +14,6 @@ Each ``Hazard`` has ``kind`` (one of ``ALL_KINDS``), ``pass_index``, ``pass_name
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +24,7 @@ from rgraph.check.hazards import (
     FINAL_STATE,
     LAYOUT_MISMATCH,
     LIFETIME,
+    MEMORY_LAYOUT,
     QUEUE_OWNERSHIP,
     RAW,
     SEMAPHORE,
@@ -33,51 +33,48 @@ from rgraph.check.hazards import (
     WAW,
     Hazard,
 )
+from rgraph.check.jsonread import read_json
+from rgraph.check.layout import check_layout
 from rgraph.check.plan import Plan, PlanShapeError, read_plan
 from rgraph.check.replay import Replay
 from rgraph.errors import RGraphError
 from rgraph.jsonloc import locate
 
 __all__ = [
-    "ALIASING_HANDOFF", "ALIASING_OVERLAP", "ALL_KINDS", "FINAL_STATE", "LAYOUT_MISMATCH", "LIFETIME",
+    "ALIASING_HANDOFF", "ALIASING_OVERLAP", "ALL_KINDS", "FINAL_STATE", "LAYOUT_MISMATCH", "LIFETIME", "MEMORY_LAYOUT",
     "QUEUE_OWNERSHIP", "RAW", "SEMAPHORE", "UNDEFINED_CONTENTS", "WAR", "WAW",
     "Hazard", "check_plan", "check_file", "load_plan_file",
 ]
 
 
-def _model(plan: dict[str, Any], file: str, text: str | None) -> Plan:
+def _model(plan: dict[str, Any], file: str, text: str | None) -> tuple[Plan, list[Hazard]]:
+    """The checker's model of ``plan`` and its memory-layout hazards."""
     try:
-        return read_plan(plan)
+        model = read_plan(plan)
+        return model, check_layout(plan)
     except PlanShapeError as exc:
         line, col = locate(text, exc.path) if text is not None else (1, 1)
         raise RGraphError.in_file(file, f"malformed plan: {exc}", line, col) from None
 
 
 def check_plan(plan: dict[str, Any]) -> list[Hazard]:
-    """Every hazard in ``plan`` (a decoded plan JSON), in replay order; [] when clean.
-
-    A malformed plan raises ``RGraphError`` (located at line 1, as there is no text)."""
-    return Replay(_model(plan, "<plan>", None)).run()
+    """Every hazard in ``plan`` (a decoded plan JSON): memory layout first, then in replay
+    order; [] when clean. A malformed plan raises ``RGraphError`` (located at line 1, as
+    there is no text)."""
+    model, layout = _model(plan, "<plan>", None)
+    return layout + Replay(model).run()
 
 
 def load_plan_file(path: str | Path) -> tuple[dict[str, Any], str]:
     """The decoded plan and its text; ``RGraphError`` for unreadable or invalid JSON."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise RGraphError.in_file(path, "plan file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RGraphError.in_file(path, f"cannot read plan file: {exc}") from None
-    try:
-        plan = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise RGraphError.in_file(path, f"invalid JSON: {exc.msg}", exc.lineno, exc.colno) from None
-    return plan, text
+    if not path.exists() and not path.is_symlink():
+        raise RGraphError.in_file(path, "plan file not found")
+    return read_json(path)
 
 
 def check_file(path: str | Path) -> tuple[Plan, list[Hazard]]:
     """Read, validate and replay a plan file; ``RGraphError`` if it is not a readable plan."""
     plan, text = load_plan_file(path)
-    model = _model(plan, str(path), text)
-    return model, Replay(model).run()
+    model, layout = _model(plan, str(path), text)
+    return model, layout + Replay(model).run()

@@ -15,10 +15,11 @@ ALIASING_OVERLAP = "aliasing overlap"
 ALIASING_HANDOFF = "aliasing hand-off"
 FINAL_STATE = "final state"
 LIFETIME = "lifetime"
+MEMORY_LAYOUT = "memory layout"
 
 ALL_KINDS = frozenset({
     RAW, WAR, WAW, LAYOUT_MISMATCH, UNDEFINED_CONTENTS, QUEUE_OWNERSHIP, SEMAPHORE,
-    ALIASING_OVERLAP, ALIASING_HANDOFF, FINAL_STATE, LIFETIME,
+    ALIASING_OVERLAP, ALIASING_HANDOFF, FINAL_STATE, LIFETIME, MEMORY_LAYOUT,
 })
 
 Subresource = tuple[tuple[int, int], tuple[int, int]]  # (mips [begin, end), layers [begin, end))

@@ -12,6 +12,7 @@ from typing import Any
 
 from rgraph.check import vocab
 from rgraph.jsonloc import PathPart, format_path
+from rgraph.errors import quote
 
 Rect = tuple[int, int, int, int]  # mip begin, mip end, layer begin, layer end (half-open)
 LIFETIMES = ("transient", "persistent", "imported", "output")
@@ -79,6 +80,7 @@ class Access:
 class SemaphoreOp:
     queue: int
     value: int
+    stages: int = vocab.ALL_STAGES  # a wait's second synchronization scope (a signal's first)
 
 
 @dataclass(slots=True)
@@ -173,7 +175,7 @@ def _int(value: Any, path: list[PathPart], allow_none: bool = False) -> int | No
     if value is None and allow_none:
         return None
     if isinstance(value, bool) or not isinstance(value, int):
-        raise _fail(path, f"expected an integer, got {value!r}")
+        raise _fail(path, f"expected an integer, got {quote(value)}")
     return value
 
 
@@ -181,7 +183,7 @@ def _str(value: Any, path: list[PathPart], allow_none: bool = False) -> str | No
     if value is None and allow_none:
         return None
     if not isinstance(value, str):
-        raise _fail(path, f"expected a string, got {value!r}")
+        raise _fail(path, f"expected a string, got {quote(value)}")
     return value
 
 
@@ -194,7 +196,7 @@ def _names(value: Any, path: list[PathPart], known: frozenset[str], what: str) -
         pass
     for i, name in enumerate(items):
         if not isinstance(name, str) or name not in known:
-            raise _fail(path + [i], f"unknown {what} name {name!r}")
+            raise _fail(path + [i], f"unknown {what} name {quote(name)}")
     return items
 
 
@@ -217,7 +219,7 @@ class _Reader:
     def layout(self, value: Any, path: list[PathPart]) -> str | None:
         name = _str(value, path, allow_none=True)
         if name is not None and name not in vocab.LAYOUTS:
-            raise _fail(path, f"unknown image layout {name!r}")
+            raise _fail(path, f"unknown image layout {quote(name)}")
         return name
 
     def rect(self, value: Any, path: list[PathPart]) -> Rect | None:
@@ -291,7 +293,7 @@ def read_plan(raw: Any) -> Plan:
     top = _obj(raw, [])
     fmt = top.get("format")
     if fmt is not None and fmt != "rgraph-plan/1":
-        raise _fail(["format"], f"unsupported plan format {fmt!r} (expected 'rgraph-plan/1')")
+        raise _fail(["format"], f"unsupported plan format {quote(fmt)} (expected 'rgraph-plan/1')")
     reader = _Reader(top)
     if "queues" in top:
         for i, name in enumerate(_list(top["queues"], ["queues"])):
@@ -316,7 +318,7 @@ def read_plan(raw: Any) -> Plan:
     def resource_ref(value: Any, path: list[PathPart]) -> int:
         name = _str(value, path)
         if name not in names:
-            raise _fail(path, f"unknown resource {name!r}")
+            raise _fail(path, f"unknown resource {quote(name)}")
         return names[name]
 
     passes: list[Pass] = []
@@ -345,12 +347,14 @@ def read_plan(raw: Any) -> Plan:
             position=position,
         )
 
-    def semaphore(value: Any, path: list[PathPart]) -> SemaphoreOp:
+    def semaphore(value: Any, path: list[PathPart], scope: str = vocab.SCOPE_SECOND) -> SemaphoreOp:
         raw_s = _obj(value, path)
-        _names(_get(raw_s, "stages", path, []), path + ["stages"], vocab.KNOWN_STAGE_NAMES, "stage")
+        names = _names(_get(raw_s, "stages", path, []), path + ["stages"], vocab.KNOWN_STAGE_NAMES, "stage")
         value_int = _int(_get(raw_s, "value", path), path + ["value"])
         assert value_int is not None
-        return SemaphoreOp(queue=reader.queue(_get(raw_s, "queue", path), path + ["queue"]), value=value_int)
+        stages = vocab.stage_mask(names, scope) if names else vocab.ALL_STAGES  # none given: ALL_COMMANDS
+        return SemaphoreOp(queue=reader.queue(_get(raw_s, "queue", path), path + ["queue"]), value=value_int,
+                           stages=stages)
 
     for i, raw_p in enumerate(raw_passes):
         at: list[PathPart] = ["passes", i]
@@ -372,7 +376,7 @@ def read_plan(raw: Any) -> Plan:
             access_list = _names(_get(a, "access", apath), apath + ["access"], vocab.KNOWN_ACCESS_NAMES, "access")
             write = _get(a, "write", apath, None)
             if write is not None and not isinstance(write, bool):
-                raise _fail(apath + ["write"], f"expected true or false, got {write!r}")
+                raise _fail(apath + ["write"], f"expected true or false, got {quote(write)}")
             access_bits = vocab.access_mask(access_list)
             accesses.append(Access(
                 resource=res, rect=rect, stages=stages, access=access_bits,
@@ -391,7 +395,7 @@ def read_plan(raw: Any) -> Plan:
                       for k, b in enumerate(_list(_get(p, "releases", at, []), at + ["releases"]))],
             waits=[semaphore(w, at + ["waits", k])
                    for k, w in enumerate(_list(_get(p, "waits", at, []), at + ["waits"]))],
-            signals=[semaphore(s, at + ["signals", k])
+            signals=[semaphore(s, at + ["signals", k], vocab.SCOPE_FIRST)
                      for k, s in enumerate(_list(_get(p, "signals", at, []), at + ["signals"]))],
         ))
 
@@ -402,10 +406,10 @@ def read_plan(raw: Any) -> Plan:
         ext = extents.get(i, [0, 0, 0])
         kind = _str(_get(r, "kind", at, "image" if ext[2] else "buffer"), at + ["kind"])
         if kind not in ("image", "buffer", "accel"):
-            raise _fail(at + ["kind"], f"unknown resource kind {kind!r}")
+            raise _fail(at + ["kind"], f"unknown resource kind {quote(kind)}")
         lifetime = _str(_get(r, "lifetime", at, "transient"), at + ["lifetime"])
         if lifetime not in LIFETIMES:
-            raise _fail(at + ["lifetime"], f"unknown lifetime {lifetime!r}")
+            raise _fail(at + ["lifetime"], f"unknown lifetime {quote(lifetime)}")
         if kind == "image":
             mips = _int(_get(r, "mips", at, max(ext[0], 1)), at + ["mips"])
             layers = _int(_get(r, "layers", at, max(ext[1], 1)), at + ["layers"])

@@ -4,9 +4,13 @@ Same queue: execution dependency chains (chains.py) and per-cell memory dependen
 (availability chains and visibility rectangles on each write record).
 Across queues: timeline semaphores as vector clocks. A signal after pass P on queue Q
 makes everything submitted on Q up to P (with its releases) happen-before, and visible
-to, everything after a wait on Q >= value: ``vc[q][Q]`` is the last pass on Q that is
-fully ordered before the current point of queue q (a round trip through another queue
-orders a queue's own past too).
+to, the stages in the wait's stage mask of everything after a wait on Q >= value (the
+wait's second synchronization scope is limited to those stages; later barriers on the
+waiting queue extend it like any execution chain). ``vc[q][Q]`` is the last pass on Q
+that is ordered before the current point of queue q in *some* stage, which is what a
+signal on q passes on; ``arrivals[q]`` keeps, per chain class of wait stages, the clock
+that reached q through waits in those stages (a round trip through another queue orders
+a queue's own past too).
 """
 
 from __future__ import annotations
@@ -51,6 +55,8 @@ class Replay:
         # Frame-boundary waits (docs/plan.md): the previous frame's accesses on *other*
         # queues are ordered before, and visible to, everything in this frame.
         self.vc = [[NOTHING if q == other else PREVIOUS_FRAME for other in range(nq)] for q in range(nq)]
+        every = [chains.get(vocab.ALL_STAGES, vocab.ALL_STAGES) for chains in self.chains]
+        self.arrivals: list[dict[int, list[int]]] = [{every[q]: list(self.vc[q])} for q in range(nq)]
         self.signals: list[list[tuple[int, int, list[int]]]] = [[] for _ in range(nq)]
         self.hazards: list[hz.Hazard] = []
         self.touched = [False] * len(plan.resources)
@@ -123,24 +129,55 @@ class Replay:
 
     # --- queries ------------------------------------------------------------------------
 
+    def semaphore_reach(self, rec: Rec, q: int) -> int:
+        """The stages of later commands on ``q`` that semaphores order after (and make see) ``rec``."""
+        if rec.pass_index > self.vc[q][rec.queue]:
+            return 0
+        chains = self.chains[q]
+        reach = 0
+        for cls, clock in self.arrivals[q].items():
+            if rec.pass_index <= clock[rec.queue]:
+                reach |= chains.reach(cls)
+        return reach
+
+    def _cross_visible(self, rec: Rec, q: int) -> tuple[int, int]:
+        """(stages, accesses) that barriers on ``q`` chained after semaphores made ``rec`` visible to."""
+        stages = access = 0
+        for xq, vis_stages, vis_access in rec.xvis:
+            if xq == q:
+                stages |= vis_stages
+                access |= vis_access
+        return stages, access
+
     def covered(self, rec: Rec, q: int) -> bool:
-        """Ordered before (and visible to) everything now on ``q`` through semaphores."""
-        return rec.pass_index <= self.vc[q][rec.queue]
+        """Ordered before (and visible to) every stage of everything now on ``q`` through semaphores."""
+        return self.semaphore_reach(rec, q) == vocab.ALL_STAGES
 
     def exec_after(self, rec: Rec, stages: int, q: int) -> bool:
         """Is a command on ``q`` in all of ``stages`` ordered after ``rec``?"""
-        if self.covered(rec, q):
+        through = self.semaphore_reach(rec, q) | self._cross_visible(rec, q)[0]
+        if stages & ~through == 0:
             return True
         if rec.queue != q or rec.cls < 0:
             return False
-        return stages & ~self.chains[q].reach(rec.cls) == 0
+        return stages & ~(self.chains[q].reach(rec.cls) | through) == 0
 
     def invisible_stages(self, rec: Rec, stages: int, access: int, q: int) -> int:
         """The stages of ``stages`` at which ``access`` does not see write ``rec``."""
-        if self.covered(rec, q):
+        through = self.semaphore_reach(rec, q)
+        stages &= ~through
+        if not stages:
             return 0
         if rec.queue != q:
-            return stages
+            missing = 0
+            for stage in vocab.bits(stages):
+                got = 0
+                for xq, vis_stages, vis_access in rec.xvis:
+                    if xq == q and vis_stages & stage:
+                        got |= vis_access
+                if access & ~got:
+                    missing |= stage
+            return missing
         missing = 0
         for stage in vocab.bits(stages):
             got = 0
@@ -154,8 +191,15 @@ class Replay:
     def in_first_access_scope(self, rec: Rec, b: Barrier) -> bool:
         return rec.kind == WRITE and bool(rec.stage & b.src.stages) and not rec.access & ~b.src.access
 
+    def _through_semaphores(self, rec: Rec, b: Barrier, q: int) -> bool:
+        """Does a semaphore chain order ``rec`` before barrier ``b`` on ``q``? The wait's stages must
+        meet the barrier's source stages, except for an acquire, which its release orders."""
+        if b.is_transfer and b.src.queue != q:
+            return rec.pass_index <= self.vc[q][rec.queue]
+        return bool(self.semaphore_reach(rec, q) & b.src.stages)
+
     def barrier_orders_read(self, rec: Rec, b: Barrier, q: int) -> bool:
-        if self.covered(rec, q):
+        if self._through_semaphores(rec, b, q):
             return True
         if rec.queue != q:
             return False
@@ -164,8 +208,8 @@ class Replay:
 
     def barrier_takes_write(self, rec: Rec, b: Barrier, q: int) -> bool:
         """Is write ``rec`` ordered before ``b`` and made available by it (or earlier)?"""
-        if self.covered(rec, q):
-            return True
+        if self._through_semaphores(rec, b, q):
+            return True  # a semaphore signal makes every write available
         if rec.queue != q:
             return False
         if self.in_first_access_scope(rec, b):
@@ -268,6 +312,19 @@ class Replay:
             heads[chosen.queue] += 1
             yield chosen
 
+    def _arrive(self, q: int, clock: list[int], stages: int) -> None:
+        """A wait in ``stages`` on ``q`` for a signal that carried ``clock``."""
+        chains = self.chains[q]
+        arrivals: dict[int, list[int]] = {}
+        for cls, old in self.arrivals[q].items():  # classes merge as barriers extend them
+            root = chains.find(cls)
+            merged = arrivals.get(root)
+            arrivals[root] = old if merged is None else [max(a, b) for a, b in zip(merged, old, strict=True)]
+        root = chains.find(chains.get(stages, stages))
+        merged = arrivals.get(root)
+        arrivals[root] = list(clock) if merged is None else [max(a, b) for a, b in zip(merged, clock, strict=True)]
+        self.arrivals[q] = arrivals
+
     def _signal_for(self, queue: int, value: int) -> tuple[int, int, list[int]] | None:
         """The first recorded signal of ``queue`` that reaches ``value`` (values increase)."""
         signals = self.signals[queue]
@@ -283,6 +340,7 @@ class Replay:
                 for i, v in enumerate(sig[2]):
                     if v > row[i]:
                         row[i] = v
+                self._arrive(q, sig[2], w.stages)
         if p.barriers:
             self._barrier_batch(p, p.barriers, before=True)
         self._accesses(p)
@@ -397,7 +455,8 @@ class Replay:
                             f"of {p.label}", ((b.dst.stages, b.dst.access),))
                 return replace(st, owner=q, release=None, layout=b.dst.layout, writes=(trans,), reads=(),
                                touched=True), out
-            return replace(st, owner=q, release=None, touched=True), out
+            return replace(st, owner=q, release=None, touched=True,
+                           writes=self._make_available(b, st.writes, q, pairs)), out
 
         if image and b.src.layout != vocab.UNDEFINED and b.src.layout != st.layout:
             out.append((hz.LAYOUT_MISMATCH, f"the barrier expects {b.src.layout} but the cells are in {st.layout}"))
@@ -440,13 +499,21 @@ class Replay:
 
     def _make_available(self, b: Barrier, writes: tuple[Rec, ...], q: int,
                         pairs: BarrierStages) -> tuple[Rec, ...]:
-        """Apply the memory dependency of a non-transition barrier to the cell's last write."""
+        """Apply the memory dependency of a non-transition barrier to the cell's last write.
+
+        A write from another queue that semaphores order before the barrier (an acquire, or a
+        barrier whose source stages meet the waits' stages) becomes visible on this queue in the
+        barrier's destination scope too (``Rec.xvis``)."""
         if not writes:
             return writes
         chains = self.chains[q]
         out = []
         changed = False
         for w in writes:
+            if w.queue != q and not self.covered(w, q) and self._through_semaphores(w, b, q):
+                out.append(replace(w, xvis=w.xvis + ((q, b.dst.stages, b.dst.access),)))
+                changed = True
+                continue
             if w.queue != q or self.covered(w, q) or not self.barrier_takes_write(w, b, q):
                 out.append(w)
                 continue

@@ -16,7 +16,8 @@ class Rec:
     ``cls`` is the execution-chain class (chains.py) on ``queue``: for reads, the chain
     of the read itself; for writes and transitions, the chain that starts where the write
     was made available (-1: not made available yet). ``vis`` lists (stages, accesses)
-    rectangles the write has been made visible to.
+    rectangles the write has been made visible to. ``xvis`` lists (queue, stages, accesses)
+    for other queues: what a barrier there, chained after a semaphore wait, made visible.
     """
 
     kind: int
@@ -27,6 +28,7 @@ class Rec:
     cls: int
     origin: str  # e.g. "pass 3 'sss_h'" or "barrier 0 of pass 3 'sss_h'"
     vis: tuple[tuple[int, int], ...] = ()
+    xvis: tuple[tuple[int, int, int], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

@@ -45,6 +45,13 @@ def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     size = default_size_text()
     parser.add_argument("--size", default=size, metavar="WxH", help=f"output size (default {size})")
     parser.add_argument("--camera", type=int, default=0, help="camera preset N of the scene's 'cameras' (default 0)")
+    add_outside_argument(parser)
+
+
+def add_outside_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--allow-include-outside", action="store_true",
+                        help="let includes, the graph's 'scene:' and a plan's scene_source name files outside "
+                             "the graph's (or plan's) folder tree")
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:

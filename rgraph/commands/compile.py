@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rgraph.commands.common import add_compile_arguments, add_graph_arguments, compile_from_args
+from rgraph.commands.outputs import check_output_file, write_output
 
 if TYPE_CHECKING:
     from rgraph.plan import Plan
@@ -26,12 +26,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from rgraph.plan import dump
 
+    if args.output:
+        check_output_file(args.output, "-o")
     plan = compile_from_args(args)
     text = dump(plan)
     if args.json:
         return _json(args, plan, text)
     if args.output:
-        Path(args.output).write_text(text)
+        write_output(args.output, text, "-o")
         print(f"wrote {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(text)
@@ -42,7 +44,7 @@ def _json(args: argparse.Namespace, plan: Plan, text: str) -> int:
     from rgraph.commands.jsonout import document, emit
 
     if args.output:
-        Path(args.output).write_text(text)
+        write_output(args.output, text, "-o")
     doc = plan.to_json_dict()
     body = {"file": plan.source, "graph": plan.graph, "output": args.output,
             "passes": [p.name for p in plan.passes], "culled": doc["culled"],

@@ -22,6 +22,13 @@ from rgraph.commands.common import (
     parse_params,
     parse_size,
 )
+from rgraph.commands.outputs import (
+    check_output_file,
+    check_pass_params,
+    frame_count,
+    output_path,
+    write_output,
+)
 from rgraph.errors import RGraphError
 
 COMMAND_LINE = "<command line>"
@@ -37,17 +44,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.set_defaults(size=DefaultSize(default_size_text()))  # a plan file has its own size
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
-    parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
+    parser.add_argument("--frames", type=frame_count, default=1, help="frames to run (default 1)")
     parser.add_argument("--validate", action="store_true",
                         help="Khronos validation + synchronization validation; exit 1 on any message")
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
-    parser.add_argument("--out", type=Path, help="write the first output image as PNG")
-    parser.add_argument("--timings", type=Path,
+    parser.add_argument("--out", type=output_path, help="write the first output image as PNG")
+    parser.add_argument("--timings", type=output_path,
                         help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
-    parser.add_argument("--heatmap", type=Path,
+    parser.add_argument("--heatmap", type=output_path,
                         help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
-    parser.add_argument("--trace", type=Path, metavar="OUT.json",
+    parser.add_argument("--trace", type=output_path, metavar="OUT.json",
                         help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
                              "a track per queue, passes as slices, barriers, semaphore waits as flows")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
@@ -74,6 +81,10 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
     model = load(path)
     if model.format != "rgraph-plan/1":
         raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
+    doc = to_json_dict(model)
+    from rgraph.spec.paths import check_plan_scene
+
+    check_plan_scene(doc, Path(path))
     if not unchecked:
         from rgraph.check import check_file
 
@@ -83,7 +94,7 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
             raise RGraphError.in_file(
                 path, f"rgraph check finds {len(hazards)} hazard{'s' if len(hazards) != 1 else ''} in this plan "
                       f"(first: {first}); see 'rgraph check {path}', or pass --unchecked to run it anyway")
-    return to_json_dict(model)
+    return doc
 
 
 def _plan_from_file(args: argparse.Namespace) -> dict:
@@ -101,6 +112,15 @@ def _plan_from_file(args: argparse.Namespace) -> dict:
 
         plan = apply_sync_mode(plan, "naive")
     return plan
+
+
+def _params_view(args: argparse.Namespace) -> dict:
+    """The passes' impls and params as a plan would carry them, without touching a device."""
+    from rgraph.compiler.pipeline import frontend
+
+    spec = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size)).spec
+    return {"source": str(spec.source) if getattr(spec, "source", None) else args.graph, "params": dict(spec.params),
+            "passes": [{"name": p.name, "impl": p.impl, "params": dict(p.params)} for p in spec.passes]}
 
 
 def _plan_size(path: str) -> str:
@@ -171,6 +191,12 @@ def run(args: argparse.Namespace) -> int:
     if args.frames < 1:
         print("rgraph: error: --frames must be at least 1", file=sys.stderr)
         return 2
+    for flag, target in (("--out", args.out), ("--timings", args.timings), ("--trace", args.trace),
+                         ("--heatmap", args.heatmap)):
+        if target is not None:
+            check_output_file(target, flag)
+    if not Path(args.graph).suffix == ".json":  # params first: compiling for the device opens it
+        check_pass_params(_params_view(args), parse_params(args.param))
     plan = _plan_from_file(args) if is_plan_file(args.graph) else None
     try:
         with open_device(validate=args.validate, device=args.device) as gpu:
@@ -181,6 +207,7 @@ def run(args: argparse.Namespace) -> int:
                                      size=parse_size(args.size), policy=args.policy,
                                      sync=args.sync, schedule=args.schedule, camera=args.camera,
                                      memory=gpu.memory_requirements())
+            check_pass_params(plan, parse_params(args.param))
             outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
             if args.heatmap and "light_heat" not in outputs:
                 raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' "
@@ -201,13 +228,13 @@ def run(args: argparse.Namespace) -> int:
         return 2
     _report_clusters(args, result.outputs)
     if args.timings:
-        args.timings.write_text(json.dumps({"device": result.device_name, "size": plan.get("size"),
-                                            **result.timings}, indent=1, sort_keys=True) + "\n")
+        write_output(args.timings, json.dumps({"device": result.device_name, "size": plan.get("size"),
+                                               **result.timings}, indent=1, sort_keys=True) + "\n", "--timings")
     if args.trace:
         from rgraph.report.trace import chrome_trace
 
         trace = chrome_trace(plan, {"device": result.device_name, **result.timings})
-        args.trace.write_text(json.dumps(trace, indent=None, sort_keys=True) + "\n")
+        write_output(args.trace, json.dumps(trace, indent=None, sort_keys=True) + "\n", "--trace")
     if args.json:
         return _json(args, plan, result)
     if plan["passes"]:

@@ -12,7 +12,7 @@ import sys
 
 from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
 from rgraph.commands.jsonout import diagnostic, document, emit
-from rgraph.errors import Location, RGraphError
+from rgraph.errors import Location, RGraphError, escape, quote
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -87,10 +87,10 @@ def run(args: argparse.Namespace) -> int:
             resources=len(front.spec.resources)))
         return 0
     for loc, msg in found:
-        print(f"{loc}: warning: {msg}", file=sys.stderr)
-    scene = f" with scene '{front.scene.name}'" if front.scene else ""
+        print(escape(f"{loc}: warning: {msg}"), file=sys.stderr)
+    scene = f" with scene {quote(front.scene.name)}" if front.scene else ""
     print(
-        f"{front.source.path}: ok: graph '{front.spec.name}'{scene}: {len(culling.passes)} passes run, "
+        f"{escape(str(front.source.path))}: ok: graph {quote(front.spec.name)}{scene}: {len(culling.passes)} passes run, "
         f"{len(culling.culled)} culled, {len(front.spec.resources)} resources"
     )
     return 0

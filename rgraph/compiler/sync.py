@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
@@ -291,13 +291,20 @@ class _Simulation:
             for c, (s, w) in self.per_pass_cells[i].items():
                 cell = self.cells[c]
                 key, release_at, wait_on = self._step(c, cell, i, p.queue, s, w)
+                wait_stages = set(s.stages)
+                if key is not None and wait_on and key.src.queue == p.queue:
+                    # A semaphore wait orders only its own stages, and a barrier chains after it only
+                    # through its source stages: they must meet (the swapchain-acquire pattern).
+                    if not key.src.stages:
+                        key = replace(key, src=replace(key.src, stages=frozenset(s.stages)))
+                    wait_stages |= key.src.stages
                 if key is not None:
                     groups[(c[0], key, release_at)].append(c)
                     if release_at is not None:
                         release_groups[(release_at, c[0], key)].append(c)
                 for q, j in wait_on:
                     prev = waits.get(q)
-                    waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | set(s.stages))
+                    waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
             self.out[i].barriers = _rectangles(groups)
             for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
                 self.out[j].releases.extend(_rectangles({(res, key): cs}))

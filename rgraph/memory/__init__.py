@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 
-from rgraph.memory.aliased import place_class
+from rgraph.memory.aliased import place_class, too_dense
 from rgraph.memory.bounds import lower_bound
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats, by_class, check_blocks
@@ -27,6 +27,8 @@ DEFAULT_BUDGET_S = 0.05
 #: ``rgraph place``'s default for ``aliased``: an offline tool for lifetime traces, where a
 #: second buys the search enough dives on the hard MiniMalloc instances (benchmarks/placement.py).
 TRACE_BUDGET_S = 1.0
+#: The largest budget a user may ask for (``--budget inf`` would never end).
+MAX_BUDGET_S = 3600.0
 
 
 def parse_place_args(policy: str, budget: float | None, source: str = "<command line>") -> tuple[Policy, float | None]:
@@ -37,8 +39,8 @@ def parse_place_args(policy: str, budget: float | None, source: str = "<command 
         chosen = parse_policy(policy)
     except ValueError as exc:
         raise RGraphError.in_file(source, str(exc)) from None
-    if budget is not None and not budget > 0:
-        raise RGraphError.in_file(source, f"time budget must be positive, got {budget}")
+    if budget is not None and not 0 < budget <= MAX_BUDGET_S:
+        raise RGraphError.in_file("<command line>", f"--budget must be in (0, {MAX_BUDGET_S:g}] seconds, got {budget}")
     return chosen, budget
 
 
@@ -64,6 +66,11 @@ def place(
         if chosen.kind == "dedicated":
             for b in group:
                 offsets[b.name] = (new_heap(b.aligned_size, memory_class, b.alignment), 0)
+        elif chosen.kind in ("aliased", "optimal") and too_dense(group, time_budget_s):
+            tlsf_offsets, high_water = place_tlsf(group)  # bounded time on very dense lifetimes
+            heap_id = new_heap(high_water, memory_class, max_align)
+            for b, offset in zip(group, tlsf_offsets, strict=True):
+                offsets[b.name] = (heap_id, offset)
         elif chosen.kind in ("aliased", "optimal"):
             result = place_class(Instance.build(group), time_budget_s)
             heap_id = new_heap(result.peak, memory_class, max_align)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from rgraph.errors import quote
+
 MIB = 1 << 20
 BLOCK_SIZES_MIB = (4, 16, 64, 256)
 POLICY_NAMES = ("dedicated", "aliased", "optimal", "tlsf", "blocks:SIZE")
@@ -40,7 +42,7 @@ def parse_policy(text: str | Policy) -> Policy:
         if mib in BLOCK_SIZES_MIB:
             return Policy("blocks", mib * MIB)
         raise ValueError(
-            f"unknown block size in policy {text!r}: valid block sizes are "
+            f"unknown block size in policy {quote(text)}: valid block sizes are "
             + ", ".join(f"{m}MiB" for m in BLOCK_SIZES_MIB)
         )
-    raise ValueError(f"unknown placement policy {text!r}; valid policies: {VALID_POLICIES_TEXT}")
+    raise ValueError(f"unknown placement policy {quote(text)}; valid policies: {VALID_POLICIES_TEXT}")

@@ -33,6 +33,8 @@ import numbers
 from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass, field
 
+from rgraph.errors import quote
+
 MAX_LENGTH = 4096
 MAX_DEPTH = 64
 INT_MIN = -(2**63)
@@ -107,12 +109,14 @@ def _scan_number(text: str, start: int) -> Token:
         while end < len(text) and (_is_ident_char(text[end]) or text[end] == "."
                                    or (text[end] in "+-" and text[end - 1] in "eE")):
             end += 1
-        raise ExprError(f"malformed number {text[start:end]!r}", start)
+        raise ExprError(f"malformed number {quote(text[start:end])}", start)
     if is_float:
         value: Number = float(literal)
         if not math.isfinite(value):
             raise ExprError(f"value out of range: {literal}", start)
     else:
+        if len(literal.lstrip("0")) > 19:  # int() refuses over 4,300 digits; nothing past 2**63 fits anyway
+            raise ExprError(f"value out of range: {literal[:24]}... ({len(literal)} digits)", start)
         value = int(literal)
         if value > INT_MAX:
             raise ExprError(f"value out of range: {literal}", start)
@@ -128,7 +132,7 @@ def _scan_name(text: str, start: int) -> int:
         while j < len(text) and _is_ident_char(text[j]):
             j += 1
         if j == i + 1:
-            raise ExprError(f"expected a name segment after '.' in {text[start:i + 1]!r}", i)
+            raise ExprError(f"expected a name segment after '.' in {quote(text[start:i + 1])}", i)
         i = j
     return i
 
@@ -161,7 +165,7 @@ def tokenize(text: str, template: bool) -> Iterator[Token]:
             if op == "${" and not template:
                 raise ExprError("'${' inside '${...}'", i)
             if op is None or (op == "}" and not template):
-                raise ExprError(f"unexpected character {ch!r}", i)
+                raise ExprError(f"unexpected character {quote(ch)}", i)
             if op == "${":
                 if group_start is not None:
                     raise ExprError(f"'${{' inside the '${{...}}' opened at offset {group_start}", i)
@@ -481,7 +485,7 @@ def _lookup(ref: Ref, env: Mapping[str, int | float | bool]) -> Number:
         return _checked(int(raw), ref.offset)
     if isinstance(raw, numbers.Real):
         return _checked(float(raw), ref.offset)
-    raise ExprError(f"'{ref.name}' is {raw!r}, not a number", ref.offset)
+    raise ExprError(f"'{ref.name}' is {quote(raw)}, not a number", ref.offset)
 
 
 # ---------------------------------------------------------------------------- entry points

@@ -13,14 +13,16 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from rgraph.errors import Location, RGraphError
+from rgraph.errors import Location, RGraphError, quote
 from rgraph.spec.models import GraphFile, Pass
 from rgraph.spec.models import Resource as ResourceModel
+from rgraph.spec.paths import referenced
 from rgraph.spec.pydantic_errors import translate
 from rgraph.spec.yaml_source import SourceMap, load_yaml
 
 FORMAT_VERSION = 1
 MAX_INCLUDE_DEPTH = 32
+MAX_INCLUDED_FILES = 256
 
 
 @dataclass(frozen=True)
@@ -74,7 +76,7 @@ def parse_graph_file(path: Path, display: str) -> tuple[GraphFile, SourceMap]:
     if version != FORMAT_VERSION or isinstance(version, bool):
         raise RGraphError.at(
             smap.value(("rgraph",)),
-            f"unsupported format version {version!r}; this rgraph reads 'rgraph: {FORMAT_VERSION}'",
+            f"unsupported format version {quote(version)}; this rgraph reads 'rgraph: {FORMAT_VERSION}'",
         )
     try:
         model = GraphFile.model_validate(data)
@@ -84,23 +86,38 @@ def parse_graph_file(path: Path, display: str) -> tuple[GraphFile, SourceMap]:
 
 
 def load_graph(path: str | Path) -> GraphSource:
-    """Load ``path`` and everything it includes."""
+    """Load ``path`` and everything it includes (each file once, however often it is included)."""
     root = Path(path)
     model, smap = parse_graph_file(root, str(path))
+    if model.memory_policy is not None:
+        _check_policy(model.memory_policy, smap)
+    scene = None
+    if model.scene:
+        scene = referenced(root.parent, root.parent, model.scene, smap.value(("scene",)), "scene file")
     source = GraphSource(
         name=model.name or root.stem,
         path=root,
         description=model.description,
-        default_scene=(root.parent / model.scene) if model.scene else None,
+        default_scene=scene,
         default_scene_loc=smap.value(("scene",)) if model.scene else None,
         memory_policy=model.memory_policy,
     )
-    _merge(source, root, str(path), model, smap, chain=(root.resolve(),))
+    _merge(source, root, str(path), model, smap, chain=(root.resolve(),), seen={root.resolve()})
     return source
 
 
+def _check_policy(text: str, smap: SourceMap) -> None:
+    from rgraph.memory.policy import parse_policy
+
+    try:
+        parse_policy(text)
+    except ValueError as exc:
+        raise RGraphError.at(smap.value(("memory_policy",)), str(exc)) from None
+
+
 def _merge(
-    source: GraphSource, file: Path, display: str, model: GraphFile, smap: SourceMap, chain: tuple[Path, ...]
+    source: GraphSource, file: Path, display: str, model: GraphFile, smap: SourceMap,
+    chain: tuple[Path, ...], seen: set[Path],
 ) -> None:
     source.files.append(file)
     for kind, table in (("params", model.params), ("resources", model.resources), ("passes", model.passes)):
@@ -111,22 +128,31 @@ def _merge(
                 where = first.key_loc()
                 raise RGraphError.at(
                     smap.key((kind, name)),
-                    f"duplicate {kind[:-1].replace('passe', 'pass')} '{name}' (first defined at {where})",
+                    f"duplicate {kind[:-1].replace('passe', 'pass')} {quote(name)} (first defined at {where})",
                 )
             target[name] = Located(name, value, smap, (kind, name))
     for i, name in enumerate(model.outputs):
         source.outputs.append(Located(name, name, smap, ("outputs", i)))
     for i, include in enumerate(model.include):
-        inc_path = (file.parent / include)
-        inc_display = str(Path(display).parent / include)
         loc = smap.value(("include", i))
+        inc_path = referenced(file.parent, source.path.parent, include, loc, "included file")
+        inc_display = str(Path(display).parent / include)
         resolved = inc_path.resolve()
         if resolved in chain:
             cycle = " -> ".join(p.name for p in (*chain, resolved))
             raise RGraphError.at(loc, f"include cycle: {cycle}")
+        if resolved in seen:
+            continue  # already merged (a diamond): its declarations are there once
         if len(chain) >= MAX_INCLUDE_DEPTH:
             raise RGraphError.at(loc, f"includes nested deeper than {MAX_INCLUDE_DEPTH}")
+        if len(seen) >= MAX_INCLUDED_FILES:
+            raise RGraphError.at(loc, f"more than {MAX_INCLUDED_FILES} included files")
         if not inc_path.is_file():
-            raise RGraphError.at(loc, f"included file '{include}' not found (looked in {file.parent or '.'})")
-        inc_model, inc_smap = parse_graph_file(inc_path, inc_display)
-        _merge(source, inc_path, inc_display, inc_model, inc_smap, (*chain, resolved))
+            raise RGraphError.at(loc, f"included file {quote(include)} not found (looked in {file.parent or '.'})")
+        seen.add(resolved)
+        try:
+            inc_model, inc_smap = parse_graph_file(inc_path, inc_display)
+            inc_smap.via = loc
+            _merge(source, inc_path, inc_display, inc_model, inc_smap, (*chain, resolved), seen)
+        except RGraphError as err:
+            raise err.included_from(inc_display, loc) from None

@@ -8,7 +8,7 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
-from rgraph.errors import Diagnostic, RGraphError
+from rgraph.errors import Diagnostic, RGraphError, quote
 from rgraph.spec.yaml_source import PathKey, SourceMap
 
 _TYPE_NAMES = {
@@ -27,6 +27,8 @@ _TYPE_NAMES = {
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
     """``" (did you mean 'x'?)"`` when a close match exists, else ``""``."""
+    if len(word) > 100:  # difflib is quadratic; nothing that long is a typo of a name
+        return ""
     match = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return f"; did you mean '{match[0]}'?" if match else ""
 
@@ -37,7 +39,7 @@ def describe(value: Any) -> str:
     if isinstance(value, bool):
         return f"boolean {str(value).lower()}"
     if isinstance(value, str):
-        return f"string '{value}'"
+        return f"string {quote(value)}"
     if isinstance(value, int | float):
         return f"number {value}"
     if isinstance(value, list):
@@ -50,31 +52,35 @@ def describe(value: Any) -> str:
 def _where(path: Sequence[str | int]) -> str:
     """A readable name of the place: ``pass 'hbao'``, ``resource 'depth'``, ``the graph``."""
     if len(path) >= 2 and path[0] == "passes":
-        return f"pass '{path[1]}'"
+        return f"pass {quote(path[1])}"
     if len(path) >= 2 and path[0] == "resources":
-        return f"resource '{path[1]}'"
+        return f"resource {quote(path[1])}"
     if len(path) >= 1 and isinstance(path[0], str) and path[0] not in ("passes", "resources"):
         return f"'{path[0]}'"
     return "the file"
 
 
-def _model_fields(model: type[BaseModel], path: Sequence[str | int]) -> list[str]:
-    """Best effort: the field names valid at ``path`` for the did-you-mean."""
+def _model_fields(model: type[BaseModel], path: Sequence[str | int], data: Any = None) -> list[str]:
+    """Best effort: the field names valid in the mapping at ``path`` for the did-you-mean."""
     from rgraph.spec import models
 
-    head = [p for p in path if isinstance(p, str)]
-    if not head:
+    if model is not models.GraphFile or not path:
         return list(model.model_fields)
-    if head[0] == "passes" and len(path) >= 3:
-        if len(path) >= 5 and path[2] in ("reads", "writes"):
+    if path[0] == "passes" and len(path) >= 2:
+        if len(path) >= 4 and path[2] in ("reads", "writes"):
             return list(models.UsageEntry.model_fields)
         return list(models.Pass.model_fields)
-    if head[0] == "resources" and len(path) >= 3:
-        names: set[str] = set()
-        for cls in (models.ImageResource, models.BufferResource, models.AccelResource):
-            names.update(cls.model_fields)
-        if "scale" in path:
+    if path[0] == "resources" and len(path) >= 2:
+        if "scale" in path or (len(path) >= 3 and path[2] == "size"):
             return ["scale"]
+        kinds = {"image": models.ImageResource, "buffer": models.BufferResource, "accel": models.AccelResource}
+        entry = data.get("resources", {}).get(path[1]) if isinstance(data, dict) else None
+        chosen = kinds.get(entry.get("kind")) if isinstance(entry, dict) else None
+        if chosen is not None:
+            return list(chosen.model_fields)
+        names: set[str] = set()
+        for cls in kinds.values():
+            names.update(cls.model_fields)
         return sorted(names)
     return list(model.model_fields)
 
@@ -114,12 +120,12 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
         at_key = False
         if kind == "extra_forbidden":
             key = str(loc[-1])
-            valid = _model_fields(model, loc[:-1] if loc else loc)
+            valid = _model_fields(model, loc[:-1] if loc else loc, data)
             if "generator" in err["loc"] or "light" in err["loc"]:  # a scene file's lights: item
                 from rgraph.spec.scene import Light, LightGenerator
 
                 valid = list((LightGenerator if "generator" in err["loc"] else Light).model_fields)
-            msg = f"unknown key '{key}' in {_where(loc[:-1])}{did_you_mean(key, valid)} (valid keys: {', '.join(valid)})"
+            msg = f"unknown key {quote(key)} in {_where(loc[:-1])}{did_you_mean(key, valid)} (valid keys: {', '.join(valid)})"
             at_key = True
         elif kind == "missing":
             msg = f"missing required key '{loc[-1]}' in {_where(loc[:-1])}"
@@ -130,7 +136,7 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
             choices = [c.strip().strip("'") for c in expected.replace(" or ", ", ").split(",")]
             field = str(loc[-1]) if loc and isinstance(loc[-1], str) else _field_before_index(loc)
             field = _FIELD_WORDS.get(field, field)
-            shown = f"'{value}'" if isinstance(value, str) else describe(value)
+            shown = quote(value) if isinstance(value, str) else describe(value)
             msg = f"unknown {field} {shown}{did_you_mean(str(value), choices)} (valid: {', '.join(choices)})"
         elif kind in ("union_tag_invalid", "union_tag_not_found"):
             if kind == "union_tag_not_found":
@@ -146,6 +152,8 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
             if any(p in ("int", "float") for p in err["loc"]) and "str" in branches:
                 expected = "a number or a '${...}' expression" if "float" in branches else "an integer or a '${...}' expression"
             msg = f"expected {expected} for '{_field_name(loc)}', got {describe(value)}"
+        elif kind == "value_error":
+            msg = str(err.get("ctx", {}).get("error", err["msg"]))
         elif kind in ("too_short", "too_long"):
             msg = f"'{_field_name(loc)}': {err['msg'].lower()}"
         else:

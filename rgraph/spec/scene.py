@@ -10,7 +10,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
 
 from rgraph.errors import RGraphError
-from rgraph.spec.pydantic_errors import translate
+from rgraph.spec.pydantic_errors import describe, translate
 from rgraph.spec.vocabulary import SCENE_FEATURES
 from rgraph.spec.yaml_source import SourceMap, load_yaml
 
@@ -20,8 +20,17 @@ LARGE_WORLD_METERS = 1e5
 Vec3 = list[float | int]
 
 
+# Limits on generated geometry: a scene is procedural, so its size is a few numbers.
+MAX_INSTANCES = 1 << 20  # per mesh (an instanced draw's positions are built on the CPU)
+MAX_SHAPE_VERTICES = 1 << 20  # product of the resolution parameters a mesh gives
+MAX_RESOLUTION = 4096  # any one of segments, rings, stacks, sides, subdivisions
+MAX_COUNT = 1024  # copies inside one shape ('count' of segments, 'lobes' of blob)
+_RESOLUTION_PARAMS = ("segments", "rings", "stacks", "sides", "subdivisions")
+_COUNT_PARAMS = ("count", "lobes")
+
+
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class Camera(_Strict):
@@ -30,6 +39,16 @@ class Camera(_Strict):
     up: Vec3 = Field(default_factory=lambda: [0.0, 1.0, 0.0], min_length=3, max_length=3)
     fov_y: float = Field(45.0, gt=0, lt=180)
     near: float = Field(0.01, gt=0)
+
+    @model_validator(mode="after")
+    def _looks_somewhere(self) -> Camera:
+        forward = [a - b for a, b in zip(self.look_at, self.position, strict=True)]
+        length = math.hypot(*forward)
+        if not length > 0 or not math.isfinite(length):
+            raise ValueError("camera 'look_at' must differ from 'position' (the camera looks nowhere)")
+        if math.hypot(*self.up) == 0:
+            raise ValueError("camera 'up' must not be zero")
+        return self
 
 
 class Light(_Strict):
@@ -96,8 +115,15 @@ class Material(_Strict):
 
 
 class Instances(_Strict):
-    grid: list[int] = Field(min_length=3, max_length=3)
+    grid: list[Annotated[int, Field(ge=1, le=MAX_INSTANCES)]] = Field(min_length=3, max_length=3)
     spacing: float = 1.0
+
+    @model_validator(mode="after")
+    def _bounded(self) -> Instances:
+        total = math.prod(self.grid)
+        if total > MAX_INSTANCES:
+            raise ValueError(f"an instance grid of {total:,} instances is over the limit of {MAX_INSTANCES:,}")
+        return self
 
 
 class Mesh(_Strict):
@@ -186,6 +212,7 @@ def load_scene(path: str | Path) -> Scene:
     except ValidationError as exc:
         raise translate(exc, smap, SceneFile, data) from None
     _check_references(model, smap)
+    _check_shapes(model, smap)
     return Scene(model.name or p.stem, p, model, features_of(model))
 
 
@@ -205,3 +232,26 @@ def _check_references(model: SceneFile, smap: SourceMap) -> None:
                 smap.value(("decals", i, "material")),
                 f"unknown decal material '{decal.material}'{did_you_mean(decal.material, pool)}",
             )
+
+
+def _check_shapes(model: SceneFile, smap: SourceMap) -> None:
+    """Resolution parameters are integers in range and a shape stays under :data:`MAX_SHAPE_VERTICES`."""
+    for i, mesh in enumerate(model.meshes):
+        product = 1
+        for name in (*_RESOLUTION_PARAMS, *_COUNT_PARAMS):
+            if name not in mesh.params:
+                continue
+            value = mesh.params[name]
+            limit = MAX_RESOLUTION if name in _RESOLUTION_PARAMS else MAX_COUNT
+            low = 0 if name == "lobes" else 1
+            where = smap.value(("meshes", i, "params", name))
+            if isinstance(value, bool) or not isinstance(value, int | float) or value != int(value):
+                raise RGraphError.at(where, f"shape parameter '{name}' must be an integer, got {describe(value)}")
+            if not low <= value <= limit:
+                raise RGraphError.at(where, f"shape parameter '{name}' must be in {low}..{limit}, got {int(value)}")
+            product *= max(1, int(value))
+        if product > MAX_SHAPE_VERTICES:
+            raise RGraphError.at(
+                smap.value(("meshes", i, "params")),
+                f"mesh {i} ({mesh.shape}) is too finely divided: its resolution parameters multiply to "
+                f"{product:,} (the limit is {MAX_SHAPE_VERTICES:,})")

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph import formats
-from rgraph.errors import Location, RGraphError
+from rgraph.errors import Location, RGraphError, quote
 from rgraph.spec.expr import ExprError, parse_value
 from rgraph.spec.loader import GraphSource, Located
 from rgraph.spec.models import AccelResource, ImageResource, ScaleSize
@@ -166,7 +166,7 @@ def resolve_params(source: GraphSource, overrides: Mapping[str, str]) -> dict[st
         if name not in params:
             known = ", ".join(sorted(params)) or "none"
             raise RGraphError.in_file(
-                "<command line>", f"unknown param '{name}'{did_you_mean(name, params)} (graph params: {known})"
+                "<command line>", f"unknown param {quote(name)}{did_you_mean(name, params)} (graph params: {known})"
             )
         params[name] = _parse_override(name, text, params[name])
     return params
@@ -189,7 +189,7 @@ def _parse_override(name: str, text: str, default: Any) -> Any:
             return value
     except ValueError:
         kind = type(default).__name__.replace("bool", "true/false").replace("int", "an integer").replace("float", "a number")
-        raise RGraphError.in_file(where, f"param '{name}' expects {kind}, got '{text}'") from None
+        raise RGraphError.in_file(where, f"param '{name}' expects {kind}, got {quote(text)}") from None
     return text
 
 
@@ -266,7 +266,7 @@ def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits) ->
     except KeyError:
         raise RGraphError.at(
             loc.loc("format"),
-            f"unknown format '{model.format}'{did_you_mean(model.format.lower(), formats.names())}",
+            f"unknown format {quote(model.format)}{did_you_mean(model.format.lower(), formats.names())}",
         ) from None
     width, height = _extent(model.size, loc, env, size, limits)
     layers = env.integer(model.layers, loc, "layers")
@@ -350,7 +350,7 @@ def _pass(name: str, order: int, located: Located, resources: dict[str, Resource
             if res is None:
                 raise RGraphError.at(
                     located.key_loc(section, key),
-                    f"pass '{name}' {section[:-1]}s undefined resource '{res_name}'{did_you_mean(res_name, resources)}",
+                    f"pass '{name}' {section[:-1]}s undefined resource {quote(res_name)}{did_you_mean(res_name, resources)}",
                 )
             for i, entry in enumerate(entries):
                 where = located.smap.value((*located.path, section, key, i)) if len(entries) > 1 else located.loc(section, key)

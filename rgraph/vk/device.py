@@ -20,6 +20,7 @@ OPTIONAL_CORE = (
     "fragmentStoresAndAtomics", "vertexPipelineStoresAndAtomics", "shaderStorageImageWriteWithoutFormat",
     "shaderStorageImageReadWithoutFormat", "drawIndirectFirstInstance", "multiDrawIndirect", "independentBlend",
     "shaderFloat64",  # float64 transform variants (the large-world study)
+    "geometryShader",  # gl_PrimitiveID in fragment shaders (the hybrid's visibility buffer)
 )
 
 

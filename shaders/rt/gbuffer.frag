@@ -1,13 +1,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// Visibility buffer: instance and primitive of the visible triangle, nothing else.
 #include "rt/gbuffer.glsl"
-layout(location = 0) in vec3 v_normal;
-layout(location = 1) flat in uint v_material;
-layout(location = 0) out vec2 o_normal;
-layout(location = 1) out uint o_material;
+layout(early_fragment_tests) in;
+layout(location = 0) flat in uint v_draw;
+layout(location = 0) out uint o_id;
 
-void main() {
-    vec3 n = normalize(v_normal);
-    o_normal = oct_encode(n);
-    o_material = v_material + 1u;
-}
+void main() { o_id = vis_encode(v_draw, uint(gl_PrimitiveID)); }

@@ -1,14 +1,10 @@
-// The hybrid's thin G-buffer: d32 reversed-Z depth, octahedral normal (rg16_snorm), material
-// index + 1 (r8_uint / r16_uint, 0: nothing). Position from depth along the camera ray.
-vec2 oct_encode(vec3 n) {
-    n /= abs(n.x) + abs(n.y) + abs(n.z);
-    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
-    return e;
-}
+// The hybrid's visibility buffer: one r32_uint per pixel, ((instance << PRIM_BITS) | primitive) + 1,
+// 0: nothing (the sky). PRIM_BITS (a define) covers the largest mesh's triangle count
+// (passes/raytrace_hybrid.py: prim_bits). Attributes are reconstructed by the shading passes.
+#ifndef PRIM_BITS
+#error "PRIM_BITS must be defined"
+#endif
 
-vec3 oct_decode(vec2 e) {
-    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-    float t = max(-n.z, 0.0);
-    n.xy += vec2(n.x >= 0.0 ? -t : t, n.y >= 0.0 ? -t : t);
-    return normalize(n);
-}
+uint vis_encode(uint instance, uint prim) { return ((instance << PRIM_BITS) | prim) + 1u; }
+uint vis_instance(uint id) { return (id - 1u) >> PRIM_BITS; }
+uint vis_prim(uint id) { return (id - 1u) & ((1u << PRIM_BITS) - 1u); }

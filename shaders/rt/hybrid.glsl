@@ -1,17 +1,49 @@
-// The hybrid's view of the G-buffer (set 0 bindings 8-10): the first surface of pixel px.
+// The hybrid's view of the visibility buffer (set 0 binding 8): the first surface of pixel px,
+// reconstructed from instance + primitive: the camera ray (origin 0, direction d) intersected
+// with that triangle (Moller-Trumbore, camera-relative world space), so the hit point, the
+// barycentrics and both normals are formed as the stand-alone's closest hit forms them
+// (common.glsl: surface). No depth is read. Where raster and ray may disagree (the pixel borders
+// another instance or the sky, or the pixel centre misses the rasterized triangle: snapped
+// vertices, edge rules) the camera ray is traced instead, as the stand-alone does.
+// Needs shade.glsl (trace_closest) included before.
 #include "rt/gbuffer.glsl"
-layout(set = 0, binding = 8) uniform sampler2D gbuf_depth;
-layout(set = 0, binding = 9) uniform sampler2D gbuf_normal;
-layout(set = 0, binding = 10) uniform usampler2D gbuf_material;
+layout(set = 0, binding = 8) uniform usampler2D visibility;
 
-// false: nothing (the sky). p: camera-relative position from depth along the camera ray d.
-bool first_surface(uvec2 px, vec3 d, out vec3 p, out vec3 n, out uint m) {
-    uint id = texelFetch(gbuf_material, ivec2(px), 0).r;
-    if (id == 0u) return false;
-    float depth = texelFetch(gbuf_depth, ivec2(px), 0).r;   // reversed-Z infinite: near / view depth
-    float view_depth = frame.forward.w / max(depth, 1e-30);
-    p = d * (view_depth / dot(d, frame.forward.xyz));
-    n = oct_decode(texelFetch(gbuf_normal, ivec2(px), 0).rg);
-    m = id - 1u;
-    return true;
+uint instance_at(ivec2 p) {
+    uint id = texelFetch(visibility, clamp(p, ivec2(0), ivec2(frame.counts.xy) - 1), 0).r;
+    return id == 0u ? 0xFFFFFFFFu : vis_instance(id);
+}
+
+bool on_boundary(ivec2 p, uint inst) {
+    return instance_at(p + ivec2(1, 0)) != inst || instance_at(p - ivec2(1, 0)) != inst
+        || instance_at(p + ivec2(0, 1)) != inst || instance_at(p - ivec2(0, 1)) != inst;
+}
+
+// The camera ray's hit on triangle (instance, prim); false when the ray misses it.
+bool hit_triangle(vec3 d, uint instance, uint prim, out Hit h) {
+    Instance I = inst[instance];
+    uint base = I.info.x + 3u * prim;
+    vec3 p0 = to_world(I, vertex_of(I.info.z + idx[base]));
+    vec3 p1 = to_world(I, vertex_of(I.info.z + idx[base + 1u]));
+    vec3 p2 = to_world(I, vertex_of(I.info.z + idx[base + 2u]));
+    vec3 e1 = p1 - p0, e2 = p2 - p0, q = cross(d, e2);
+    float det = dot(e1, q);
+    if (abs(det) < 1e-30) return false;
+    float inv = 1.0 / det;
+    vec3 s = -p0;  // ray origin 0 - p0
+    vec3 r = cross(s, e1);
+    float u = dot(s, q) * inv, v = dot(d, r) * inv, t = dot(e2, r) * inv;
+    h = Hit(t, instance, prim, vec2(u, v));
+    return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
+}
+
+// false: nothing (the sky).
+bool first_hit(uvec2 px, vec3 d, out Hit h) {
+    uint id = texelFetch(visibility, ivec2(px), 0).r;
+    uint instance = id == 0u ? 0xFFFFFFFFu : vis_instance(id);
+    bool boundary = on_boundary(ivec2(px), instance);
+    if (id == 0u && !boundary) return false;
+    if (id != 0u && !boundary && hit_triangle(d, instance, vis_prim(id), h)) return true;
+    h = trace_closest(vec3(0.0), d);
+    return h.t >= 0.0;
 }

@@ -1,5 +1,5 @@
 """Acceleration structures on the device: one BLAS per mesh and one TLAS per plan accel, placed
-in the plan's accel buffer at the offsets the compiler chose (``rgraph.compiler.accel``).
+in the plan's accel buffer at the offsets the compiler chose (the compiler's accel sizing phase).
 
 Geometry inputs (vertices, indices, instances) are runtime-owned host-visible buffers with
 device addresses. A build records every BLAS build in one call, a memory dependency of the
@@ -39,7 +39,7 @@ class Geometry:
 
 
 def probe_geometry(value: int) -> Geometry:
-    """The probe's test geometry (``rgraph.compiler.accel.PROBE_BLAS``): a quad [-1, 1]^2 at
+    """The probe's test geometry (PROBE_BLAS of the compiler's accel sizing): a quad [-1, 1]^2 at
     z = 0, instanced at the origin (custom index ``value``) and at x = 3 (``value + 1``)."""
     quad = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0]], dtype=np.float32)
     idx = np.array([[0, 1, 2], [2, 1, 3]], dtype=np.uint32)

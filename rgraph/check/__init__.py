@@ -57,7 +57,25 @@ def check_plan(plan: dict[str, Any]) -> list[Hazard]:
     """Every hazard in ``plan`` (a decoded plan JSON), in replay order; [] when clean.
 
     A malformed plan raises ``RGraphError`` (located at line 1, as there is no text)."""
+    if plan.get("multi_device"):
+        return _check_devices(plan, "<plan>", None)[1]
     return Replay(_model(plan, "<plan>", None)).run()
+
+
+def _check_devices(plan: dict[str, Any], file: str, text: str | None) -> tuple[Plan, list[Hazard]]:
+    """A multi-device plan: cross-device ordering, then each device's own plan replayed."""
+    from rgraph.check.devices import cross_device_hazards, device_plan
+
+    found = cross_device_hazards(plan)
+    devices = int(plan["multi_device"].get("devices", 1))
+    first = None
+    for d in range(devices):
+        model = _model(device_plan(plan, d), file, text)
+        first = first or model
+        found += [Hazard(h.kind, h.pass_index, h.pass_name, h.resource, h.subresource, f"device {d}: {h.message}")
+                  for h in Replay(model).run()]
+    assert first is not None
+    return first, found
 
 
 def load_plan_file(path: str | Path) -> tuple[dict[str, Any], str]:
@@ -79,5 +97,7 @@ def load_plan_file(path: str | Path) -> tuple[dict[str, Any], str]:
 def check_file(path: str | Path) -> tuple[Plan, list[Hazard]]:
     """Read, validate and replay a plan file; ``RGraphError`` if it is not a readable plan."""
     plan, text = load_plan_file(path)
+    if isinstance(plan, dict) and plan.get("multi_device"):
+        return _check_devices(plan, str(path), text)
     model = _model(plan, str(path), text)
     return model, Replay(model).run()

@@ -42,6 +42,9 @@ def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, blocks:SIZE, tlsf")
     parser.add_argument("--profile", help="device profile (bundled name or JSON path) for sizes and alignments")
     add_sync_argument(parser)
+    from rgraph.commands.multi_args import add_split_arguments
+
+    add_split_arguments(parser)
 
 
 def add_sync_argument(parser: argparse.ArgumentParser) -> None:
@@ -51,6 +54,7 @@ def add_sync_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def compile_from_args(args: argparse.Namespace) -> Plan:
+    from rgraph.commands.multi_args import split_from_args
     from rgraph.compiler.pipeline import compile_graph_plan
 
     return compile_graph_plan(
@@ -61,4 +65,5 @@ def compile_from_args(args: argparse.Namespace) -> Plan:
         policy=getattr(args, "policy", None),
         profile=getattr(args, "profile", None),
         sync=getattr(args, "sync", "normal"),
+        split=split_from_args(args),
     )

@@ -51,13 +51,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--size", metavar="WxH", help="output size (when compiling a graph)")
     parser.add_argument("--policy", metavar="P", help="memory placement policy (when compiling a graph)")
     parser.add_argument("--profile", metavar="D", help="device profile for memory sizes (when compiling a graph)")
+    from rgraph.commands.multi_args import add_split_arguments
+
+    add_split_arguments(parser)
     parser.set_defaults(func=run)
 
 
 def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     """Load the plan file, or compile the graph with the given scene, params, size and policy."""
     target: str = args.target
-    compile_flags = [f for f in ("scene", "size", "policy", "profile") if getattr(args, f)] + (["-p"] if args.params else [])
+    compile_flags = [f for f in ("scene", "size", "policy", "profile", "devices", "split") if getattr(args, f, None)] + (["-p"] if args.params else [])
     if target.endswith(".json"):
         if compile_flags:
             raise RGraphError.in_file(
@@ -71,6 +74,9 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
         options["size"] = parse_size(args.size)
     if args.profile:
         options["profile"] = args.profile
+    from rgraph.commands.multi_args import split_from_args
+
+    options["split"] = split_from_args(args)
     plan = compile_graph(target, scene_path=args.scene, **options)
     check_plan(plan, target)
     return plan
@@ -163,6 +169,9 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
         out.write(lowered_text(source, args.queues, args.layer_workarounds))
     if not (args.barriers or args.memory or dot_to_stdout or args.lowered):
         text.print_summary(console, plan, timings)
+        from rgraph.report.devices import print_devices
+
+        print_devices(console, plan)
     if args.barriers:
         text.print_barriers(console, plan)
     if args.memory:

@@ -230,7 +230,9 @@ class Probe(PassImpl):
             vertexAttributeDescriptionCount=len(va), pVertexAttributeDescriptions=va or None)
         assembly = v.VkPipelineInputAssemblyStateCreateInfo(topology=v.VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST)
         viewport = v.VkViewport(x=0, y=0, width=float(w), height=float(h), minDepth=0.0, maxDepth=1.0)
-        scissor = v.VkRect2D(offset=v.VkOffset2D(x=0, y=0), extent=v.VkExtent2D(width=w, height=h))
+        from rgraph.vk.multi.tiles import scissor_rect
+
+        scissor = scissor_rect(self.p, w, h)  # a sort-first tile, else all of it
         viewport_state = v.VkPipelineViewportStateCreateInfo(viewportCount=1, pViewports=[viewport], scissorCount=1,
                                                              pScissors=[scissor])
         raster = v.VkPipelineRasterizationStateCreateInfo(

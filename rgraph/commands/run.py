@@ -40,6 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
                         help="record the plan without the validation-layer 1.3.239 workarounds "
                              "(rgraph/vk/lower/workarounds; validation messages are then reported, not avoided)")
+    from rgraph.commands.multi_args import add_split_arguments
+
+    add_split_arguments(parser, indices=True)
     parser.set_defaults(func=run)
 
 
@@ -82,6 +85,13 @@ def _plan_from_file(args: argparse.Namespace) -> dict:
     return plan
 
 
+def _is_multi_plan(target: str) -> bool:
+    try:
+        return is_plan_file(target) and bool(json.loads(Path(target).read_text()).get("multi_device"))
+    except (OSError, ValueError):
+        return False
+
+
 def _plan_size(path: str) -> str:
     try:
         size = json.loads(Path(path).read_text()).get("size")
@@ -116,6 +126,15 @@ def run(args: argparse.Namespace) -> int:
     if args.frames < 1:
         print("rgraph: error: --frames must be at least 1", file=sys.stderr)
         return 2
+    from rgraph.commands.multi_args import device_list
+
+    devices = device_list(args)
+    if devices is not None and (len(devices) > 1 or _is_multi_plan(args.graph)):
+        from rgraph.commands.run_multi import run_multi
+
+        return run_multi(args, devices, DEFAULT_SIZE)
+    if devices is not None and args.device is None:
+        args.device = devices[0]
     plan = _plan_from_file(args) if is_plan_file(args.graph) else None
     try:
         with open_device(validate=args.validate, device=args.device) as gpu:

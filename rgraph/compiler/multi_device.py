@@ -46,6 +46,7 @@ SPLITS = ("sort-first", "sort-last")
 BALANCES = ("static", "dynamic")
 SCISSOR = "rgraph.scissor"
 DRAWS = "rgraph.draws"
+PROBE_INDEX = "rgraph.probe_index"
 DOWNLOAD_IMPL = "rgraph.multi.download"
 UPLOAD_IMPL = "rgraph.multi.upload"
 COMPOSITE_IMPL = "rgraph.multi.depth_composite"
@@ -139,8 +140,9 @@ def partition(spec: Spec, passes: Sequence[PassSpec], mode: str) -> Partition:
                       or spec.resources[r].lifetime != "transient")
     depth = None
     if mode == "sort-last" and crossing:
-        depths = [r for r in crossing if spec.resources[r].is_image and spec.resources[r].format is not None
-                  and spec.resources[r].format.has_depth]
+        depths = sorted(r for r in split if _screen(spec, r) and spec.resources[r].format is not None
+                        and spec.resources[r].format.has_depth)
+        crossing = sorted(set(crossing) | set(depths))
         if len(depths) != 1:
             raise RGraphError.in_file(spec.source, f"--split sort-last: the composite needs exactly one split depth "
                                                    f"image, the graph splits {depths or 'none'}")
@@ -251,8 +253,10 @@ def compile_split(spec: Spec, split: Split, **options) -> Plan:
     from rgraph.plan.devices import merge
 
     culling = cull_spec(spec)
-    part = partition(spec, culling.passes, split.mode)
-    kept = replace(spec, passes=list(culling.passes), removed=[])
+    # every pass keeps its one-device index for the probe's values (rgraph.probe.semantics)
+    kept_passes = [replace(p, params={**p.params, PROBE_INDEX: i}) for i, p in enumerate(culling.passes)]
+    part = partition(spec, kept_passes, split.mode)
+    kept = replace(spec, passes=kept_passes, removed=[])
     plans = []
     for d, sub in enumerate(device_specs(kept, part, split)):
         plan = compilation(sub, **options).plan

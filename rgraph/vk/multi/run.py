@@ -111,11 +111,12 @@ class MultiExecutable:
                             [host_import_supported(g) for g in self.gpus], timings=summary.timings)
 
     def read_back(self) -> dict[tuple, bytes]:
-        """Device 0's outputs (the composited frame) as ``Executable.read_back``."""
+        """Device 0's outputs (the composited frame) as ``Executable.read_back`` (once per run)."""
         assert self.receiver is not None, "run first"
         return self.receiver.read_back()
 
     def read_outputs(self) -> dict[str, Any]:
+        """``read_back`` decoded (instead of it, not after it)."""
         from rgraph.vk.runtime.readback import decode_outputs
 
         return decode_outputs(self.plans[0], self.read_back())

@@ -51,7 +51,7 @@ def _messages(gpus):
     return [m for g in gpus for m in g.instance.log.messages]
 
 
-@pytest.mark.parametrize("mode", ["sort-first"])
+@pytest.mark.parametrize("mode", ["sort-first", "sort-last"])
 def test_probe_graph_split_equals_one_device_and_passes_data_check(gpus, mode):
     reference, _data, ref = _one_device(gpus[0], PROBE_GRAPH)
     plan, data, out, summary = _split(gpus, PROBE_GRAPH, mode)
@@ -80,7 +80,7 @@ def test_missing_band_is_caught_by_the_data_check(gpus):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("mode", ["sort-first"])
+@pytest.mark.parametrize("mode", ["sort-first", "sort-last"])
 def test_surgery_split_equals_one_device(gpus, mode):
     _plan, _data, ref = _one_device(gpus[0], "surgery")
     _plan, _data, out, _summary = _split(gpus, "surgery", mode)

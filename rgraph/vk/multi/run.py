@@ -29,6 +29,7 @@ from typing import Any
 
 from rgraph.plan import Plan, to_json_dict
 from rgraph.plan.devices import devices_of, project
+from rgraph.vk.multi import composite as _composite  # noqa: F401 -- registers the composite
 from rgraph.vk.multi import copies as _copies  # noqa: F401 -- registers the copy passes
 
 HOST_IMPORT = "VK_EXT_external_memory_host"

@@ -69,6 +69,12 @@ def _check_devices(plan: dict[str, Any], file: str, text: str | None) -> tuple[P
     found = cross_device_hazards(plan)
     devices = int(plan["multi_device"].get("devices", 1))
     first = None
+    if any(" accesses " in h.message for h in found):  # a device's plan would name a resource it lacks
+        for d in range(devices):
+            try:
+                return _model(device_plan(plan, d), file, text), found
+            except RGraphError:
+                continue
     for d in range(devices):
         model = _model(device_plan(plan, d), file, text)
         first = first or model

@@ -34,7 +34,7 @@ def cross_device_hazards(plan: dict[str, Any]) -> list[hz.Hazard]:
         for a in p["accesses"]:
             if owner.get(a["resource"], 0) != p["device"]:
                 out.append(_hazard(hz.RAW, p, a["resource"], f"pass {p['index']} '{p['name']}' on device {p['device']} "
-                                   f"accesses '{a['resource']}' of device {owner.get(a['resource'])}"))
+                                   f"accesses '{a['resource']}' of device {owner.get(a['resource'], '(none)')}"))
         source = (p.get("params") or {}).get("copy_from")
         cross = [w for w in p["waits"] if w.get("device") is not None]
         if source is None:

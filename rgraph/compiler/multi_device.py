@@ -223,7 +223,7 @@ def device_specs(spec: Spec, part: Partition, split: Split) -> list[Spec]:
             order += 1
         result.append(replace(spec, resources=resources, passes=passes,
                               outputs=[f"{x}.tile" for x in part.crossing]))
-    if split.mode == "sort-last":
+    if split.mode == "sort-last" and part.crossing:
         for d in range(1, n):
             receive.append(_composite(spec, part, d, order, loc))
             order += 1

@@ -34,10 +34,23 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
             options = dict(scene_path=args.scene, params=parse_params(args.param),
                            size=parse_size(args.size or default_size), policy=args.policy,
                            memory=gpus[0].memory_requirements())
-            plan = compile_graph_plan(args.graph, split=split_from_args(args, indices=True), **options)
+            split = split_from_args(args, indices=True)
+            plan = compile_graph_plan(args.graph, split=split, **options)
             reference = compile_graph(args.graph, **options)
-        multi = MultiExecutable(gpus, plan)
-        summary = multi.run(args.frames)
+        if args.balance == "dynamic" and reference is not None and plan.multi_device["split"] == "sort-first":
+            from dataclasses import replace
+
+            from rgraph.vk.multi.balance import run_balanced
+
+            multi, summary, history = run_balanced(
+                gpus, lambda w: compile_graph_plan(args.graph, split=replace(split, weights=w), **options),
+                args.frames)
+            plan = multi.plan
+            print("rgraph: shares per frame: " + " -> ".join("/".join(f"{x:.2f}" for x in w) for w in history),
+                  file=sys.stderr)
+        else:
+            multi = MultiExecutable(gpus, plan)
+            summary = multi.run(args.frames)
         data = multi.read_back()
         check = args.validate if args.check_data is None else args.check_data
         verdict = None

@@ -56,6 +56,7 @@ class MultiSummary:
     host_memory_import: list[bool]
     messages: list[Any] = field(default_factory=list)
     timings: dict[str, Any] = field(default_factory=dict)  # device 0's last RunSummary.timings
+    device_passes: list[dict[str, float]] = field(default_factory=list)  # last frame: pass -> GPU ms, per device
 
 
 class MultiExecutable:
@@ -108,8 +109,10 @@ class MultiExecutable:
             for d, r in enumerate(runs, start=1):
                 per_device[d].append(r.timings.get("total_ms") or 0.0)
         assert summary is not None
+        passes = [dict(summary.timings.get("passes", {}))] + [dict(r.timings.get("passes", {})) for r in runs]
         return MultiSummary(frames, [_median(x) for x in per_device], _median(reads), _median(zeros), _median(walls),
-                            [host_import_supported(g) for g in self.gpus], timings=summary.timings)
+                            [host_import_supported(g) for g in self.gpus], timings=summary.timings,
+                            device_passes=passes)
 
     def read_back(self) -> dict[tuple, bytes]:
         """Device 0's outputs (the composited frame) as ``Executable.read_back`` (once per run)."""

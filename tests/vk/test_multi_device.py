@@ -87,3 +87,23 @@ def test_surgery_split_equals_one_device(gpus, mode):
     # the one-device golden tolerance of surgery is far looser; the split is exact on lavapipe
     assert np.array_equal(ref["color"], out["color"])
     assert _messages(gpus) == []
+
+
+@pytest.mark.parametrize("mode", ["sort-first", "sort-last"])
+def test_later_frames_refill_the_received_tiles(gpus, mode):
+    """Frames after the first reuse device 0's executable (``rgraph.vk.multi.receive.refill``)."""
+    reference = compile_graph(PROBE_GRAPH, size=SIZE, memory=gpus[0].memory_requirements())
+    plan = compile_graph_plan(PROBE_GRAPH, size=SIZE, memory=gpus[0].memory_requirements(), split=Split(2, mode))
+    multi = MultiExecutable(gpus, plan)
+    try:
+        multi.run(3)
+        receiver = multi.receiver
+        multi.run(1)
+        assert multi.receiver is receiver
+        data = multi.read_back()
+    finally:
+        multi.close()
+    known = {r["name"] for r in reference["resources"]}
+    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 4)
+    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert _messages(gpus) == []

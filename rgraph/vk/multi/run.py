@@ -10,15 +10,15 @@ Per frame, in this order (v1, staged path):
    into its tile buffer) -- they run concurrently with each other;
 2. the host waits for each sender's frame (its timeline values: the executor waits per
    device, never a device-wide idle) and reads the tile buffers back (device -> host);
-3. device 0 receives them as the initial contents of its ``X.from<d>`` buffers (host ->
-   staging -> device) and runs its frame: its own tiles, ``X.upload<d>`` (the cross-device
-   wait of the plan is this host-side ordering), then everything after the composite.
+3. device 0 receives them into its ``X.from<d>`` buffers (host -> staging -> device: at
+   load for the first frame, then ``rgraph.vk.multi.receive.refill``, one fenced one-time
+   submit) and runs its frame: its own tiles, ``X.upload<d>`` (the cross-device wait of
+   the plan is this host-side ordering), then everything after the composite.
 
 Not yet: ``VK_EXT_external_memory_host`` (one host allocation imported by both devices);
-``host_memory_import`` in the summary says whether each device offers it. Device 0's
-executable is re-loaded per frame to take the received bytes (the received buffers are
-imported resources filled at load), so device 0 does not overlap the senders: frame
-latency is one frame, and the timings below separate render, copy and composite.
+``host_memory_import`` in the summary says whether each device offers it. Device 0 starts
+its frame after the senders' frames end (no overlap across devices yet, no frame of
+latency); the timings separate render, copy and composite.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from rgraph.plan import Plan, to_json_dict
 from rgraph.plan.devices import devices_of, project
 from rgraph.vk.multi import composite as _composite  # noqa: F401 -- registers the composite
 from rgraph.vk.multi import copies as _copies  # noqa: F401 -- registers the copy passes
+from rgraph.vk.multi.receive import refill
 
 HOST_IMPORT = "VK_EXT_external_memory_host"
 
@@ -96,9 +97,10 @@ class MultiExecutable:
             t1 = time.perf_counter()
             received = self._received()
             t2 = time.perf_counter()
-            if self.receiver is not None:
-                self.receiver.close()
-            self.receiver = self.gpus[0].load(self.plans[0], inputs=received, **self._kw)
+            if self.receiver is None:
+                self.receiver = self.gpus[0].load(self.plans[0], inputs=received, **self._kw)
+            else:
+                refill(self.receiver, received)
             summary = self.receiver.run(1)
             t3 = time.perf_counter()
             self.frames_done += 1

@@ -1,12 +1,16 @@
 """Forward PBR shading: ``forward_pbr`` (the ``forward`` pass of surgery.yaml).
 
 GGX Cook-Torrance (Smith height-correlated visibility, Schlick Fresnel; shaders/forward/brdf.glsl)
-for every light of the graph buffer ``lights`` (directional and point; spot lights shade as
-points), PCF shadows on shadow-casting directional lights, split-sum IBL from ``brdf_lut`` and
+for every light of the graph buffer ``lights`` (directional, point and spot with its cone),
+PCF shadows on shadow-casting directional lights, split-sum IBL from ``brdf_lut`` and
 ``env_map`` (passes/ibl.py) and ambient occlusion combine(screen-space ``ao``, the material's
 baked AO). Writes ``diffuse`` and ``specular`` (HDR, separate) and ``normal_sss``
 (rgb = 0.5 * n + 0.5 of the unit world-space normal, a = the material's sss). Depth is
 ``depth_read``: GREATER_OR_EQUAL against the prepass (reversed-Z), no depth writes.
+
+Clustered: when the pass reads ``light_grid`` and ``light_indices`` (graphs/surgery_clustered.yaml;
+``lights`` then as ``storage_read``, any count) each fragment shades only its froxel's lights
+(passes/clustered.py, params ``clusters.*`` and ``lighting.mode``).
 
 Optional reads: without ``ao`` (HBAO culled) the screen-space AO is 1.0, without
 ``shadow_maps`` (no shadow lights) lights are unshadowed, both by compile-time defines.
@@ -61,8 +65,12 @@ class ForwardPBR(PassImpl):
         self.has_ao = setup.has("ao")
         self.has_shadows = setup.has("shadow_maps") and scene.shadow_lights > 0
         env_mips = int(setup.resource_plan("env_map")["mips"])
-        bindings = [Binding(0, "uniform_buffer", "lights"), Binding(1, "sampled", "brdf_lut"),
-                    Binding(2, "sampled", "env_map")]
+        self.clustered = setup.has("light_grid")
+        bindings = [Binding(0, "storage_buffer" if self.clustered else "uniform_buffer", "lights"),
+                    Binding(1, "sampled", "brdf_lut"), Binding(2, "sampled", "env_map")]
+        if self.clustered:
+            bindings += [Binding(5, "storage_image", "light_grid", array=True),
+                         Binding(6, "storage_buffer", "light_indices")]
         if self.has_ao:
             bindings.append(Binding(3, "sampled", "ao"))
         if self.has_shadows:
@@ -77,6 +85,10 @@ class ForwardPBR(PassImpl):
             "IBL_INTENSITY": float(setup.param("forward.ibl_intensity", 0.5)),
             "AO_COMBINE": ao_combine_mode(setup),
         }
+        if self.clustered:
+            from .clustered import cluster_defines
+
+            defines.update(cluster_defines(setup), CLUSTERED=1)
         self.pipeline = setup.graphics_pipeline(
             "forward/forward.vert", "forward/forward.frag", [scene.set_layout, self.sets.layout], defines=defines,
             vertex_input=scene.vertex_input, cull=cull, front_face="COUNTER_CLOCKWISE", depth_test=True,

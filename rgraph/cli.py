@@ -1,7 +1,7 @@
 """The ``rgraph`` command line: dispatches to ``rgraph.commands.<name>``.
 
 Bad input (``RGraphError``) prints ``FILE:LINE:COL: error: message`` lines and exits 2,
-never a traceback.
+never a traceback. An unknown option prints the usage of the subcommand it was given to.
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from rgraph import __version__
 from rgraph.commands import COMMAND_MODULES
 from rgraph.errors import RGraphError
 
@@ -18,13 +19,14 @@ from rgraph.errors import RGraphError
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # argparse default exits 2 too; keep its usage line
         self.print_usage(sys.stderr)
-        print(f"rgraph: error: {message}", file=sys.stderr)
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
         raise SystemExit(2)
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="rgraph", description="A declarative render-graph compiler for Vulkan.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser.add_argument("--version", action="version", version=f"rgraph {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser, metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:
             module = importlib.import_module(f"rgraph.commands.{name}")
@@ -33,14 +35,34 @@ def build_parser() -> argparse.ArgumentParser:
                 continue  # command not built yet
             raise
         module.register(sub)
+    for action in sub._choices_actions:  # every command's own --help gets a description
+        command = sub.choices[action.dest]
+        if command.description is None:
+            command.description = action.help[:1].upper() + action.help[1:] + "." if action.help else None
     return parser
 
 
+def subcommand_parser(parser: argparse.ArgumentParser, name: str) -> argparse.ArgumentParser | None:
+    """The parser of subcommand ``name`` (None when there is no such command)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return action.choices.get(name)
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra:
+        (subcommand_parser(parser, args.command) or parser).error(f"unrecognized arguments: {' '.join(extra)}")
     try:
         return int(args.func(args) or 0)
     except RGraphError as err:
+        if getattr(args, "json", None) is True:  # --json: the diagnostics as a document on stdout
+            from rgraph.commands.jsonout import document, emit, error_objects
+
+            emit(document(args.command, False, error_objects(err.diagnostics)))
+            return 2
         for diagnostic in err.diagnostics:
             print(diagnostic, file=sys.stderr)
         return 2

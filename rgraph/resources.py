@@ -43,6 +43,25 @@ def resolve_graph(arg: str) -> Path:
     return bundled_graphs().get(arg, path)
 
 
+def bundled_scenes() -> dict[str, Path]:
+    """Bundled scene names -> paths (``--scene cct_no_sss``)."""
+    return {p.stem: p for p in sorted((graphs_dir() / "scenes").glob("*.yaml"))}
+
+
+def resolve_scene(arg: str | Path) -> Path:
+    """A scene path as given, or the bundled scene of that name; a name that is neither is an error."""
+    path = Path(arg)
+    if path.exists() or path.suffix in (".yaml", ".yml"):
+        return path
+    scenes = bundled_scenes()
+    if str(arg) in scenes:
+        return scenes[str(arg)]
+    from rgraph.errors import RGraphError
+
+    raise RGraphError.in_file("<command line>", f"--scene {arg}: no such file or bundled scene "
+                                                f"(bundled: {', '.join(scenes) or 'none'})")
+
+
 def builtin_passes() -> ModuleType:
     """Import ``rgraph.passes`` (the built-in implementations), from a wheel or a checkout."""
     if "rgraph.passes" in sys.modules:

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Idempotent setup for a Debian 12 machine: Vulkan (Mesa lavapipe from bookworm-backports,
-# validation layers, glslc, spirv-tools) when missing, then .venv with rgraph editable.
+# validation layers, glslc, spirv-tools, graphviz, headless chromium for the HTML report's
+# screenshot test) when missing, then .venv with rgraph editable.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need_pkgs=()
-for p in libvulkan1 mesa-vulkan-drivers vulkan-validationlayers glslc spirv-tools spirv-headers graphviz; do
+for p in libvulkan1 mesa-vulkan-drivers vulkan-validationlayers glslc spirv-tools spirv-headers graphviz chromium; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need_pkgs+=("$p")
 done
 mesa_ok() {  # lavapipe from Mesa >= 25 (Vulkan 1.4, ray tracing)
@@ -21,7 +22,7 @@ if [ ${#need_pkgs[@]} -gt 0 ] || ! mesa_ok; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq -t bookworm-backports \
     libvulkan1 mesa-vulkan-drivers >/dev/null
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq \
-    vulkan-validationlayers glslc spirv-tools spirv-headers graphviz >/dev/null
+    vulkan-validationlayers glslc spirv-tools spirv-headers graphviz chromium >/dev/null
 fi
 
 PY=${PYTHON:-python3}

@@ -14,4 +14,5 @@ COMMAND_MODULES = [
     "devices",
     "graphs",
     "schema",
+    "completion",
 ]

@@ -31,15 +31,23 @@ def parse_params(items: list[str] | None) -> dict[str, str]:
     return out
 
 
-def add_graph_arguments(parser: argparse.ArgumentParser, *, size_default: str = "1920x1080") -> None:
+def default_size_text() -> str:
+    """The one default output size of every command (``rgraph.defaults.DEFAULT_SIZE``)."""
+    from rgraph.defaults import DEFAULT_SIZE
+
+    return f"{DEFAULT_SIZE[0]}x{DEFAULT_SIZE[1]}"
+
+
+def add_graph_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("graph", help="graph file, or the name of a bundled graph (rgraph graphs)")
     parser.add_argument("--scene", help="scene file (default: the graph's own 'scene:', else every feature present)")
     parser.add_argument("-p", "--param", action="append", metavar="NAME=VALUE", help="override a graph param")
-    parser.add_argument("--size", default=size_default, help=f"output size WxH (default {size_default})")
+    size = default_size_text()
+    parser.add_argument("--size", default=size, metavar="WxH", help=f"output size (default {size})")
 
 
 def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, blocks:SIZE, tlsf")
+    parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, optimal, tlsf, blocks:SIZE (docs/memory.md)")
     parser.add_argument("--profile", help="device profile (bundled name or JSON path) for sizes and alignments")
     add_sync_argument(parser)
     from rgraph.commands.multi_args import add_split_arguments
@@ -47,7 +55,16 @@ def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
     add_split_arguments(parser)
 
 
+def add_schedule_argument(parser: argparse.ArgumentParser) -> None:
+    from rgraph.defaults import SCHEDULES
+
+    parser.add_argument("--schedule", default="declaration", choices=SCHEDULES,
+                        help="pass order: declaration (default: declaration order minus culled passes) or "
+                             "async-early (compute/transfer-queue passes as early as dependencies allow)")
+
+
 def add_sync_argument(parser: argparse.ArgumentParser) -> None:
+    add_schedule_argument(parser)
     parser.add_argument("--sync", default="normal", choices=("normal", "naive"),
                         help="normal (default): the barrier generator's plan; naive: a full barrier before "
                              "every pass, all passes on the graphics queue, no semaphores (for comparison)")
@@ -66,4 +83,5 @@ def compile_from_args(args: argparse.Namespace) -> Plan:
         profile=getattr(args, "profile", None),
         sync=getattr(args, "sync", "normal"),
         split=split_from_args(args),
+        schedule=getattr(args, "schedule", "declaration"),
     )

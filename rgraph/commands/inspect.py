@@ -11,9 +11,8 @@ import sys
 from pathlib import Path
 from typing import Any, TextIO
 
-from rgraph.commands.common import parse_params, parse_size
+from rgraph.commands.common import default_size_text, parse_params, parse_size
 from rgraph.errors import RGraphError
-from rgraph.report.plan_file import check_plan, load_plan
 
 COMMAND_LINE = "<command line>"
 
@@ -27,10 +26,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("target", metavar="G-or-PLAN", help="plan.json, a graph file or a bundled graph name")
     parser.add_argument("--barriers", action="store_true", help="every barrier, release, wait and signal in order")
     parser.add_argument("--memory", action="store_true", help="resources, placement, heaps, culling savings")
-    parser.add_argument("--timeline", metavar="OUT.png", help="draw the memory timeline into a PNG")
+    parser.add_argument("--timeline", metavar="OUT.png", help="draw the memory timeline (.png, .svg or .pdf)")
     parser.add_argument(
         "--dot", metavar="OUT", nargs="?", const="-",
-        help="the pass graph as DOT (stdout; OUT.dot for text, OUT.svg renders with graphviz)",
+        help="the pass graph as DOT (stdout; OUT.dot/.gv for text, OUT.svg/.pdf/.png rendered by graphviz)",
     )
     parser.add_argument("--html", metavar="OUT", help="write a self-contained HTML report")
     parser.add_argument("--lowered", action="store_true",
@@ -42,13 +41,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              "NVIDIA)")
     parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
                         help="--lowered without the validation-layer 1.3.239 workarounds")
+    parser.add_argument("--json", action="store_true",
+                        help="print the summary (and --barriers/--memory) as JSON (docs/cli-json.md)")
     parser.add_argument("--timings", metavar="T.json",
                         help="per-pass GPU times of a run that kept the culled passes (rgraph run --timings): "
                              "shows the milliseconds culling saved")
     parser.add_argument("--scene", metavar="S", help="scene file or name (when compiling a graph)")
     parser.add_argument("-p", "--param", dest="params", metavar="K=V", action="append", default=[],
                         help="override a graph parameter (when compiling a graph)")
-    parser.add_argument("--size", metavar="WxH", help="output size (when compiling a graph)")
+    parser.add_argument("--size", metavar="WxH", help=f"output size (when compiling a graph; default {default_size_text()})")
     parser.add_argument("--policy", metavar="P", help="memory placement policy (when compiling a graph)")
     parser.add_argument("--profile", metavar="D", help="device profile for memory sizes (when compiling a graph)")
     from rgraph.commands.multi_args import add_split_arguments
@@ -59,6 +60,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     """Load the plan file, or compile the graph with the given scene, params, size and policy."""
+    from rgraph.report.plan_file import check_plan, load_plan
+
     target: str = args.target
     compile_flags = [f for f in ("scene", "size", "policy", "profile", "devices", "split") if getattr(args, f, None)] + (["-p"] if args.params else [])
     if target.endswith(".json"):
@@ -97,6 +100,15 @@ def load_timings(path: str) -> dict[str, Any]:
     return data
 
 
+def check_timings_size(plan: dict[str, Any], timings: dict[str, Any], path: str) -> None:
+    """Refuse timings measured at another output size than the plan's (older files carry none)."""
+    measured, planned = timings.get("size"), plan.get("size")
+    if measured and planned and list(measured) != list(planned):
+        raise RGraphError.in_file(
+            path, f"timings were measured at {measured[0]}x{measured[1]} but the plan is {planned[0]}x{planned[1]}; "
+                  f"pass --size {measured[0]}x{measured[1]} (or rerun with --size {planned[0]}x{planned[1]})")
+
+
 def _write(path: str, data: str | bytes) -> None:
     try:
         if isinstance(data, bytes):
@@ -108,21 +120,26 @@ def _write(path: str, data: str | bytes) -> None:
 
 
 def emit_dot(plan: dict[str, Any], dest: str, out: TextIO) -> None:
-    """DOT text to ``out`` (``-``), or to a file; ``.svg`` files are rendered by graphviz."""
-    from rgraph.report.dot import dot_available, dot_to_svg, plan_to_dot
+    """DOT text to ``out`` (``-``) or a ``.dot``/``.gv`` file; ``.svg``/``.pdf``/``.png`` are
+    rendered by graphviz; any other suffix is refused."""
+    from rgraph.report.dot import RENDERED_SUFFIXES, TEXT_SUFFIXES, dot_available, dot_render, plan_to_dot
 
     text = plan_to_dot(plan)
+    suffix = Path(dest).suffix.lower().lstrip(".")
     if dest == "-":
         out.write(text)
-    elif dest.lower().endswith(".svg"):
+    elif suffix in RENDERED_SUFFIXES:
         if not dot_available():
             raise RGraphError.in_file(dest, "graphviz 'dot' is not installed; write a .dot file instead")
         try:
-            _write(dest, dot_to_svg(text))
+            _write(dest, dot_render(text, suffix))
         except RuntimeError as exc:
             raise RGraphError.in_file(dest, str(exc)) from None
-    else:
+    elif suffix in TEXT_SUFFIXES:
         _write(dest, text)
+    else:
+        known = ", ".join("." + s for s in (*TEXT_SUFFIXES, *RENDERED_SUFFIXES))
+        raise RGraphError.in_file(COMMAND_LINE, f"--dot {dest}: unknown suffix; use one of {known} (or no file for stdout)")
 
 
 def lowered_text(plan: Any, queues: str, workarounds: bool = True) -> str:
@@ -162,19 +179,29 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     console = make_console(out)
     dot_to_stdout = args.dot == "-"
     timings = load_timings(args.timings) if args.timings else None
+    if timings is not None:
+        check_timings_size(plan, timings, args.timings)
     if args.lowered:  # what rgraph run would record: a plan file must pass the typed loader
         from rgraph.plan import load
 
         source = load(args.target) if args.target.endswith(".json") else plan
         out.write(lowered_text(source, args.queues, args.layer_workarounds))
-    if not (args.barriers or args.memory or dot_to_stdout or args.lowered):
+    if args.json:
+        if dot_to_stdout:
+            raise RGraphError.in_file(COMMAND_LINE, "--json and --dot to stdout both print; give --dot a file")
+        from rgraph.commands.jsonout import document, emit
+        from rgraph.report.json_view import inspect_document
+
+        emit(document("inspect", True, **inspect_document(plan, timings, barriers=args.barriers,
+                                                           memory=args.memory)), out)
+    elif not (args.barriers or args.memory or dot_to_stdout or args.lowered):
         text.print_summary(console, plan, timings)
         from rgraph.report.devices import print_devices
 
         print_devices(console, plan)
-    if args.barriers:
+    if args.barriers and not args.json:
         text.print_barriers(console, plan)
-    if args.memory:
+    if args.memory and not args.json:
         if args.barriers:
             console.print()
         text.print_memory(console, plan, timings)
@@ -183,8 +210,12 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
         if not dot_to_stdout:
             print(f"wrote {args.dot}", file=err)
     if args.timeline:
-        from rgraph.report.timeline import write_timeline_png
+        from rgraph.report.timeline import timeline_format, write_timeline_png
 
+        try:
+            timeline_format(args.timeline)
+        except ValueError as exc:
+            raise RGraphError.in_file(COMMAND_LINE, f"--timeline {args.timeline}: {exc}") from None
         try:
             write_timeline_png(plan, args.timeline)
         except OSError as exc:
@@ -193,6 +224,6 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
     if args.html:
         from rgraph.report.html import plan_html
 
-        _write(args.html, plan_html(plan))
+        _write(args.html, plan_html(plan, timings=timings))
         print(f"wrote {args.html}", file=err)
     return 0

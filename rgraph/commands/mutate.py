@@ -20,7 +20,7 @@ from rgraph.errors import RGraphError
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("mutate", help="mutate every barrier of a compiled graph and report which oracle "
                                            "catches each mutant")
-    add_graph_arguments(parser, size_default="64x64")
+    add_graph_arguments(parser)
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     parser.add_argument("--oracles", default="check,syncval,data",
                         help="comma-separated subset of check,syncval,data (default: all three)")

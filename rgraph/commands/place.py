@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 
 from rgraph.errors import RGraphError
-from rgraph.memory import parse_place_args
-from rgraph.memory.trace import read_trace
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -25,7 +23,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.memory import TRACE_BUDGET_S, place
+    from rgraph.memory import TRACE_BUDGET_S, parse_place_args, place
+    from rgraph.memory.trace import read_trace
     from rgraph.memory.verify import overlaps
 
     policy, budget = parse_place_args(args.policy, args.budget, source="--policy")

@@ -10,21 +10,27 @@ unless ``--unchecked``.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
 
-from rgraph.commands.common import add_graph_arguments, add_sync_argument, parse_params, parse_size
+from rgraph.commands.common import (
+    add_graph_arguments,
+    add_sync_argument,
+    default_size_text,
+    parse_params,
+    parse_size,
+)
 from rgraph.errors import RGraphError
 
-DEFAULT_SIZE = "640x360"
 COMMAND_LINE = "<command line>"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
-    add_graph_arguments(parser, size_default=DEFAULT_SIZE)
-    parser.set_defaults(size=None)  # None: not given (a plan file has its own size)
+    add_graph_arguments(parser)
+    parser.set_defaults(size=None)  # None: not given (a plan file has its own size; graphs get the default)
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
@@ -33,8 +39,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
     parser.add_argument("--out", type=Path, help="write the first output image as PNG")
-    parser.add_argument("--timings", type=Path, help="write per-pass GPU times (median ms) as JSON")
+    parser.add_argument("--timings", type=Path,
+                        help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
+    parser.add_argument("--heatmap", type=Path,
+                        help="write the output image light_heat (lights shaded per pixel: graphs/clustered.yaml) as PNG")
+    parser.add_argument("--trace", type=Path, metavar="OUT.json",
+                        help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
+                             "a track per queue, passes as slices, barriers, semaphore waits as flows")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.add_argument("--json", action="store_true",
+                        help="print the result (timings, validation messages, data check) as JSON (docs/cli-json.md)")
     parser.add_argument("--unchecked", action="store_true",
                         help="run a plan file even if rgraph check finds hazards in it")
     parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
@@ -73,7 +87,8 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
 
 def _plan_from_file(args: argparse.Namespace) -> dict:
     given = [flag for flag, value in (("--size", args.size), ("--scene", args.scene), ("-p", args.param),
-                                      ("--policy", args.policy)) if value]
+                                      ("--policy", args.policy),
+                                      ("--schedule", args.schedule != "declaration")) if value]
     if given:
         raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only apply when compiling a graph, not to "
                                                 f"a plan file (its size is {_plan_size(args.graph)})")
@@ -118,6 +133,40 @@ def _print_table(plan: dict, timings: dict) -> None:
     Console(stderr=True).print(table)
 
 
+def _status(args: argparse.Namespace, result) -> int:
+    failed = (args.validate and result.messages) or result.data_ok is False
+    return 1 if failed else 0
+
+
+def _json(args: argparse.Namespace, plan: dict, result) -> int:
+    from rgraph.commands.jsonout import document, emit
+
+    status = _status(args, result)
+    emit(document(
+        "run", status == 0, graph=plan.get("graph"), device=result.device_name, size=plan.get("size"),
+        frames=args.frames, timings=result.timings, culled=plan.get("culled") or [],
+        validation={"enabled": bool(args.validate), "messages": [str(m) for m in result.messages]},
+        data_check=None if result.data_ok is None else {
+            "ok": bool(result.data_ok), "mismatches": [str(m) for m in result.mismatches],
+            "unpredictable": [str(u) for u in result.unchecked]},
+        out=str(args.out) if args.out else None))
+    return status
+
+
+def _report_clusters(args: argparse.Namespace, outputs: dict) -> None:
+    """Light-list statistics and the heatmap of a clustered graph (rgraph.passes.cluster_report)."""
+    if "cluster_stats" not in outputs and not args.heatmap:
+        return
+    from rgraph.resources import builtin_passes
+
+    cluster_report = importlib.import_module(f"{builtin_passes().__name__}.cluster_report")
+
+    if "cluster_stats" in outputs:
+        print(cluster_report.stats_line(cluster_report.stats_of(outputs["cluster_stats"])), file=sys.stderr)
+    if args.heatmap:
+        print(cluster_report.write_heatmap(args.heatmap, outputs["light_heat"][..., 0]), file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
     from rgraph.api import open_device
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
@@ -142,24 +191,43 @@ def run(args: argparse.Namespace) -> int:
                 from rgraph.compiler.pipeline import compile_graph
 
                 plan = compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
-                                     size=parse_size(args.size or DEFAULT_SIZE), policy=args.policy,
-                                     sync=args.sync, memory=gpu.memory_requirements())
+                                     size=parse_size(args.size or default_size_text()), policy=args.policy,
+                                     sync=args.sync, schedule=args.schedule, memory=gpu.memory_requirements())
+            outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
+            if args.heatmap and "light_heat" not in outputs:
+                raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' "
+                                                      "(see graphs/clustered.yaml)")
             exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else ())
             result = exe.run_and_check(args.frames, check_data=args.validate if args.check_data is None
-                                       else args.check_data, out_png=args.out)
+                                       else args.check_data, out_png=args.out,
+                                       read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
             result.messages = gpu.close()  # the device's teardown included
     except (VulkanUnavailable, ExecutionError) as exc:
+        if args.json:
+            from rgraph.commands.jsonout import diagnostic, document, emit
+            from rgraph.errors import Location
+
+            emit(document("run", False, [diagnostic("error", Location("<device>"), str(exc))]))
+            return 2
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
+    _report_clusters(args, result.outputs)
+    if args.timings:
+        args.timings.write_text(json.dumps({"device": result.device_name, "size": plan.get("size"),
+                                            **result.timings}, indent=1, sort_keys=True) + "\n")
+    if args.trace:
+        from rgraph.report.trace import chrome_trace
+
+        trace = chrome_trace(plan, {"device": result.device_name, **result.timings})
+        args.trace.write_text(json.dumps(trace, indent=None, sort_keys=True) + "\n")
+    if args.json:
+        return _json(args, plan, result)
     if plan["passes"]:
         _print_table(plan, result.timings)
     else:
         print("rgraph: nothing to execute: every pass was culled", file=sys.stderr)
     for entry in plan.get("culled", []):
         print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
-    if args.timings:
-        args.timings.write_text(json.dumps({"device": result.device_name, **result.timings}, indent=1,
-                                           sort_keys=True) + "\n")
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 
-from rgraph.spec.models import GraphFile
-
 
 def schema_text() -> str:
+    from rgraph.spec.models import GraphFile
+
     schema = GraphFile.model_json_schema()
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "rgraph graph file, version 1"

@@ -19,7 +19,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "(median of --frames) and compares each image with the reference setting "
                     "(defaults overridden by every --reference). Writes sweep.csv, sweep.md, "
                     "pareto_<knob>.png, images/ and errors/ into -o DIR.")
-    add_graph_arguments(parser, size_default="640x360")
+    add_graph_arguments(parser)
     parser.add_argument("--knob", action="append", metavar="NAME=V1,V2,...", required=True,
                         help="a graph param and the values to try (repeatable)")
     parser.add_argument("--reference", action="append", metavar="NAME=VALUE",

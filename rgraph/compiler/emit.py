@@ -12,6 +12,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from rgraph.compiler import sync as csync
+from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
@@ -124,6 +125,7 @@ def emit(c: Compilation) -> pm.Plan:
             barriers=sum(len(p.barriers) for p in passes), semaphores=sum(1 for p in passes if p.signals),
             peak_bytes=st.peak_bytes, lower_bound_bytes=st.lower_bound_bytes, unaliased_bytes=st.unaliased_bytes,
             allocations=st.allocations, policy=st.policy,
+            schedule=None if c.schedule == DEFAULT_SCHEDULE else c.schedule,  # absent = declaration order
         ),
     )
 

@@ -7,12 +7,13 @@ Each phase takes a ``Compilation`` and returns a new one with its fields filled 
 out, to the memory-requirements provider (a device profile or a live device).
 
 networkx: ``Compilation.graph`` is the dependency DAG of the scheduled passes
-(``rgraph.ir.graph.build_graph``), built on demand for views and tests (DOT, the
-lexicographic topological order check). The hot path does without it: dependencies are
-found in program order, so every edge points forward and declaration order already *is*
-the lexicographic topological order keyed by declaration index; culling is a backwards
-walk over read-after-write edges that ``rgraph.ir.graph.raw_ancestors`` does on the edge
-dict it already has. Building a DiGraph for either costs more than the phase itself
+(``rgraph.ir.graph.build_graph``), built on demand for views and tests; ``--schedule
+async-early`` orders passes with ``networkx.lexicographical_topological_sort`` on it
+(``rgraph.ir.schedule``). The default path does without it: dependencies are found in
+program order, so every edge points forward and declaration order already *is* the
+lexicographic topological order keyed by declaration index; culling is a backwards walk
+over read-after-write edges that ``rgraph.ir.graph.raw_ancestors`` does on the edge dict
+it already has. Building a DiGraph for either costs more than the phase itself
 (benchmarks/compile_scaling.py).
 """
 
@@ -27,9 +28,11 @@ from rgraph.compiler import memory
 from rgraph.compiler.emit import emit as emit_plan
 from rgraph.compiler.sync import SyncResult
 from rgraph.compiler.sync import synchronize as synchronize_passes
+from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.errors import RGraphError
 from rgraph.ir.cull import Culling
 from rgraph.ir.cull import cull as cull_spec
+from rgraph.ir.schedule import schedule_passes
 from rgraph.memory.model import Placement
 from rgraph.spec.specialize import PassSpec, Spec
 
@@ -48,6 +51,7 @@ class Compilation:
     policy: str
     provider: MemoryRequirementsProvider
     profile_name: str
+    schedule: str = DEFAULT_SCHEDULE  # rgraph.ir.schedule mode (``--schedule``)
     culling: Culling | None = None
     passes: tuple[PassSpec, ...] = ()  # scheduled (executed) order
     memory: Mapping[str, memory.ResourceMemory] = field(default_factory=dict)  # used resources, name order
@@ -71,9 +75,9 @@ def cull(c: Compilation) -> Compilation:
 
 
 def schedule(c: Compilation) -> Compilation:
-    """Executed order: declaration order of the kept passes (a topological order, see above)."""
+    """Executed order of the kept passes (``rgraph.ir.schedule``; default: declaration order)."""
     assert c.culling is not None
-    return replace(c, passes=tuple(c.culling.passes))
+    return replace(c, passes=tuple(schedule_passes(c.culling.passes, c.schedule)))
 
 
 def measure(c: Compilation) -> Compilation:

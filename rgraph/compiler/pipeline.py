@@ -18,15 +18,15 @@ from typing import Any
 
 from rgraph.compiler.memory import MemoryRequirementsProvider
 from rgraph.compiler.phases import Compilation, run_phases
+from rgraph.defaults import DEFAULT_SCHEDULE, DEFAULT_SIZE  # re-exported: the one default everywhere
 from rgraph.errors import RGraphError
 from rgraph.plan import Plan, to_json_dict
-from rgraph.resources import resolve_graph
+from rgraph.resources import resolve_graph, resolve_scene
 from rgraph.spec.loader import GraphSource, load_graph
 from rgraph.spec.pydantic_errors import did_you_mean
 from rgraph.spec.scene import ALL_PRESENT, Scene, load_scene
 from rgraph.spec.specialize import Spec, resolve_params, specialize
 
-DEFAULT_SIZE = (1920, 1080)
 DEFAULT_POLICY = "aliased"
 DEFAULT_PROFILE = "lavapipe"
 
@@ -42,7 +42,7 @@ class Frontend:
 
 def load_scene_for(source: GraphSource, scene_path: str | Path | None) -> Scene | None:
     if scene_path is not None:
-        return load_scene(scene_path)
+        return load_scene(resolve_scene(scene_path))
     if source.default_scene is not None:
         if not source.default_scene.is_file():
             assert source.default_scene_loc is not None
@@ -73,8 +73,9 @@ def compilation(
     policy: str = DEFAULT_POLICY,
     memory_provider: MemoryRequirementsProvider | None = None,
     profile_name: str | None = None,
+    schedule: str = DEFAULT_SCHEDULE,
 ) -> Compilation:
-    """The ``Compilation`` after every phase (``.plan`` is the result)."""
+    """The ``Compilation`` after every phase (``.plan`` is the result); ``schedule``: ``--schedule``."""
     if memory_provider is None:
         from rgraph.memory_requirements import ProfileMemoryRequirements
 
@@ -85,7 +86,7 @@ def compilation(
     enabled = gc.isenabled()
     gc.disable()
     try:
-        return run_phases(Compilation(spec, policy, memory_provider, profile_name or "device"))
+        return run_phases(Compilation(spec, policy, memory_provider, profile_name or "device", schedule))
     finally:
         if enabled:
             gc.enable()
@@ -126,6 +127,7 @@ def compile_graph_plan(
     profile: str | None = None,
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
+    schedule: str = DEFAULT_SCHEDULE,
     split: Any = None,
 ) -> Plan:
     """Compile a graph file (or bundled graph name) into a typed plan.
@@ -151,8 +153,10 @@ def compile_graph_plan(
 
         if sync != "normal":
             raise RGraphError.in_file("<command line>", "--sync naive applies to one-device plans only")
+        if schedule != DEFAULT_SCHEDULE:
+            raise RGraphError.in_file("<command line>", f"--schedule {schedule} applies to one-device plans only")
         return compile_split(spec, split, policy=chosen, memory_provider=provider, profile_name=profile_name)
-    plan = compile_plan(spec, policy=chosen, memory_provider=provider, profile_name=profile_name)
+    plan = compile_plan(spec, policy=chosen, memory_provider=provider, profile_name=profile_name, schedule=schedule)
     return apply_sync_mode(plan, sync)
 
 

@@ -21,6 +21,7 @@ from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
+from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell, cells
 from rgraph.spec.specialize import PassSpec, ResourceSpec
@@ -148,7 +149,7 @@ def synchronize(
     (all of them ended before it starts).
     """
     alias_sources = alias_sources or {}
-    syncs = [access_syncs(p, resources) for p in passes]
+    syncs = unify_read_layouts(passes, resources, [access_syncs(p, resources) for p in passes])
     per_pass_cells = [_pass_cells(p, s) for p, s in zip(passes, syncs, strict=True)]
     timeline: dict[Cell, list[_Use]] = defaultdict(list)
     for i, (p, pc) in enumerate(zip(passes, per_pass_cells, strict=True)):

@@ -123,7 +123,7 @@ def _heap(h: Heap) -> dict[str, Any]:
 
 def _stats(s: Stats) -> dict[str, Any]:
     keys = ("barriers", "semaphores", "peak_bytes", "lower_bound_bytes", "unaliased_bytes", "allocations",
-            "policy", "sync")
+            "policy", "sync", "schedule")
     return {k: getattr(s, k) for k in keys if getattr(s, k) is not None}
 
 

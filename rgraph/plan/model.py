@@ -192,6 +192,7 @@ class Stats:
     allocations: int | None = None
     policy: str | None = None
     sync: str | None = None  # "naive" for --sync naive plans
+    schedule: str | None = None  # the --schedule mode when not the default (declaration order)
 
 
 @dataclass(frozen=True)

@@ -320,11 +320,12 @@ def _dropped(value: Any, where: Where) -> DroppedRead:
 
 def _stats(value: Any, where: Where) -> Stats:
     o = _Obj(value, where, ("barriers", "semaphores", "peak_bytes", "lower_bound_bytes", "unaliased_bytes",
-                            "allocations", "policy", "sync"))
+                            "allocations", "policy", "sync", "schedule"))
     count = _int
     return Stats(o("barriers", count, None), o("semaphores", count, None), o("peak_bytes", _size, None),
                  o("lower_bound_bytes", _size, None), o("unaliased_bytes", _size, None),
-                 o("allocations", count, None), o("policy", _str, None), o("sync", _str, None))
+                 o("allocations", count, None), o("policy", _str, None), o("sync", _str, None),
+                 o("schedule", _str, None))
 
 
 def _format(value: Any, where: Where) -> str:

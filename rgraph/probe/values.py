@@ -15,6 +15,7 @@ import numpy as np
 from rgraph import formats
 
 HEADER_WORDS = 16  # indirect-capable buffers: words [0:4] draw, [4:9] indexed draw, [12:15] dispatch
+INDIRECT_MIN_BYTES = 4 * (HEADER_WORDS + 1)  # the header plus one value word: what the probe needs
 BUFFER_MODULUS = 1 << 30
 UINT32 = 0xFFFFFFFF
 

@@ -74,12 +74,21 @@ def dot_available() -> bool:
     return shutil.which("dot") is not None
 
 
-def dot_to_svg(dot_text: str) -> str:
-    """SVG rendered by ``dot -Tsvg``; raises ``RuntimeError`` when dot fails or is missing."""
+RENDERED_SUFFIXES = ("svg", "pdf", "png")
+TEXT_SUFFIXES = ("dot", "gv")
+
+
+def dot_render(dot_text: str, fmt: str) -> bytes:
+    """``dot -T<fmt>`` output; raises ``RuntimeError`` when dot fails or is missing."""
     exe = shutil.which("dot")
     if exe is None:
         raise RuntimeError("graphviz 'dot' is not installed")
-    proc = subprocess.run([exe, "-Tsvg"], input=dot_text, capture_output=True, text=True, timeout=60)
+    proc = subprocess.run([exe, f"-T{fmt}"], input=dot_text.encode(), capture_output=True, timeout=60)
     if proc.returncode != 0:
-        raise RuntimeError(f"dot -Tsvg failed ({proc.returncode}): {proc.stderr.strip()}")
+        raise RuntimeError(f"dot -T{fmt} failed ({proc.returncode}): {proc.stderr.decode(errors='replace').strip()}")
     return proc.stdout
+
+
+def dot_to_svg(dot_text: str) -> str:
+    """SVG rendered by ``dot -Tsvg``; raises ``RuntimeError`` when dot fails or is missing."""
+    return dot_render(dot_text, "svg").decode("utf-8")

@@ -139,12 +139,47 @@ def culling_table(plan: Plan) -> TableData:
     )
 
 
+def culled_resource_bytes(plan: Plan) -> dict[str, int]:
+    """Bytes of each resource only culled passes used, derived from the culled entries.
+
+    An entry's ``bytes`` is the sum over its ``resources``; two culled passes that share a
+    resource (``sss_blur_h`` and ``sss_blur_v`` both use ``sss_tmp``) list it twice, so the
+    total counts each resource once: single-resource entries give a resource's bytes, and an
+    entry whose other resources are known gives the rest.
+    """
+    entries = [(list(c["resources"]), c["bytes"]) for c in plan.get("culled") or []
+               if c.get("resources") is not None and c.get("bytes") is not None]
+    known: dict[str, int] = {}
+    progress = True
+    while progress:
+        progress = False
+        for names, total in entries:
+            unknown = [n for n in dict.fromkeys(names) if n not in known]
+            if len(unknown) == 1:
+                known[unknown[0]] = total - sum(known[n] for n in dict.fromkeys(names) if n in known)
+                progress = True
+    return known
+
+
+def culled_bytes_total(plan: Plan) -> int | None:
+    """Bytes culling saved, each resource counted once (None when the plan lists no bytes)."""
+    entries = [c for c in plan.get("culled") or [] if c.get("bytes") is not None]
+    if not entries:
+        return None
+    known = culled_resource_bytes(plan)
+    names = {n for c in entries for n in c.get("resources") or []}
+    if names <= known.keys() and all(c.get("resources") is not None for c in entries):
+        return sum(known[n] for n in names)
+    return sum(c["bytes"] for c in entries)  # not derivable per resource: an upper bound
+
+
 def culling_total_line(plan: Plan, timings: dict | None = None) -> str | None:
     """The total saved by culling (bytes; GPU ms per frame when ``timings`` of a run of the
     full scene are given), or ``None`` when there is nothing to report."""
     from rgraph.report.summary import culled_ms
 
-    counted = [c["bytes"] for c in plan.get("culled") or [] if c.get("bytes") is not None]
+    saved = culled_bytes_total(plan)
+    counted = [saved] if saved is not None else []
     times = [culled_ms(timings, c["pass"]) for c in plan.get("culled") or []]
     measured = [t for t in times if t is not None]
     parts = []

@@ -110,7 +110,7 @@ def stats_lines(plan: Plan) -> list[str]:
     barriers = stats.get("barriers", listed)
     barrier_text = str(barriers)
     if releases:
-        barrier_text += f" ({plural(releases, 'queue-family release')})"
+        barrier_text += f" + {plural(releases, 'queue-family release')}"
     if barriers != listed:
         barrier_text += f" [passes list {listed}]"
     peak = stats.get("peak_bytes")

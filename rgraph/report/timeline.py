@@ -1,4 +1,4 @@
-"""The ``--timeline`` view: the plan's memory placement drawn as a PNG.
+"""The ``--timeline`` view: the plan's memory placement drawn as PNG, SVG or PDF (by suffix).
 
 Pass index runs across, offset up (a panel per memory class, its heaps stacked in id
 order); one rectangle per placed resource. ``rgraph.memory.timeline.draw_timeline`` can
@@ -176,6 +176,7 @@ def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
         bound = max(live, default=0)
         top = max([totals[cls], bound, 1] + [heap_base[b.heap] + b.offset + b.aligned_size for b in members])
         scale, unit = (MIB, "MiB") if top >= MIB else (1024, "KiB") if top >= 1024 else (1, "B")
+        unlabeled: list[str] = []
         for k, b in enumerate(members):
             bottom = heap_base[b.heap] + b.offset
             ax.add_patch(Rectangle(
@@ -184,6 +185,9 @@ def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
                 hatch=None if b.aliasable else "//",
             ))
             tall = b.aligned_size / top > 0.08
+            if b.aligned_size / top < 0.03 or len(b.name) * 0.09 > b.end - b.start + 0.9:
+                unlabeled.append(b.name)  # too small for a legible label: listed in the legend instead
+                continue
             ax.text(
                 (b.start + b.end) / 2, (bottom + b.aligned_size / 2) / scale,
                 f"{b.name}\n{human_bytes(b.size)}" if tall else b.name,
@@ -199,6 +203,9 @@ def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
                    label=f"lower bound {human_bytes(bound)}")
         ax.plot([], [], color="black", linestyle=":", linewidth=1.0,
                 label=f"{len(column)} heap{'s' if len(column) != 1 else ''}: {human_bytes(totals[cls])}")
+        if unlabeled:
+            shown = ", ".join(unlabeled[:8]) + (f" +{len(unlabeled) - 8}" if len(unlabeled) > 8 else "")
+            ax.plot([], [], " ", label=f"too small to label: {shown}")
         ax.set_ylim(0, top / scale * 1.08)
         ax.set_ylabel(f"offset ({unit})")
         ax.set_title(cls, fontsize=9, loc="left")
@@ -211,4 +218,18 @@ def draw_plan_timeline(plan: Plan, path: str | Path, title: str) -> None:
     axes[-1].set_xlabel("pass (executed order); hatched: not aliasable (persistent, imported, output)")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(str(path), format="png", metadata={"Software": None})
+    fmt = timeline_format(path)
+    fig.savefig(str(path), format=fmt, metadata={"Software": None} if fmt == "png" else None)
+
+
+TIMELINE_FORMATS = ("png", "svg", "pdf")
+
+
+def timeline_format(path: str | Path) -> str:
+    """The image format named by ``path``'s suffix (png when it has none); ValueError otherwise."""
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if not suffix:
+        return "png"
+    if suffix not in TIMELINE_FORMATS:
+        raise ValueError(f"cannot draw a timeline as .{suffix}: use {', '.join('.' + f for f in TIMELINE_FORMATS)}")
+    return suffix

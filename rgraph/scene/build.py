@@ -14,6 +14,7 @@ import numpy as np
 
 from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
 from rgraph.scene.deform import FRAME_SECONDS, Deformer
+from rgraph.scene.generate import expand_lights
 from rgraph.scene.shapes import MeshData, make_shape
 from rgraph.spec.scene import Material, SceneFile, load_scene
 
@@ -66,6 +67,8 @@ class SceneLightData:
     intensity: float
     radius: float
     shadow_layer: int  # -1 without a shadow map
+    cos_inner: float = 1.0  # spot lights: cosines of the cone's inner (full) and outer (zero) half-angles
+    cos_outer: float = 0.0
 
 
 @dataclass
@@ -184,7 +187,7 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
         draw += mesh.instances
         meshes.append(mesh)
     lights, layer = [], 0
-    for li in model.lights:
+    for li in expand_lights(model.lights):
         kind = LIGHT_TYPES[li.type]
         direction = _vec(li.direction if li.direction is not None else (0, -1, 0))
         norm = np.linalg.norm(direction)
@@ -194,8 +197,10 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
             if layer >= MAX_SHADOW_LIGHTS:
                 raise ValueError(f"at most {MAX_SHADOW_LIGHTS} shadow-casting lights are supported")
             shadow, layer = layer, layer + 1
+        cos_inner, cos_outer = (float(np.cos(np.radians(a))) for a in li.cone)
         lights.append(SceneLightData(kind, _vec(li.position if li.position is not None else (0, 0, 0)), direction,
-                                     _vec(li.color) * li.intensity, float(li.intensity), float(li.radius), shadow))
+                                     _vec(li.color) * li.intensity, float(li.intensity), float(li.radius), shadow,
+                                     cos_inner, cos_outer))
     pool = {**BUILTIN_DECALS, **model.materials, **model.decal_materials}
     decals = [DecalData(_vec(d.position), _vec(d.size), tuple(d.rotation), pool[d.material]) for d in model.decals]
     corners = (np.concatenate([m.world_corners() for m in meshes]) if meshes

@@ -133,10 +133,21 @@ def materials_bytes(scene: SceneData) -> bytes:
 
 
 def scene_lights_bytes(scene: SceneData) -> bytes:
-    out = np.zeros((max(len(scene.lights), 1), SCENE_LIGHT_BYTES // 4), dtype=np.float32)
-    for k, li in enumerate(scene.lights):
-        hi, lo = split_hi_lo(li.position)
-        out[k] = (*hi, li.type, *lo, li.radius, *li.direction, li.shadow_layer, *li.radiance, li.intensity)
+    """SceneLights (scene.glsl): spot lights carry cos(inner) in direction.w and cos(outer) in
+    radiance.w (they cast no shadows and shaders use no intensity)."""
+    n = len(scene.lights)
+    out = np.zeros((max(n, 1), SCENE_LIGHT_BYTES // 4), dtype=np.float32)
+    if n:
+        pos = np.array([li.position for li in scene.lights], dtype=np.float64)
+        hi, lo = split_hi_lo(pos)
+        spot = np.array([li.type == LIGHT_TYPES["spot"] for li in scene.lights])
+        out[:n, 0:3], out[:n, 4:7] = hi, lo
+        out[:n, 3] = [li.type for li in scene.lights]
+        out[:n, 7] = [li.radius for li in scene.lights]
+        out[:n, 8:11] = [li.direction for li in scene.lights]
+        out[:n, 11] = np.where(spot, [li.cos_inner for li in scene.lights], [li.shadow_layer for li in scene.lights])
+        out[:n, 12:15] = [li.radiance for li in scene.lights]
+        out[:n, 15] = np.where(spot, [li.cos_outer for li in scene.lights], [li.intensity for li in scene.lights])
     return out.tobytes()
 
 

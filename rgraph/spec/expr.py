@@ -7,6 +7,7 @@ Grammar (whitespace is free between tokens)::
     unary   := ("-" | "+") unary | primary
     primary := NUMBER | REF | FUNC "(" expr ("," expr)* ")" | "(" expr ")" | "${" expr "}"
     REF     := ("params" | "scene") ("." SEGMENT)+        e.g. params.shadow.size
+             | LOOPVAR                                  a repeated pass's variable, e.g. i
     FUNC    := "min" | "max" (2+ arguments) | "ceil" | "floor" (1 argument)
 
 Numbers are ``12``, ``1.5``, ``.5``, ``2e3``; a literal with ``.`` or an exponent is a float.
@@ -245,8 +246,9 @@ def _render_operand(node: Node, min_level: int) -> str:
 # ---------------------------------------------------------------------------- parser
 
 class _Parser:
-    def __init__(self, text: str, template: bool) -> None:
+    def __init__(self, text: str, template: bool, local_names: Collection[str] = ()) -> None:
         self.text = text
+        self.local_names = frozenset(local_names)
         self.tokens = tokenize(text, template)
         self.tok = next(self.tokens)
         self.depth = 0
@@ -358,6 +360,10 @@ class _Parser:
         head, dot, _ = name.partition(".")
         if name in FUNCTIONS:
             raise ExprError(f"'{name}' is a function: call it as {name}(...)", tok.offset)
+        if name in self.local_names and tok.in_group:  # a loop variable of a repeated pass
+            ref = Ref(name, tok.offset)
+            self.refs.append(ref)
+            return ref
         if head not in NAMESPACES or not dot:
             hint = ""
             if dot:
@@ -480,21 +486,22 @@ def _lookup(ref: Ref, env: Mapping[str, int | float | bool]) -> Number:
 
 # ---------------------------------------------------------------------------- entry points
 
-def _parse(text: str, template: bool) -> Expr:
+def _parse(text: str, template: bool, local_names: Collection[str] = ()) -> Expr:
     if len(text) > MAX_LENGTH:
         raise ExprError(f"expression too long ({len(text)} characters; the limit is {MAX_LENGTH})", MAX_LENGTH)
-    parser = _Parser(text, template)
+    parser = _Parser(text, template, local_names)
     root = parser.parse()
     return Expr(text, root, tuple(parser.refs))
 
 
-def parse(text: str) -> Expr:
-    """Parse the inside of one ``${...}``; raises ExprError."""
-    return _parse(text, template=False)
+def parse(text: str, local_names: Collection[str] = ()) -> Expr:
+    """Parse the inside of one ``${...}``; ``local_names`` are bare names allowed besides
+    ``params.*``/``scene.*`` (a repeated pass's loop variable); raises ExprError."""
+    return _parse(text, template=False, local_names=local_names)
 
 
-def parse_value(text: object) -> Expr | None:
+def parse_value(text: object, local_names: Collection[str] = ()) -> Expr | None:
     """Parse a whole YAML value: None for a non-string or a string without ``${``; raises ExprError."""
     if not isinstance(text, str) or "${" not in text:
         return None
-    return _parse(text, template=True)
+    return _parse(text, template=True, local_names=local_names)

@@ -79,6 +79,10 @@ UsageValue = Annotated[
 
 
 class Pass(_Strict):
+    for_: dict[str, list[IntExpr]] | None = Field(
+        None, alias="for",
+        description="Repeat this pass: {VAR: [first, stop]} (half-open, values may be expressions); "
+                    "${VAR} may appear in the pass name and in its reads/writes keys.")
     kind: PassKind
     impl: str | None = Field(None, description="A registered implementation; omitted -> the probe.")
     queue: QueueName = "graphics"

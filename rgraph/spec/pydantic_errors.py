@@ -80,7 +80,8 @@ def _model_fields(model: type[BaseModel], path: Sequence[str | int]) -> list[str
 
 
 _FIELD_WORDS = {"requires": "scene feature", "stages": "shader stage", "kind": "pass kind", "usage": "usage"}
-_BRANCHES = ("int", "str", "float", "bool", "list[union[int,str]]", "literal['output']", "ScaleSize")
+_BRANCHES = ("int", "str", "float", "bool", "list[union[int,str]]", "literal['output']", "ScaleSize", "light",
+             "generator")
 
 
 def _siblings(exc: ValidationError, loc: tuple[Any, ...]) -> list[Any]:
@@ -114,6 +115,10 @@ def translate(exc: ValidationError, smap: SourceMap, model: type[BaseModel], dat
         if kind == "extra_forbidden":
             key = str(loc[-1])
             valid = _model_fields(model, loc[:-1] if loc else loc)
+            if "generator" in err["loc"] or "light" in err["loc"]:  # a scene file's lights: item
+                from rgraph.spec.scene import Light, LightGenerator
+
+                valid = list((LightGenerator if "generator" in err["loc"] else Light).model_fields)
             msg = f"unknown key '{key}' in {_where(loc[:-1])}{did_you_mean(key, valid)} (valid keys: {', '.join(valid)})"
             at_key = True
         elif kind == "missing":

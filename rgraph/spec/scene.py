@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, model_validator
 
 from rgraph.errors import RGraphError
 from rgraph.spec.pydantic_errors import translate
@@ -38,8 +38,48 @@ class Light(_Strict):
     position: Vec3 | None = Field(None, min_length=3, max_length=3)
     color: Vec3 = Field(default_factory=lambda: [1.0, 1.0, 1.0], min_length=3, max_length=3)
     intensity: float = Field(1.0, ge=0)
-    radius: float = Field(1.0, gt=0)
+    radius: float = Field(1.0, ge=0)  # metres: the light reaches exactly zero here (0: no reach)
     shadows: bool = False
+    cone: list[float] = Field(default_factory=lambda: [30.0, 45.0], min_length=2, max_length=2)  # spot: inner, outer (deg)
+
+    @model_validator(mode="after")
+    def _cone_order(self) -> Light:
+        inner, outer = self.cone
+        if not 0 <= inner <= outer <= 90:
+            raise ValueError(f"cone must be [inner, outer] degrees with 0 <= inner <= outer <= 90, got {self.cone}")
+        return self
+
+
+class LightGenerator(_Strict):
+    """FORMAT.md 7: ``count`` seeded random point lights (rgraph.scene.generate expands them)."""
+
+    generate: Literal["point"]
+    count: int = Field(ge=0, le=1 << 20)
+    seed: int = 0
+    bounds: list[Vec3] = Field(min_length=2, max_length=2)
+    radius: list[float] = Field(default_factory=lambda: [1.0, 1.0], min_length=2, max_length=2)
+    intensity: list[float] = Field(default_factory=lambda: [1.0, 1.0], min_length=2, max_length=2)
+    color: Vec3 | None = Field(None, min_length=3, max_length=3)  # omitted: seeded random colours
+
+    @model_validator(mode="after")
+    def _ranges(self) -> LightGenerator:
+        for name in ("radius", "intensity"):
+            lo, hi = getattr(self, name)
+            if not 0 <= lo <= hi:
+                raise ValueError(f"{name} must be [low, high] with 0 <= low <= high, got {[lo, hi]}")
+        for k in range(3):
+            if len(self.bounds[k % 2]) != 3 or self.bounds[0][k] > self.bounds[1][k]:
+                raise ValueError("bounds must be [[x0, y0, z0], [x1, y1, z1]] with x0 <= x1, y0 <= y1, z0 <= z1")
+        return self
+
+
+def _light_kind(value: Any) -> str:
+    return "generator" if isinstance(value, dict) and "generate" in value else "light"
+
+
+#: A ``lights:`` item: an authored light, or a generator (an item with ``generate:``).
+LightItem = Annotated[Annotated[Light, Tag("light")] | Annotated[LightGenerator, Tag("generator")],
+                      Discriminator(_light_kind)]
 
 
 class Material(_Strict):
@@ -83,7 +123,7 @@ class SceneFile(_Strict):
     scene: int
     name: str | None = None
     camera: Camera = Field(default_factory=Camera)
-    lights: list[Light] = Field(default_factory=list)
+    lights: list[LightItem] = Field(default_factory=list)
     materials: dict[str, Material] = Field(default_factory=dict)
     meshes: list[Mesh] = Field(default_factory=list)
     decals: list[Decal] = Field(default_factory=list)
@@ -107,10 +147,12 @@ def features_of(scene: SceneFile) -> dict[str, int]:
         [math.dist(scene.camera.position, (0, 0, 0))]
         + [math.dist(m.position, (0, 0, 0)) for m in scene.meshes],
     )
+    authored = [light for light in scene.lights if isinstance(light, Light)]
+    generated = sum(g.count for g in scene.lights if isinstance(g, LightGenerator))
     feats = {
-        "lights": len(scene.lights),
-        "point_lights": sum(1 for light in scene.lights if light.type in ("point", "spot")),
-        "shadow_lights": sum(1 for light in scene.lights if light.type == "directional" and light.shadows),
+        "lights": len(authored) + generated,
+        "point_lights": sum(1 for light in authored if light.type in ("point", "spot")) + generated,
+        "shadow_lights": sum(1 for light in authored if light.type == "directional" and light.shadows),
         "sss_materials": sum(1 for m in mats if m.sss > 0),
         "decals": len(scene.decals),
         "reflective_materials": sum(1 for m in mats if m.reflective > 0 or m.metallic > 0.5),

@@ -19,6 +19,7 @@ from rgraph.spec.expr import ExprError, parse_value
 from rgraph.spec.loader import GraphSource, Located
 from rgraph.spec.models import ImageResource, ScaleSize
 from rgraph.spec.pydantic_errors import describe, did_you_mean
+from rgraph.spec.repeat import instances, substitute
 from rgraph.spec.vocabulary import (
     QUEUE_PASS_KINDS,
     USAGE_PASS_KINDS,
@@ -105,7 +106,8 @@ class Spec:
 
 
 _SELECTOR = re.compile(r"^(?P<name>[^\[\]]+?)\s*(\[(?P<sel>[^\]]*)\])?$")
-_SEL_PART = re.compile(r"^\s*(?P<key>mips?|layers?)\s*=\s*(?P<a>\d+)\s*(:\s*(?P<b>\d+)\s*)?$")
+_SEL_PART = re.compile(r"^\s*(?P<key>mip|layer)\s*=\s*(?P<a>\d+)\s*(:\s*(?P<b>\d+)\s*)?$")
+_SEL_PLURAL = re.compile(r"^\s*(mips|layers)\s*=")
 
 
 class _Env:
@@ -114,6 +116,18 @@ class _Env:
     def __init__(self, params: Mapping[str, Any], features: Mapping[str, int]) -> None:
         self.values: dict[str, Any] = {f"params.{k}": v for k, v in params.items()}
         self.values.update({f"scene.{k}": v for k, v in features.items()})
+        self.locals: frozenset[str] = frozenset()
+
+    def bind(self, bindings: Mapping[str, int]) -> _Env:
+        """This environment with a repeated pass's loop variables bound."""
+        env = _Env({}, {})
+        env.values = {**self.values, **bindings}
+        env.locals = self.locals | frozenset(bindings)
+        return env
+
+    def text(self, text: str, where: Location) -> str:
+        """``text`` with each ``${...}`` replaced by its integer value."""
+        return substitute(text, self.values, self.locals, where) if "${" in text else text
 
     def number(self, value: Any, where: Located, *path: str | int) -> int | float:
         if isinstance(value, bool):
@@ -121,7 +135,7 @@ class _Env:
         if isinstance(value, int | float):
             return value
         try:
-            expr = parse_value(value)
+            expr = parse_value(value, self.locals)
             if expr is None:
                 raise RGraphError.at(
                     where.loc(*path), f"expected a number or a '${{...}}' expression, got {describe(value)}"
@@ -188,12 +202,18 @@ def specialize(
     outputs = _outputs(source, resources)
     passes: list[PassSpec] = []
     removed: list[tuple[str, str]] = []
-    for order, (name, located) in enumerate(source.passes.items()):
-        spec = _pass(name, order, located, resources, env)
-        missing = [f for f in spec.requires if not features.get(f)]
-        if missing:
-            removed.append((name, "scene has no " + " and no ".join(missing)))
-        passes.append(spec)
+    first_seen: dict[str, Location] = {}
+    for template, located in source.passes.items():
+        for name, bindings in instances(template, located, env):
+            if name in first_seen:
+                raise RGraphError.at(located.key_loc(), f"pass name '{name}' (from '{template}') is already "
+                                                        f"used by the pass at {first_seen[name]}")
+            first_seen[name] = located.key_loc()
+            spec = _pass(name, len(passes), located, resources, env.bind(bindings))
+            missing = [f for f in spec.requires if not features.get(f)]
+            if missing:
+                removed.append((name, "scene has no " + " and no ".join(missing)))
+            passes.append(spec)
     _check_program_order(passes, resources)
     return Spec(
         name=source.name,
@@ -279,9 +299,10 @@ def _extent(value: Any, loc: Located, env: _Env, size: tuple[int, int], limits: 
     return dims
 
 
-def _selector(key: str, located: Located, section: str) -> tuple[str, dict[str, tuple[int, int]]]:
+def _selector(template: str, located: Located, section: str, env: _Env) -> tuple[str, dict[str, tuple[int, int]]]:
+    where = located.key_loc(section, template)
+    key = env.text(template, where)
     match = _SELECTOR.match(key)
-    where = located.key_loc(section, key)
     if not match:
         raise RGraphError.at(where, f"bad resource reference '{key}' (expected NAME or NAME[layer=a:b, mip=c])")
     ranges: dict[str, tuple[int, int]] = {}
@@ -289,11 +310,15 @@ def _selector(key: str, located: Located, section: str) -> tuple[str, dict[str, 
     if sel is not None:
         for part in sel.split(","):
             pm = _SEL_PART.match(part)
+            plural = _SEL_PLURAL.match(part)
+            if plural:
+                raise RGraphError.at(where, f"bad subresource selector '{part.strip()}' in '{key}': the axis is "
+                                            f"'{plural.group(1)[:-1]}' (mip=a:b, layer=a:b), not '{plural.group(1)}'")
             if not pm:
                 raise RGraphError.at(
                     where, f"bad subresource selector '{part.strip()}' in '{key}' (expected layer=a:b or mip=a:b, half-open)"
                 )
-            axis = "mips" if pm.group("key").startswith("mip") else "layers"
+            axis = "mips" if pm.group("key") == "mip" else "layers"
             a = int(pm.group("a"))
             b = int(pm.group("b")) if pm.group("b") is not None else a + 1
             if b <= a:
@@ -311,7 +336,7 @@ def _pass(name: str, order: int, located: Located, resources: dict[str, Resource
     accesses: list[AccessSpec] = []
     for section in ("reads", "writes"):
         for key, entries in getattr(model, section).items():
-            res_name, ranges = _selector(key, located, section)
+            res_name, ranges = _selector(key, located, section, env)
             res = resources.get(res_name)
             if res is None:
                 raise RGraphError.at(

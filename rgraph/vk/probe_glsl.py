@@ -92,7 +92,8 @@ def _words(resource: dict) -> int:
     n = int(resource.get("size_bytes") or resource["bytes"]) // 4
     minimum = HEADER_WORDS + 1 if has_header(resource) else 1
     if n < minimum:
-        raise ExecutionError(f"buffer {resource['name']!r} is too small for the probe ({n * 4} bytes)")
+        raise ExecutionError(f"buffer {resource['name']!r} is too small for the probe ({n * 4} bytes; it needs at "
+                             f"least {4 * minimum} bytes{' for its indirect-argument header' if minimum > 1 else ''})")
     return n
 
 

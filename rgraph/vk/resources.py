@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph.vk import names
+from rgraph.vk.debug_names import name_object, resource_name
 from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
@@ -140,6 +141,8 @@ class ResourceSet:
                         continue
                     handle = self._create_object(res, alias=res["name"] in aliased)
                     r = Resource(res, handle, set_index)
+                    name_object(self.device, handle, v.VK_OBJECT_TYPE_IMAGE if r.is_image else v.VK_OBJECT_TYPE_BUFFER,
+                                resource_name(res, set_index, copies))
                     if r.is_image:
                         req = v.vkGetImageMemoryRequirements(dev, handle)
                     else:
@@ -159,6 +162,9 @@ class ResourceSet:
                 memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(allocationSize=int(heap["bytes"]),
                                                                         memoryTypeIndex=index), None)
                 self.memories.append(memory)
+                name_object(self.device, memory, v.VK_OBJECT_TYPE_DEVICE_MEMORY,
+                            f"heap {heap_id} ({heap.get('memory_class') or '?'})"
+                            + (f" (frame set {set_index})" if copies > 1 else ""))
                 for r in created:
                     offset = int(r.plan["offset"])
                     if r.is_image:
@@ -197,6 +203,8 @@ class ResourceSet:
                     baseArrayLayer=layers[0], layerCount=layers[1] - layers[0]),
             )
             r.views[key] = v.vkCreateImageView(self.device.handle, info, None)
+            name_object(self.device, r.views[key], v.VK_OBJECT_TYPE_IMAGE_VIEW,
+                        f"{r.plan['name']} view mips {mips[0]}:{mips[1]} layers {layers[0]}:{layers[1]}")
         return r.views[key]
 
     def destroy(self) -> None:

@@ -35,6 +35,6 @@ void main() {
         o.to_light = vec4(type == LIGHT_SPOT ? -dir : vec3(0.0), float(type));  // spot: minus its axis
         o.view = vec4(mat3(frame.view) * rel, 1.0 / (r * r));
     }
-    o.radiance = vec4(s.radiance.rgb, s.direction.w);
+    o.radiance = vec4(s.radiance.rgb, type == LIGHT_SPOT ? -1.0 : s.direction.w);  // spot: w holds its cone
     lights_out[i] = o;
 }

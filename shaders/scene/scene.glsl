@@ -71,7 +71,8 @@ struct SceneLight {
     vec4 position_hi;     //   0  xyz: float32(world position); w: type (LIGHT_*)
     vec4 position_lo;     //  16  xyz: float32(position - hi); w: radius (m)
     vec4 direction;       //  32  xyz: unit direction the light TRAVELS (directional, spot); w: shadow layer or -1
-    vec4 radiance;        //  48  rgb: color * intensity; w: intensity
+                          //      (spot: cos of the cone's inner half-angle, full intensity inside)
+    vec4 radiance;        //  48  rgb: color * intensity; w: intensity (spot: cos of the outer half-angle, 0 outside)
 };
 layout(set = 0, binding = 3, std430) readonly buffer SceneLights { SceneLight scene_lights[]; };
 

@@ -42,7 +42,10 @@ def test_json_output(capsys, tmp_path):
     path.write_text(json.dumps(without(load("subresources"), "mip2", "pyramid")))
     code, out, _ = run(capsys, "--json", str(path))
     assert code == 1
-    (item,) = json.loads(out)
+    doc = json.loads(out)
+    assert doc["format"] == "rgraph-check/1" and doc["ok"] is False and doc["diagnostics"] == []
+    assert doc["checked"] == {"passes": 7, "barriers": 7, "releases": 0, "resources": 2}
+    (item,) = doc["hazards"]
     assert item["kind"] == "RAW" and item["pass"] == 5 and item["pass_name"] == "mip2"
     assert item["resource"] == "pyramid" and item["subresource"] == {"mips": [1, 2], "layers": [0, 1]}
 

@@ -12,6 +12,8 @@ from rgraph.resources import bundled_graphs
 # Small-run params per graph: the graphs' defaults target a real GPU at 1920x1080.
 SMALL = {
     "surgery": {"shadow.size": "256"},
+    "surgery_clustered": {"shadow.size": "256", "clusters.tile": "16"},
+    "clustered": {"clusters.tile": "16", "clusters.slices": "8"},
     "allocator_lines": {"alloc.meshes": "200", "alloc.segments": "10"},
 }
 

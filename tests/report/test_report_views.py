@@ -47,7 +47,7 @@ def test_summary_culled_dropped_and_stats(capsys):
     assert " ".join(row(out, "debug_overlay")) == "debug_overlay reaches no output"
     assert "Dropped optional reads (1)" in lines
     assert " ".join(row(out, "lighting")) == "lighting ssr optional read with no producer"
-    assert "barriers     16 (3 queue-family releases)" in lines
+    assert "barriers     16 + 3 queue-family releases" in lines
     assert "semaphores   2" in lines
     assert "peak         71.8 MiB (75301120 B) in 3 allocations" in lines
     assert "lower bound  71.8 MiB (75301120 B), peak/lower bound 1.000" in lines

@@ -74,11 +74,11 @@ REGRESSIONS = [
     (4, 4, "dedicated"),
     # NVIDIA, session 3: the 1.3.239 layer's cross-queue racing false positive (a queue's own
     # access imported by another queue counted as that queue's); session 4 adds the semaphore
-    # edge its model predicts (rgraph.vk.layer_races)
+    # edge its model predicts (rgraph.vk.lower.workarounds.layer_races)
     (391, 18, "dedicated"),
     # NVIDIA, session 4: graphics wrote, read, then waited for compute, which had imported the
     # write; the layer replaced graphics' own dependency chain for it and reported the next
-    # transition (runtime: the transition after reads also names the write, rgraph.vk.after_reads)
+    # transition (runtime: the transition after reads also names the write, rgraph.vk.lower.workarounds.after_reads)
     (2936, 17, "dedicated"),
     # NVIDIA, session 4: an aliased image's first use on the compute family after the previous
     # occupant's attachment write on graphics: fitting the barrier to the family left its src
@@ -105,14 +105,14 @@ REGRESSIONS = [
     # NVIDIA, session 5 (benchmarks/fuzz_sweep.py, 7 of 1,659 graphs): the layer places images
     # tightly packed, NVIDIA pads them, so a hand-off on a smaller-packed new occupant left the
     # previous occupant's other bytes unsynchronized in its model (runtime: a global memory
-    # barrier with such hand-offs, rgraph.vk.packed_ranges)
+    # barrier with such hand-offs, rgraph.vk.lower.workarounds.packed_ranges)
     (1289, 37, "aliased"),
     (1337, 40, "aliased"),
     (1080, 32, "aliased"),
     (333, 36, "aliased"),
     # NVIDIA, session 5: chains the layer replaced at semaphore waits for an aliased buffer's
     # first use after reads, and for layout changes after an ownership acquire (runtime: those
-    # barriers name every cross-queue wait stage of their VkQueue, rgraph.vk.after_reads)
+    # barriers name every cross-queue wait stage of their VkQueue, rgraph.vk.lower.workarounds.after_reads)
     (885, 24, "aliased"),
     (422, 25, "aliased"),
     (156, 32, "aliased"),

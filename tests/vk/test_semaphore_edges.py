@@ -1,4 +1,4 @@
-"""Cross-queue semaphores (``rgraph.vk.semaphore_edges``), pure: plans on a fake device with
+"""Cross-queue semaphores (``rgraph.vk.lower.semaphores``), pure: plans on a fake device with
 separate graphics/compute/transfer VkQueues (as on NVIDIA; lavapipe has one queue, so CI never
 submits a semaphore). Two properties, over several frames of host submission order:
 
@@ -154,7 +154,7 @@ def test_latest_signal_per_queue_is_kept_and_stages_merge():
 
 
 def racing_reports(plan: dict, device: FakeDevice, order_of, frames: int = 3, avoid: bool = False) -> set[str]:
-    """Passes the 1.3.239 layer's racing check reports (``rgraph.vk.layer_races`` model) with
+    """Passes the 1.3.239 layer's racing check reports (``rgraph.vk.lower.workarounds.layer_races`` model) with
     the submission order ``order_of`` gives, or with ``avoid``: the executor's edges and order."""
     batches = make_batches(plan, device, one_per_pass=True)
     syncs = syncs_of(plan, device, True)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rgraph.vk.debug_names import name_object
 from rgraph.vk.loader import vk
 from rgraph.vk.record import barrier_batches
 from rgraph.vk.record_context import RecordContext
@@ -65,12 +66,3 @@ def label_begin(device: Any, cb: Any, text: str | None) -> None:
     fn = device.fn("vkCmdBeginDebugUtilsLabelEXT")
     if fn:
         fn(cb, v.VkDebugUtilsLabelEXT(pLabelName=text, color=[0.0, 0.0, 0.0, 0.0]))
-
-
-def name_object(device: Any, handle: Any, object_type: int, name: str) -> None:
-    v = vk()
-    fn = device.fn("vkSetDebugUtilsObjectNameEXT")
-    if not fn:
-        return
-    raw = int(v.ffi.cast("uint64_t", handle))
-    fn(device.handle, v.VkDebugUtilsObjectNameInfoEXT(objectType=object_type, objectHandle=raw, pObjectName=name))

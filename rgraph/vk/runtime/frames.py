@@ -137,8 +137,11 @@ def timings(ex: Any, rows: Any, frames: int, cpu_s: Any) -> dict[str, Any]:
         for i, p in enumerate(ex.plan["passes"]):
             per_pass[p["name"]] = float(np.median(ends[:, i] - starts[:, i])) * period
         total = float(np.median(ends.max(axis=1) - starts.min(axis=1))) * period
+    from rgraph.vk.pass_intervals import pass_intervals
+
     return {"passes": per_pass, "total_ms": total, "frames": frames,
-            "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None}
+            "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None,
+            "intervals": pass_intervals(ex.plan, rows, period)}
 
 
 def check_result(result: int, call: str) -> None:

@@ -181,7 +181,7 @@ def run(args: argparse.Namespace) -> int:
     if devices is not None and (len(devices) > 1 or _is_multi_plan(args.graph)):
         from rgraph.commands.run_multi import run_multi
 
-        return run_multi(args, devices, DEFAULT_SIZE)
+        return run_multi(args, devices, default_size_text())
     if devices is not None and args.device is None:
         args.device = devices[0]
     plan = _plan_from_file(args) if is_plan_file(args.graph) else None

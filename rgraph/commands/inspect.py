@@ -79,7 +79,9 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
         options["profile"] = args.profile
     from rgraph.commands.multi_args import split_from_args
 
-    options["split"] = split_from_args(args)
+    split = split_from_args(args)
+    if split is not None:
+        options["split"] = split
     plan = compile_graph(target, scene_path=args.scene, **options)
     check_plan(plan, target)
     return plan

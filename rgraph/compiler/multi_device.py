@@ -26,7 +26,7 @@ executed order and tracking which resources hold only a device's *share* ("split
 
 Split resources that the cut's side reads (or outputs, or persistent ones) *cross*: device
 ``d > 0`` copies its band (sort-first) or whole image (sort-last) into a host-visible
-buffer (``X.download``), device 0 waits for it and copies it into place (``X.upload<d>``,
+buffer (``X.download``, read back to the host), device 0 waits for it and copies it into place (``X.upload<d>``,
 the sort-first composite) or into ``X.remote<d>`` that ``composite<d>`` depth-tests in.
 """
 
@@ -84,7 +84,7 @@ def bands(height: int, split: Split) -> list[tuple[int, int]]:
         acc += w
         edges.append(min(height, max(edges[-1], round(height * acc / total))))
     edges.append(height)
-    return [(a, b - a) for a, b in zip(edges, edges[1:])]
+    return [(a, b - a) for a, b in zip(edges, edges[1:], strict=False)]
 
 
 @dataclass(frozen=True)
@@ -118,7 +118,7 @@ def partition(spec: Spec, passes: Sequence[PassSpec], mode: str) -> Partition:
     tiled: set[str] = set()
     cut, reason = None, "no pass reads a split result: the composite is at the end"
     prefix: list[PassSpec] = []
-    for i, p in enumerate(passes):
+    for p in passes:
         far = [a for a in p.accesses if a.resource in split and not a.write and a.usage not in LOCAL_USAGES]
         if far:
             cut, reason = p.name, f"pass '{p.name}' reads split '{far[0].resource}' as {far[0].usage}"
@@ -258,7 +258,7 @@ def compile_split(spec: Spec, split: Split, **options) -> Plan:
     part = partition(spec, kept_passes, split.mode)
     kept = replace(spec, passes=kept_passes, removed=[])
     plans = []
-    for d, sub in enumerate(device_specs(kept, part, split)):
+    for sub in device_specs(kept, part, split):
         plan = compilation(sub, **options).plan
         assert plan is not None
         plans.append(plan)

@@ -17,7 +17,7 @@ from dataclasses import replace
 from types import MappingProxyType
 from typing import Any
 
-from rgraph.plan.model import Access, Barrier, Plan, PlanPass, PlanResource, Signal, Stats, Wait
+from rgraph.plan.model import Access, Barrier, Plan, PlanPass, Signal, Stats, Wait
 
 SUFFIX = "@"
 
@@ -61,7 +61,7 @@ def merge(plans: Sequence[Plan], info: Mapping[str, Any], culled: Sequence[Any] 
     index = {(d, p.index): i for i, (d, p) in enumerate(order)}
     # cross-device signals: the sending pass signals its queue's next value
     sends: dict[tuple[int, str], Signal] = {}
-    for d, p in order:
+    for _d, p in order:
         src = _cross_copies(p)
         if src is None:
             continue

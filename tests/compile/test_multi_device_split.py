@@ -27,7 +27,7 @@ def _plan(graph, mode, devices=2):
 def test_bands_cover_the_screen_top_to_bottom(height, devices):
     out = bands(height, Split(devices, "sort-first"))
     assert out[0][0] == 0 and sum(r for _y, r in out) == height
-    assert all(a[0] + a[1] == b[0] for a, b in zip(out, out[1:]))
+    assert all(a[0] + a[1] == b[0] for a, b in zip(out, out[1:], strict=False))
     assert max(r for _y, r in out) - min(r for _y, r in out) <= 1
 
 

@@ -20,9 +20,9 @@ def rebalance(weights: Sequence[float], times_ms: Sequence[float], damping: floa
     """The next shares (summing to 1) from this frame's shares and per-device times."""
     total = sum(weights)
     shares = [w / total for w in weights]
-    speeds = [s / max(t, 1e-6) for s, t in zip(shares, times_ms)]
+    speeds = [s / max(t, 1e-6) for s, t in zip(shares, times_ms, strict=True)]
     target = [v / sum(speeds) for v in speeds]
-    mixed = [max(MIN_SHARE, (1 - damping) * s + damping * g) for s, g in zip(shares, target)]
+    mixed = [max(MIN_SHARE, (1 - damping) * s + damping * g) for s, g in zip(shares, target, strict=True)]
     return tuple(m / sum(mixed) for m in mixed)
 
 

@@ -42,31 +42,31 @@ def _image_and_buffer(setup: Any) -> tuple[str, str]:
     return image, buffer
 
 
-@register(DOWNLOAD_IMPL)
-class Download(PassImpl):
-    """Device ``d > 0``: the band (or whole image) into the host-visible tile buffer."""
+class _BandCopy(PassImpl):
+    """The image and buffer a copy pass names, and the regions of its ``rect``."""
 
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
         self.image, self.buffer = _image_and_buffer(setup)
         self.regions = band_regions(setup, self.image)
+        self.layout = names.layout(setup.access(self.image)["layout"])
+
+
+@register(DOWNLOAD_IMPL)
+class Download(_BandCopy):
+    """Device ``d > 0``: the band (or whole image) into the tile buffer (read back to the host after the frame)."""
 
     def record(self, rec: Any, frame_set: int) -> None:
         img = self.setup.resource(self.image, frame_set)
         buf, _size = self.setup.buffer(self.buffer, frame_set)
-        rec.copy_image_to_buffer(img.handle, names.layout(self.setup.access(self.image)["layout"]), buf, self.regions)
+        rec.copy_image_to_buffer(img.handle, self.layout, buf, self.regions)
 
 
 @register(UPLOAD_IMPL)
-class Upload(PassImpl):
+class Upload(_BandCopy):
     """Device 0: the received buffer into place (sort-first: the composite itself)."""
-
-    def __init__(self, setup: Any) -> None:
-        super().__init__(setup)
-        self.image, self.buffer = _image_and_buffer(setup)
-        self.regions = band_regions(setup, self.image)
 
     def record(self, rec: Any, frame_set: int) -> None:
         img = self.setup.resource(self.image, frame_set)
         buf, _size = self.setup.buffer(self.buffer, frame_set)
-        rec.copy_buffer_to_image(buf, img.handle, names.layout(self.setup.access(self.image)["layout"]), self.regions)
+        rec.copy_buffer_to_image(buf, img.handle, self.layout, self.regions)

@@ -48,7 +48,7 @@ def heat_rgba(heat: np.ndarray, scale: float | None = None) -> tuple[np.ndarray,
 
 def write_heatmap(path: Path, heat: np.ndarray) -> str:
     """Write the heatmap PNG; returns a one-line description."""
-    from rgraph.vk.readback import write_png
+    from rgraph.png import write_png
 
     rgba, top = heat_rgba(heat)
     write_png(Path(path), rgba)

@@ -27,10 +27,14 @@ from rgraph.errors import RGraphError
 COMMAND_LINE = "<command line>"
 
 
+class DefaultSize(str):
+    """The default ``--size`` (a str subclass), so that a plan file can tell it was not given."""
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     parser = sub.add_parser("run", help="compile and execute a graph (or a plan JSON) on a Vulkan device")
     add_graph_arguments(parser)
-    parser.set_defaults(size=None)  # None: not given (a plan file has its own size; graphs get the default)
+    parser.set_defaults(size=DefaultSize(default_size_text()))  # a plan file has its own size
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=int, default=1, help="frames to run (default 1)")
@@ -86,11 +90,13 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
 
 
 def _plan_from_file(args: argparse.Namespace) -> dict:
-    given = [flag for flag, value in (("--size", args.size), ("--scene", args.scene), ("-p", args.param),
+    given = [flag for flag, value in (("--size", not isinstance(args.size, DefaultSize)), ("--scene", args.scene),
+                                      ("-p", args.param),
                                       ("--policy", args.policy),
                                       ("--schedule", args.schedule != "declaration")) if value]
     if given:
-        raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only apply when compiling a graph, not to "
+        verb = "applies" if len(given) == 1 else "apply"
+        raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only {verb} when compiling a graph, not to "
                                                 f"a plan file (its size is {_plan_size(args.graph)})")
     plan = load_checked_plan(Path(args.graph), unchecked=args.unchecked)
     if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
@@ -191,7 +197,7 @@ def run(args: argparse.Namespace) -> int:
                 from rgraph.compiler.pipeline import compile_graph
 
                 plan = compile_graph(args.graph, scene_path=args.scene, params=parse_params(args.param),
-                                     size=parse_size(args.size or default_size_text()), policy=args.policy,
+                                     size=parse_size(args.size), policy=args.policy,
                                      sync=args.sync, schedule=args.schedule, memory=gpu.memory_requirements())
             outputs = {r["name"] for r in plan["resources"] if r["lifetime"] == "output"}
             if args.heatmap and "light_heat" not in outputs:

@@ -98,11 +98,12 @@ def test_not_json_is_one_line(tmp_path, capsys):
     assert rc == 2 and len(err) == 1 and ONE_LINE.match(err[0]), err
 
 
-@pytest.mark.parametrize("flags", [["--size", "32x32"], ["--policy", "dedicated"], ["-p", "x=1"]])
+@pytest.mark.parametrize("flags", [["--size", "32x32"], ["--size", "640x360"], ["--policy", "dedicated"], ["-p", "x=1"],
+                                   ["--schedule", "async-early"]])
 def test_compile_flags_are_refused_for_a_plan(tmp_path, capsys, surgery, flags):
     rc, err = _run(tmp_path, capsys, surgery, *flags)
     assert rc == 2
-    assert len(err) == 1 and "only apply when compiling a graph" in err[0] and "64x64" in err[0], err
+    assert len(err) == 1 and "only applies when compiling a graph" in err[0] and "64x64" in err[0], err
 
 
 @pytest.mark.vulkan

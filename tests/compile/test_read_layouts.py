@@ -71,8 +71,8 @@ def test_reads_in_one_usage_keep_their_optimal_layout(graph):
 
 
 def test_runs_clean_with_the_data_check(graph):
+    from rgraph.api import compile_for_device
     from rgraph.vk.executor import execute_plan
-    from rgraph.vk.memreq import compile_for_device
 
     plan = compile_for_device(graph, None, size=(16, 16))
     result = execute_plan(plan, validate=True, frames=2, check_data=True)

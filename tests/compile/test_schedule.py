@@ -42,8 +42,8 @@ def test_unknown_schedule_is_refused(graph):
 
 
 def test_async_early_runs_clean_and_computes_the_same_frame(graph):
+    from rgraph.api import compile_for_device
     from rgraph.vk.executor import execute_plan
-    from rgraph.vk.memreq import compile_for_device
 
     outputs = {}
     for mode in ("declaration", "async-early"):

@@ -72,8 +72,8 @@ def test_chain_compiles_and_checks_clean(tmp_path):
 def test_chain_runs_clean_under_validation_with_the_data_check(tmp_path):
     """End to end on lavapipe: the expanded chain runs with the probe, no validation message,
     and the read-back data equals the CPU simulation of the graph."""
-    from rgraph.vk.executor import execute_plan
     from rgraph.api import compile_for_device
+    from rgraph.vk.executor import execute_plan
 
     plan = compile_for_device(write(tmp_path, CHAIN), None, size=(64, 64))
     result = execute_plan(plan, validate=True, frames=2, check_data=True)

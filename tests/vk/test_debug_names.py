@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rgraph.api import compile_for_device
 from rgraph.mutate import mutants
 from rgraph.vk.executor import execute_plan
-from rgraph.api import compile_for_device
 
 GRAPH = """\
 rgraph: 1

@@ -164,8 +164,9 @@ def _rect(spec: Spec, split: Split, device: int) -> list[int]:
 
 
 def _transfer(name: str, order: int, impl: str, accesses: list[AccessSpec], params: dict, loc) -> PassSpec:
+    # a copy into place writes part of its target, which a later copy does not make dead (cull)
     return PassSpec(name=name, order=order, kind="transfer", queue="graphics", impl=impl, requires=(),
-                    side_effects=False, accesses=tuple(accesses), params=params, loc=loc)
+                    side_effects=impl == UPLOAD_IMPL, accesses=tuple(accesses), params=params, loc=loc)
 
 
 def _access(resource: str, usage: str, write: bool, r: ResourceSpec, loc) -> AccessSpec:
@@ -242,7 +243,7 @@ def _composite(spec: Spec, part: Partition, d: int, order: int, loc) -> PassSpec
         usage = "depth_attachment" if x == part.depth else "color_attachment_blend"
         accesses.append(_access(x, usage, True, r, loc))
     return PassSpec(name=f"composite{d}", order=order, kind="raster", queue="graphics", impl=COMPOSITE_IMPL,
-                    requires=(), side_effects=False, accesses=tuple(accesses),
+                    requires=(), side_effects=True, accesses=tuple(accesses),
                     params={"depth": part.depth, "from_device": d}, loc=loc)
 
 

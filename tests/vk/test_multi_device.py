@@ -107,3 +107,25 @@ def test_later_frames_refill_the_received_tiles(gpus, mode):
     verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 4)
     assert verdict.ok is True, [str(m) for m in verdict.mismatches]
     assert _messages(gpus) == []
+
+
+@pytest.mark.parametrize("mode", ["sort-first", "sort-last"])
+def test_three_logical_devices_with_uneven_bands(gpus, mode):
+    """Three devices, 64x50 (bands of 17/17/16 rows): every sender's share reaches device 0."""
+    third = open_device(validate=True, device=0, verbose=False)
+    trio = [*gpus, third]
+    size = (64, 50)
+    reference = compile_graph(PROBE_GRAPH, size=size, memory=gpus[0].memory_requirements())
+    plan = compile_graph_plan(PROBE_GRAPH, size=size, memory=gpus[0].memory_requirements(), split=Split(3, mode))
+    assert sum(1 for p in plan.passes if "copy_from" in p.params) == 2 * len(plan.multi_device["crossing"])
+    multi = MultiExecutable(trio, plan)
+    try:
+        multi.run(2)
+        data = multi.read_back()
+    finally:
+        multi.close()
+    assert third.close() == []
+    known = {r["name"] for r in reference["resources"]}
+    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 2)
+    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert _messages(gpus) == []

@@ -19,7 +19,11 @@ def refill(executable: Any, received: dict[str, bytes]) -> None:
     by_name = {r.plan["name"]: r for r in ex.resources.shared()}
     work = []
     for name, data in received.items():
-        r = by_name[name]
+        r = by_name.get(name)
+        if r is None:
+            from rgraph.vk.errors import ExecutionError
+
+            raise ExecutionError(f"device 0's plan has no receiving buffer {name!r}")
         staging = HostBuffer.create(ex.device, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
         staging.write(data)
         ex.host_buffers.append(staging)

@@ -98,6 +98,12 @@ class MultiExecutable:
             received = self._received()
             t2 = time.perf_counter()
             if self.receiver is None:
+                have = {r["name"] for r in self.plans[0]["resources"]}
+                missing = sorted(set(received) - have)
+                if missing:
+                    from rgraph.vk.errors import ExecutionError
+
+                    raise ExecutionError(f"device 0's plan has no receiving buffer(s) {missing}")
                 self.receiver = self.gpus[0].load(self.plans[0], inputs=received, **self._kw)
             else:
                 refill(self.receiver, received)

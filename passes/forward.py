@@ -100,4 +100,4 @@ class ForwardPBR(PassImpl):
 
     def record(self, rec, frame_set: int) -> None:
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
-        self.scene.draw(rec, frame_set)
+        self.scene.draw(rec, frame_set, self.setup.param("rgraph.draws"))

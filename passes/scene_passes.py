@@ -41,7 +41,7 @@ class DepthPrepass(PassImpl):
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set)])
-        self.scene.draw(rec, frame_set)
+        self.scene.draw(rec, frame_set, self.setup.param("rgraph.draws"))
 
 
 @register("shadow_map")
@@ -77,7 +77,7 @@ class ShadowMap(PassImpl):
         for k in range(self.count):
             # light k's matrix, framebuffer layer k (the attachment view starts at the access's first layer)
             rec.push(self.pipeline, pack("4i", k, k, 0, 0))
-            self.scene.draw(rec, frame_set)
+            self.scene.draw(rec, frame_set, self.setup.param("rgraph.draws"))
 
 
 @register("light_setup")

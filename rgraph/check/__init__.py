@@ -61,8 +61,26 @@ def check_plan(plan: dict[str, Any]) -> list[Hazard]:
     """Every hazard in ``plan`` (a decoded plan JSON): memory layout first, then in replay
     order; [] when clean. A malformed plan raises ``RGraphError`` (located at line 1, as
     there is no text)."""
+    if plan.get("multi_device"):
+        return _check_devices(plan, "<plan>", None)[1]
     model, layout = _model(plan, "<plan>", None)
     return layout + Replay(model).run()
+
+
+def _check_devices(plan: dict[str, Any], file: str, text: str | None) -> tuple[Plan, list[Hazard]]:
+    """A multi-device plan: cross-device ordering, then each device's own plan replayed.
+    The model returned is the whole plan's (for the counts a report prints)."""
+    from rgraph.check.devices import cross_device_hazards, device_plan
+
+    whole, _ = _model(plan, file, text)  # memory layout is checked per device below
+    found = cross_device_hazards(plan)
+    if any(" accesses " in h.message for h in found):  # a device's plan would name a resource it lacks
+        return whole, found
+    for d in range(int(plan["multi_device"].get("devices", 1))):
+        model, layout = _model(device_plan(plan, d), file, text)
+        found += [Hazard(h.kind, h.pass_index, h.pass_name, h.resource, h.subresource, f"device {d}: {h.message}")
+                  for h in layout + Replay(model).run()]
+    return whole, found
 
 
 def load_plan_file(path: str | Path) -> tuple[dict[str, Any], str]:
@@ -76,5 +94,7 @@ def load_plan_file(path: str | Path) -> tuple[dict[str, Any], str]:
 def check_file(path: str | Path) -> tuple[Plan, list[Hazard]]:
     """Read, validate and replay a plan file; ``RGraphError`` if it is not a readable plan."""
     plan, text = load_plan_file(path)
+    if isinstance(plan, dict) and plan.get("multi_device"):
+        return _check_devices(plan, str(path), text)
     model, layout = _model(plan, str(path), text)
     return model, layout + Replay(model).run()

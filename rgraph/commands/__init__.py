@@ -11,6 +11,7 @@ COMMAND_MODULES = [
     "sweep",
     "place",
     "device_profile",
+    "devices",
     "graphs",
     "schema",
     "completion",

@@ -58,6 +58,9 @@ def add_compile_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--policy", help="memory placement: aliased (default), dedicated, optimal, tlsf, blocks:SIZE (docs/memory.md)")
     parser.add_argument("--profile", help="device profile (bundled name or JSON path) for sizes and alignments")
     add_sync_argument(parser)
+    from rgraph.commands.multi_args import add_split_arguments
+
+    add_split_arguments(parser)
 
 
 def add_schedule_argument(parser: argparse.ArgumentParser) -> None:
@@ -76,6 +79,7 @@ def add_sync_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def compile_from_args(args: argparse.Namespace) -> Plan:
+    from rgraph.commands.multi_args import split_from_args
     from rgraph.compiler.pipeline import compile_graph_plan
 
     return compile_graph_plan(
@@ -86,6 +90,7 @@ def compile_from_args(args: argparse.Namespace) -> Plan:
         policy=getattr(args, "policy", None),
         profile=getattr(args, "profile", None),
         sync=getattr(args, "sync", "normal"),
+        split=split_from_args(args),
         schedule=getattr(args, "schedule", "declaration"),
         camera=getattr(args, "camera", 0),
     )

@@ -52,6 +52,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--size", metavar="WxH", help=f"output size (when compiling a graph; default {default_size_text()})")
     parser.add_argument("--policy", metavar="P", help="memory placement policy (when compiling a graph)")
     parser.add_argument("--profile", metavar="D", help="device profile for memory sizes (when compiling a graph)")
+    from rgraph.commands.multi_args import add_split_arguments
+
+    add_split_arguments(parser)
     parser.set_defaults(func=run)
 
 
@@ -60,7 +63,7 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
     from rgraph.report.plan_file import check_plan, load_plan
 
     target: str = args.target
-    compile_flags = [f for f in ("scene", "size", "policy", "profile") if getattr(args, f)] + (["-p"] if args.params else [])
+    compile_flags = [f for f in ("scene", "size", "policy", "profile", "devices", "split") if getattr(args, f, None)] + (["-p"] if args.params else [])
     if target.endswith(".json"):
         if compile_flags:
             raise RGraphError.in_file(
@@ -74,6 +77,11 @@ def obtain_plan(args: argparse.Namespace) -> dict[str, Any]:
         options["size"] = parse_size(args.size)
     if args.profile:
         options["profile"] = args.profile
+    from rgraph.commands.multi_args import split_from_args
+
+    split = split_from_args(args)
+    if split is not None:
+        options["split"] = split
     plan = compile_graph(target, scene_path=args.scene, **options)
     check_plan(plan, target)
     return plan
@@ -190,6 +198,9 @@ def run(args: argparse.Namespace, out: TextIO | None = None, err: TextIO | None 
                                                            memory=args.memory)), out)
     elif not (args.barriers or args.memory or dot_to_stdout or args.lowered):
         text.print_summary(console, plan, timings)
+        from rgraph.report.devices import print_devices
+
+        print_devices(console, plan)
     if args.barriers and not args.json:
         text.print_barriers(console, plan)
     if args.memory and not args.json:

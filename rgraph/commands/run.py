@@ -65,6 +65,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-layer-workarounds", dest="layer_workarounds", action="store_false",
                         help="record the plan without the validation-layer 1.3.239 workarounds "
                              "(rgraph/vk/lower/workarounds; validation messages are then reported, not avoided)")
+    from rgraph.commands.multi_args import add_split_arguments
+
+    add_split_arguments(parser, indices=True)
     parser.set_defaults(func=run)
 
 
@@ -121,6 +124,13 @@ def _params_view(args: argparse.Namespace) -> dict:
     spec = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size)).spec
     return {"source": str(spec.source) if getattr(spec, "source", None) else args.graph, "params": dict(spec.params),
             "passes": [{"name": p.name, "impl": p.impl, "params": dict(p.params)} for p in spec.passes]}
+
+
+def _is_multi_plan(target: str) -> bool:
+    try:
+        return is_plan_file(target) and bool(json.loads(Path(target).read_text()).get("multi_device"))
+    except (OSError, ValueError):
+        return False
 
 
 def _plan_size(path: str) -> str:
@@ -197,6 +207,15 @@ def run(args: argparse.Namespace) -> int:
             check_output_file(target, flag)
     if not Path(args.graph).suffix == ".json":  # params first: compiling for the device opens it
         check_pass_params(_params_view(args), parse_params(args.param))
+    from rgraph.commands.multi_args import device_list
+
+    devices = device_list(args)
+    if devices is not None and (len(devices) > 1 or _is_multi_plan(args.graph)):
+        from rgraph.commands.run_multi import run_multi
+
+        return run_multi(args, devices, default_size_text())
+    if devices is not None and args.device is None:
+        args.device = devices[0]
     plan = _plan_from_file(args) if is_plan_file(args.graph) else None
     try:
         with open_device(validate=args.validate, device=args.device) as gpu:

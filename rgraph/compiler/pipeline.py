@@ -129,6 +129,7 @@ def compile_graph_plan(
     sync: str = "normal",
     schedule: str = DEFAULT_SCHEDULE,
     camera: int = 0,
+    split: Any = None,
 ) -> Plan:
     """Compile a graph file (or bundled graph name) into a typed plan.
 
@@ -136,6 +137,7 @@ def compile_graph_plan(
     writers are not culled and the runtime reads them back), e.g. an HDR intermediate.
     ``sync="naive"`` transforms the plan with ``rgraph.compiler.naive_sync`` (a full barrier
     before every pass, one queue, no semaphores), for comparison.
+    ``split`` (``rgraph.compiler.multi_device.Split``) makes a multi-device plan (FORMAT.md 6).
     """
     front = frontend(graph, scene_path, params, size)
     spec = with_outputs(front.spec, extra_outputs)
@@ -147,6 +149,14 @@ def compile_graph_plan(
         provider = ProfileMemoryRequirements.named(profile)
         profile_name = provider.name
     chosen = policy or spec.memory_policy or DEFAULT_POLICY
+    if split is not None and split.devices > 1:
+        from rgraph.compiler.multi_device import compile_split
+
+        if sync != "normal":
+            raise RGraphError.in_file("<command line>", "--sync naive applies to one-device plans only")
+        if schedule != DEFAULT_SCHEDULE:
+            raise RGraphError.in_file("<command line>", f"--schedule {schedule} applies to one-device plans only")
+        return compile_split(spec, split, policy=chosen, memory_provider=provider, profile_name=profile_name)
     plan = compile_plan(spec, policy=chosen, memory_provider=provider, profile_name=profile_name, schedule=schedule)
     if camera:
         plan = replace(plan, camera=check_camera(front.scene, camera))

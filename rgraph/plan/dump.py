@@ -12,12 +12,15 @@ from rgraph.plan.model import (
     Barrier,
     CellState,
     EndState,
+    Heap,
     Plan,
     PlanPass,
     PlanResource,
     State,
+    Signal,
     Stats,
     Subresource,
+    Wait,
 )
 
 
@@ -76,6 +79,13 @@ def _thaw(value: Any) -> Any:
     return value
 
 
+def _timeline(t: Wait | Signal) -> dict[str, Any]:
+    out: dict[str, Any] = {"queue": t.queue, "value": t.value, "stages": list(t.stages)}
+    if t.device is not None:
+        out["device"] = t.device
+    return out
+
+
 def _pass(p: PlanPass) -> dict[str, Any]:
     return {
         "name": p.name, "index": p.index, "device": p.device, "queue": p.queue, "kind": p.kind, "impl": p.impl,
@@ -83,8 +93,8 @@ def _pass(p: PlanPass) -> dict[str, Any]:
         "accesses": [_access(a) for a in p.accesses],
         "barriers": [barrier_json(b) for b in p.barriers],
         "releases": [barrier_json(b) for b in p.releases],
-        "waits": [{"queue": w.queue, "value": w.value, "stages": list(w.stages)} for w in p.waits],
-        "signals": [{"queue": s.queue, "value": s.value, "stages": list(s.stages)} for s in p.signals],
+        "waits": [_timeline(w) for w in p.waits],
+        "signals": [_timeline(s) for s in p.signals],
     }
 
 
@@ -103,6 +113,15 @@ def _resource(r: PlanResource) -> dict[str, Any]:
         out["accel"] = _thaw(r.accel)
     if r.scratch_of is not None:
         out["scratch_of"] = r.scratch_of
+    if r.device:
+        out["device"] = r.device
+    return out
+
+
+def _heap(h: Heap) -> dict[str, Any]:
+    out: dict[str, Any] = {"id": h.id, "bytes": h.bytes, "memory_class": h.memory_class, "alignment": h.alignment}
+    if h.device:
+        out["device"] = h.device
     return out
 
 
@@ -124,13 +143,14 @@ def to_json_dict(plan: Plan) -> dict[str, Any]:
         "dropped_reads": [{"pass": d.pass_name, "resource": d.resource, "reason": d.reason}
                           for d in plan.dropped_reads],
         "resources": [_resource(r) for r in plan.resources],
-        "heaps": [{"id": h.id, "bytes": h.bytes, "memory_class": h.memory_class, "alignment": h.alignment}
-                  for h in plan.heaps],
+        "heaps": [_heap(h) for h in plan.heaps],
         "outputs": list(plan.outputs),
         "stats": _stats(plan.stats),
     }
     if plan.camera:
         out["camera"] = plan.camera
+    if plan.multi_device is not None:
+        out["multi_device"] = _thaw(plan.multi_device)
     for key in plan.absent:
         del out[key]
     return out

@@ -89,6 +89,7 @@ class TimelineValue:
     queue: str
     value: int
     stages: Names
+    device: int | None = None  # a cross-device wait names the other device (JSON key only when set)
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,6 +146,7 @@ class PlanResource:
     scratch_of: str | None = None
     #: which of IMAGE_KEYS the file lacked; None: all four iff ``extent`` is None (what compile writes)
     absent: frozenset[str] | None = None
+    device: int = 0  # the device that owns it (multi-device plans; JSON key only when != 0)
 
     @property
     def is_image(self) -> bool:
@@ -162,6 +164,7 @@ class Heap:
     bytes: int
     memory_class: str
     alignment: int
+    device: int = 0  # the device whose memory it is (JSON key only when != 0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -217,6 +220,8 @@ class Plan:
     outputs: Names = ()
     scene_source: str | None = None
     camera: int = 0  # ``--camera N`` (FORMAT.md 7); written only when not 0
+    #: ``{"devices": N, "split": ..., "balance": ..., ...}`` for multi-device plans (FORMAT.md 6), else None
+    multi_device: Mapping[str, Any] | None = None
     format: str = PLAN_FORMAT
     #: keys of OPTIONAL_TOP_KEYS the file did not have (older plans); ``dump`` leaves them out
     absent: frozenset[str] = field(default=frozenset())

@@ -246,8 +246,8 @@ def _barrier(value: Any, where: Where) -> Barrier:
 
 def _semaphore(cls: type) -> Callable[[Any, Where], Any]:
     def read(value: Any, where: Where) -> Any:
-        o = _Obj(value, where, ("queue", "value", "stages"))
-        return cls(o("queue", _queue), o("value", _int, lo=1), o("stages", _flags))
+        o = _Obj(value, where, ("queue", "value", "stages", "device"))
+        return cls(o("queue", _queue), o("value", _int, lo=1), o("stages", _flags), o("device", _int, None))
     return read
 
 
@@ -275,7 +275,7 @@ def _extent(value: Any, where: Where) -> tuple[int, int, int] | None:
 def _resource(value: Any, where: Where) -> PlanResource:
     o = _Obj(value, where, ("name", "kind", "format", "bytes", "size_bytes", "alignment", "memory_type_bits",
                             "memory_class", "usages", "lifetime", "first", "last", "heap", "offset", "initial",
-                            "final", "extent", "mips", "layers", "samples", "accel", "scratch_of"))
+                            "final", "extent", "mips", "layers", "samples", "accel", "scratch_of", "device"))
     extent = o("extent", _extent, None)
     kind = o("kind", _one_of(RESOURCE_KINDS))
     if kind == "image" and extent is None:
@@ -292,7 +292,7 @@ def _resource(value: Any, where: Where) -> PlanResource:
         first=o("first", _opt_int), last=o("last", _opt_int), heap=heap, offset=offset,
         initial=o("initial", _end_state), final=o("final", _end_state), extent=extent, **counts,
         accel=o("accel", _accel, None), scratch_of=o("scratch_of", _opt_str, None),
-        absent=_image_keys_absent(o.d, extent),
+        absent=_image_keys_absent(o.d, extent), device=o("device", _int, 0),
     )
 
 
@@ -317,8 +317,9 @@ def _image_keys_absent(d: Mapping[str, Any], extent: Any) -> frozenset[str] | No
 
 
 def _heap(value: Any, where: Where) -> Heap:
-    o = _Obj(value, where, ("id", "bytes", "memory_class", "alignment"))
-    return Heap(o("id", _int), o("bytes", _size), o("memory_class", _str), o("alignment", _int, lo=1, hi=MAX_SIZE))
+    o = _Obj(value, where, ("id", "bytes", "memory_class", "alignment", "device"))
+    return Heap(o("id", _int), o("bytes", _size), o("memory_class", _str), o("alignment", _int, lo=1, hi=MAX_SIZE),
+                o("device", _int, 0))
 
 
 def _culled(value: Any, where: Where) -> Culled:
@@ -350,7 +351,7 @@ def _format(value: Any, where: Where) -> str:
 def _plan(doc: Any) -> Plan:
     o = _Obj(doc, "", ("format", "graph", "source", "scene", "scene_source", "size", "params", "features",
                        "device_profile", "queues", "passes", "culled", "dropped_reads", "resources", "heaps",
-                       "outputs", "stats", "camera"))
+                       "outputs", "stats", "camera", "multi_device"))
     fmt = o("format", _format)
     passes = o("passes", _list, item=_pass)
     resources = o("resources", _list, item=_resource)
@@ -364,7 +365,9 @@ def _plan(doc: Any) -> Plan:
         queues=o("queues", _list, item=_queue), passes=passes, resources=resources,
         culled=o("culled", _list, item=_culled), dropped_reads=o("dropped_reads", _list, item=_dropped),
         heaps=o("heaps", _list, item=_heap), outputs=o("outputs", _names, ()), stats=o("stats", _stats),
-        camera=o("camera", lambda v, at: _int(v, at, 0), 0), absent=frozenset(k for k in OPTIONAL_TOP_KEYS if k not in doc),
+        camera=o("camera", lambda v, at: _int(v, at, 0), 0),
+        multi_device=o("multi_device", _mapping, None),
+        absent=frozenset(k for k in OPTIONAL_TOP_KEYS if k not in doc),
     )
     from rgraph.plan.consistency import check_consistency
 

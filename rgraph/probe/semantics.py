@@ -109,7 +109,8 @@ def _copy_compatible(src_res: dict, src: dict, dst_res: dict, dst: dict) -> bool
 
 def analyze(plan_pass: dict, resources: dict[str, dict]) -> PassProbe:
     probe = PassProbe()
-    index = plan_pass["index"]
+    # a pass of a multi-device plan keeps the seed of its one-device index (rgraph.compiler.multi_device)
+    index = (plan_pass.get("params") or {}).get("rgraph.probe_index", plan_pass["index"])
     accesses = plan_pass["accesses"]
     if plan_pass["kind"] == "transfer":
         srcs = [i for i, a in enumerate(accesses) if a["usage"] == "transfer_src"]

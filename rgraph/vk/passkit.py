@@ -323,7 +323,9 @@ class PassSetup:
         assembly = v.VkPipelineInputAssemblyStateCreateInfo(topology=getattr(v, f"VK_PRIMITIVE_TOPOLOGY_{topology}"))
         w, h = extent or self.extent
         viewport = v.VkViewport(x=0, y=0, width=float(w), height=float(h), minDepth=0.0, maxDepth=1.0)
-        scissor = v.VkRect2D(offset=v.VkOffset2D(x=0, y=0), extent=v.VkExtent2D(width=w, height=h))
+        from rgraph.vk.multi.tiles import scissor_rect
+
+        scissor = scissor_rect(self.plan_pass, w, h)  # a sort-first tile, else all of it
         vps = v.VkPipelineViewportStateCreateInfo(viewportCount=1, pViewports=[viewport], scissorCount=1,
                                                   pScissors=[scissor])
         raster = v.VkPipelineRasterizationStateCreateInfo(

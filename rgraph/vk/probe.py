@@ -240,7 +240,9 @@ class Probe(PassImpl):
             vertexAttributeDescriptionCount=len(va), pVertexAttributeDescriptions=va or None)
         assembly = v.VkPipelineInputAssemblyStateCreateInfo(topology=v.VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST)
         viewport = v.VkViewport(x=0, y=0, width=float(w), height=float(h), minDepth=0.0, maxDepth=1.0)
-        scissor = v.VkRect2D(offset=v.VkOffset2D(x=0, y=0), extent=v.VkExtent2D(width=w, height=h))
+        from rgraph.vk.multi.tiles import scissor_rect
+
+        scissor = scissor_rect(self.p, w, h)  # a sort-first tile, else all of it
         viewport_state = v.VkPipelineViewportStateCreateInfo(viewportCount=1, pViewports=[viewport], scissorCount=1,
                                                              pScissors=[scissor])
         raster = v.VkPipelineRasterizationStateCreateInfo(
@@ -319,7 +321,10 @@ class Probe(PassImpl):
             ctx.bind_graphics(self.pipeline, self.layout, descriptor_sets)
             ctx.bind_vertex_buffers([r.handle for r in vertex],
                                     [4 * HEADER_WORDS if has_header(r.plan) else 0 for r in vertex])
-            if indirect:
+            share = (self.p.get("params") or {}).get("rgraph.draws")  # sort-last: the one draw is device 0's
+            if share is not None and int(share[0]) != 0:
+                pass
+            elif indirect:
                 for r in indirect:
                     ctx.draw_indirect(r.handle, 0)
             else:

@@ -253,14 +253,21 @@ class SceneGPU:
             self.deform_buffers[frame_set].write(packing.vertex_bytes(data.deformed(mesh, frame)),
                                                  base * packing.VERTEX_BYTES)
 
-    def draw(self, rec: Any, frame_set: int) -> None:
+    def draw(self, rec: Any, frame_set: int, share: Any = None) -> None:
         """Bind vertex and index buffers and record one drawIndexed per mesh
-        (instances = the mesh's instances, firstInstance = its first draw index)."""
-        if not self.calls:
+        (instances = the mesh's instances, firstInstance = its first draw index).
+        ``share = [device, devices]`` (sort-last, ``params["rgraph.draws"]``): only this device's
+        calls (``rgraph.vk.multi.shares``: balanced by triangle count)."""
+        calls = self.calls
+        if share is not None:
+            from rgraph.vk.multi.shares import share_of
+
+            calls = share_of(calls, int(share[0]), int(share[1]))
+        if not calls:
             return
         rec.bind_index_buffer(self.index_buffer.handle)
         bound = None
-        for call in self.calls:
+        for call in calls:
             want = self.deform_buffers[frame_set].handle if call.deformable else self.vertex_buffer.handle
             if want is not bound:
                 rec.bind_vertex_buffers([want])

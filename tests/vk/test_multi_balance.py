@@ -1,0 +1,29 @@
+"""Dynamic sort-first balance (pure): damped shares from per-device times."""
+
+from __future__ import annotations
+
+import pytest
+
+from rgraph.vk.multi.balance import MIN_SHARE, rebalance
+
+
+def test_equal_speeds_keep_equal_shares():
+    assert rebalance((0.5, 0.5), (10.0, 10.0)) == pytest.approx((0.5, 0.5))
+
+
+def test_a_device_twice_as_fast_converges_to_two_thirds():
+    w = (0.5, 0.5)
+    for _ in range(30):
+        # device 0 takes 1 ms per share unit, device 1 takes 2 ms
+        w = rebalance(w, (w[0] * 1.0, w[1] * 2.0), damping=0.5)
+    assert w == pytest.approx((2 / 3, 1 / 3), abs=1e-3)
+
+
+def test_damping_moves_part_of_the_way():
+    w = rebalance((0.5, 0.5), (1.0, 3.0), damping=0.5)  # target 0.75/0.25
+    assert w == pytest.approx((0.625, 0.375))
+
+
+def test_a_very_slow_device_keeps_a_sliver():
+    w = rebalance((0.5, 0.5), (1.0, 1e6), damping=1.0)
+    assert min(w) >= MIN_SHARE / (1 + MIN_SHARE) and sum(w) == pytest.approx(1.0)

@@ -80,12 +80,14 @@ def compile(
     memory: MemoryRequirementsProvider | None = None,
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
+    schedule: str | None = None,
 ) -> Compiled:
     """Compile a spec (``rgraph.load``), a graph file or a bundled graph name.
 
     ``size``, ``scene`` and ``params`` apply to files and names (a spec is already
     specialized). ``policy`` defaults to the graph's ``memory_policy``, else aliased;
-    ``extra_outputs`` and ``sync`` are ``rgraph compile``'s ``--sync`` and extra outputs.
+    ``extra_outputs``, ``sync`` and ``schedule`` are ``rgraph compile``'s extra outputs,
+    ``--sync`` and ``--schedule`` (default declaration order).
     """
     from rgraph.compiler.pipeline import DEFAULT_POLICY, apply_sync_mode, compilation, with_outputs
     from rgraph.spec.specialize import Spec
@@ -100,7 +102,7 @@ def compile(
     spec = with_outputs(spec, extra_outputs)
     provider, profile_name = _provider(device, profile, memory)
     done = compilation(spec, policy=policy or spec.memory_policy or DEFAULT_POLICY, memory_provider=provider,
-                       profile_name=profile_name)
+                       profile_name=profile_name, **({"schedule": schedule} if schedule else {}))
     assert done.plan is not None
     return Compiled(apply_sync_mode(done.plan, sync), spec)
 

@@ -100,3 +100,13 @@ def test_import_rgraph_is_cheap():
             " if m in sys.modules]; print(heavy)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_schedule_matches_the_command_line(tmp_path):
+    from rgraph.cli import main
+
+    out = tmp_path / "p.json"
+    assert main(["compile", "surgery", "--size", "64x64", "--schedule", "async-early", "-o", str(out)]) == 0
+    compiled = rgraph.compile("surgery", size=(64, 64), schedule="async-early")
+    assert compiled.plan.stats.schedule == "async-early"
+    assert compiled.as_json() == out.read_text()

@@ -21,6 +21,7 @@ off after a fixed number of nodes, so results never depend on machine speed.
 from __future__ import annotations
 
 import sys
+from bisect import bisect_right
 from collections.abc import Sequence
 
 from rgraph.memory.instance import Instance
@@ -60,11 +61,16 @@ class CapacitySearch:
         for r, i in enumerate(order):
             self.rank[i] = r
         # Zero-size blocks occupy nothing: they go at offset 0 outside the search.
-        self.unplaced = [i for i in order if inst.size[i] > 0]
+        self.order = [i for i in order if inst.size[i] > 0]
         self.offsets = [0 if inst.size[i] == 0 else -1 for i in range(inst.n)]
         self.min_off = [0] * inst.n
         self.floor = [0] * inst.section_count
         self.total = inst.section_totals()
+        # cuts[s]: unplaced blocks living in both section s and s + 1.
+        self.cuts = [0] * max(inst.section_count - 1, 0)
+        for i in self.order:
+            for s in range(inst.sec_lo[i], inst.sec_hi[i] - 1):
+                self.cuts[s] += 1
 
     def run(self) -> list[int] | None:
         """Offsets if a placement within capacity was found; None if none exists or the
@@ -74,9 +80,9 @@ class CapacitySearch:
         if max(self.total, default=0) > self.capacity:
             return None
         limit = sys.getrecursionlimit()
-        sys.setrecursionlimit(max(limit, 4 * self.inst.n + 1000))
+        sys.setrecursionlimit(max(limit, 8 * self.inst.n + 1000))
         try:
-            found = self._dfs(0, -1)
+            found = self._split(self.order, 0, self.inst.section_count)
         except _OutOfNodes:
             self.exhausted = True
             return None
@@ -85,15 +91,35 @@ class CapacitySearch:
             self.work = start_budget - self.nodes_left
         return list(self.offsets) if found else None
 
-    def _dfs(self, last_off: int, last_rank: int) -> bool:
-        unplaced = self.unplaced
+    def _split(self, unplaced: list[int], lo: int, hi: int) -> bool:
+        """Solve the blocks ``unplaced`` (preorder) living in sections ``lo..hi-1``, one
+        independent part per run of sections joined by a block still to place (MiniMalloc's
+        dynamic temporal decomposition). On failure, every part is undone."""
+        if not unplaced:
+            return True
+        cuts, sec_lo = self.cuts, self.inst.sec_lo
+        points = [s + 1 for s in range(lo, hi - 1) if cuts[s] == 0]
+        if not points:
+            return self._dfs(unplaced, lo, hi, 0, -1)
+        bounds = [lo, *points, hi]
+        parts: list[list[int]] = [[] for _ in range(len(bounds) - 1)]
+        for i in unplaced:
+            parts[bisect_right(bounds, sec_lo[i]) - 1].append(i)
+        saved = (list(self.offsets), list(self.min_off), list(self.floor), list(self.total))
+        for k, part in enumerate(parts):
+            if part and not self._dfs(part, bounds[k], bounds[k + 1], 0, -1):
+                self.offsets[:], self.min_off[:], self.floor[:], self.total[:] = saved
+                return False
+        return True
+
+    def _dfs(self, unplaced: list[int], plo: int, phi: int, last_off: int, last_rank: int) -> bool:
         if not unplaced:
             return True
         if self.nodes_left <= 0:
             raise _OutOfNodes
         inst, mins, rank, offsets = self.inst, self.min_off, self.rank, self.offsets
         size, align, neighbors = inst.size, inst.align, inst.neighbors
-        floor, total, capacity = self.floor, self.total, self.capacity
+        floor, total, capacity, cuts = self.floor, self.total, self.capacity, self.cuts
         min_height = min([mins[i] + size[i] for i in unplaced])
         candidates = [
             i
@@ -101,7 +127,7 @@ class CapacitySearch:
             if last_off <= mins[i] < min_height and (mins[i] > last_off or rank[i] > last_rank)
         ]
         candidates.sort(key=mins.__getitem__)  # stable: ties keep preorder rank
-        headroom = capacity - max(total)
+        headroom = capacity - max(total[plo:phi])
         for i in candidates:
             off = mins[i]
             if off > headroom:
@@ -127,14 +153,21 @@ class CapacitySearch:
                 ok = self._pending_ok(changed, lo, hi)
             saved = floor[lo:hi]
             z = size[i]
+            split = False
             for s in range(lo, hi):
                 floor[s] = top
                 left = total[s] - z
                 total[s] = left
                 if top + left > capacity:
                     ok = False
-            if ok and self._dfs(off, rank[i]):
+            for s in range(lo, hi - 1):
+                cuts[s] -= 1
+                if not cuts[s]:
+                    split = True
+            if ok and (self._split(unplaced, plo, phi) if split else self._dfs(unplaced, plo, phi, off, rank[i])):
                 return True
+            for s in range(lo, hi - 1):
+                cuts[s] += 1
             floor[lo:hi] = saved
             for s in range(lo, hi):
                 total[s] += z

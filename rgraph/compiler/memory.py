@@ -133,8 +133,10 @@ def place_resources(
     memory: Mapping[str, ResourceMemory],
     policy: str,
     outputs: Sequence[str],
+    conflicts: Mapping[str, set[str]] | None = None,
 ) -> Placement:
-    """Place transients with ``policy``; give every other resource its own heap."""
+    """Place transients with ``policy``; give every other resource its own heap.
+    ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
     aliasable = [
         n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in outputs
     ]
@@ -143,7 +145,7 @@ def place_resources(
     ]
     from rgraph.memory import place
 
-    placed = place(blocks, policy)
+    placed = place(blocks, policy, conflicts=conflicts)
     offsets = dict(placed.offsets)
     heaps = list(placed.heaps)
     extra = 0

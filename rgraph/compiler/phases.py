@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 from rgraph.compiler import memory
 from rgraph.compiler.emit import emit as emit_plan
+from rgraph.compiler.queue_order import cross_queue_conflicts
 from rgraph.compiler.sync import SyncResult
 from rgraph.compiler.sync import synchronize as synchronize_passes
 from rgraph.defaults import DEFAULT_SCHEDULE
@@ -109,7 +110,9 @@ def measure(c: Compilation) -> Compilation:
 def place(c: Compilation) -> Compilation:
     """Heaps and offsets: transients by the allocator policy (may alias), others dedicated."""
     try:
-        placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs)
+        aliasable = [n for n in c.memory if c.spec.resources[n].lifetime == "transient"]
+        conflicts = cross_queue_conflicts(c.passes, aliasable)
+        placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs, conflicts)
     except ValueError as exc:
         raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
     return replace(c, placement=placement, aliases=memory.alias_sources(placement, c.memory))
@@ -117,7 +120,9 @@ def place(c: Compilation) -> Compilation:
 
 def synchronize(c: Compilation) -> Compilation:
     """Barriers, queue-ownership releases, semaphore waits and signals per pass."""
-    return replace(c, sync=synchronize_passes(list(c.passes), c.spec.resources, c.aliases))
+    assert c.placement is not None
+    ranges = {n: (heap, off, off + c.memory[n].bytes) for n, (heap, off) in c.placement.offsets.items()}
+    return replace(c, sync=synchronize_passes(list(c.passes), c.spec.resources, c.aliases, ranges))
 
 
 def emit(c: Compilation) -> Compilation:

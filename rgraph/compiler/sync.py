@@ -143,11 +143,14 @@ def synchronize(
     passes: Sequence[PassSpec],
     resources: Mapping[str, ResourceSpec],
     alias_sources: Mapping[str, Sequence[str]] | None = None,
+    ranges: Mapping[str, tuple[int, int, int]] | None = None,
 ) -> SyncResult:
     """Barriers and semaphores for ``passes`` (executed order).
 
     ``alias_sources`` maps a transient resource to the resources whose memory it reuses
-    (all of them ended before it starts).
+    (all of them ended before it starts); ``ranges`` gives (heap, first byte, end byte) of
+    the placed resources, so that older occupants reached through a partial hand-off count
+    only where their bytes overlap.
     """
     alias_sources = alias_sources or {}
     syncs = unify_read_layouts(passes, resources, [access_syncs(p, resources) for p in passes])
@@ -157,7 +160,7 @@ def synchronize(
         for c, (s, w) in pc.items():
             timeline[c].append(_Use(i, s, w, p.queue))
 
-    alias_sources = _with_partial_handoffs(alias_sources, timeline, resources)
+    alias_sources = _with_partial_handoffs(alias_sources, timeline, resources, ranges)
 
     def fresh(c: Cell) -> _Cell:
         res = resources[c[0]]
@@ -208,7 +211,8 @@ def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
 
 
 def _with_partial_handoffs(
-    alias_sources: Mapping[str, Sequence[str]], timeline: Mapping[Cell, list], resources: Mapping[str, ResourceSpec]
+    alias_sources: Mapping[str, Sequence[str]], timeline: Mapping[Cell, list], resources: Mapping[str, ResourceSpec],
+    ranges: Mapping[str, tuple[int, int, int]] | None = None,
 ) -> dict[str, list[str]]:
     """``alias_sources`` plus, through every predecessor that touches only some of its
     subresources, that predecessor's own predecessors (recursively).
@@ -235,11 +239,18 @@ def _with_partial_handoffs(
             pred = stack.pop(0)
             if pred in found:
                 continue
+            if ranges is not None and not _share_bytes(ranges, name, pred):
+                continue
             found.append(pred)
             if partial(pred):
                 stack.extend(alias_sources.get(pred, ()))
         out[name] = found
     return out
+
+
+def _share_bytes(ranges: Mapping[str, tuple[int, int, int]], a: str, b: str) -> bool:
+    (ha, lo_a, hi_a), (hb, lo_b, hi_b) = ranges[a], ranges[b]
+    return ha == hb and lo_a < hi_b and lo_b < hi_a
 
 
 def _alias_initial_states(alias_sources, first: _Simulation):

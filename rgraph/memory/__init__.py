@@ -7,7 +7,7 @@ policies. Pure Python and numpy (no Vulkan): sizes and alignments come in with t
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Mapping, Sequence
 
 from rgraph.memory.aliased import place_class, too_dense
 from rgraph.memory.bounds import lower_bound
@@ -45,10 +45,13 @@ def parse_place_args(policy: str, budget: float | None, source: str = "<command 
 
 
 def place(
-    blocks: Sequence[Block], policy: str | Policy = "aliased", *, time_budget_s: float = DEFAULT_BUDGET_S
+    blocks: Sequence[Block], policy: str | Policy = "aliased", *, time_budget_s: float = DEFAULT_BUDGET_S,
+    conflicts: Mapping[str, Collection[str]] | None = None,
 ) -> Placement:
     """Place ``blocks`` under ``policy``. Heap ids go by memory class (sorted), then by
-    creation order within a class. Deterministic: the same input gives the same output."""
+    creation order within a class. Deterministic: the same input gives the same output.
+    ``conflicts`` (``aliased`` and ``optimal``): pairs of names that may not share bytes
+    although apart in time."""
     began = time.perf_counter()
     chosen = parse_policy(policy)
     check_blocks(blocks)
@@ -72,7 +75,7 @@ def place(
             for b, offset in zip(group, tlsf_offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)
         elif chosen.kind in ("aliased", "optimal"):
-            result = place_class(Instance.build(group), time_budget_s)
+            result = place_class(Instance.build(group, conflicts), time_budget_s)
             heap_id = new_heap(result.peak, memory_class, max_align)
             for b, offset in zip(group, result.offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from bisect import bisect_left
-from collections.abc import Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -29,13 +29,16 @@ class Instance:
     sec_lo: list[int]
     sec_hi: list[int]
     section_count: int
+    separable: bool = True  # no overlaps beyond the time ones: parts split in time are independent
 
     @property
     def n(self) -> int:
         return len(self.blocks)
 
     @classmethod
-    def build(cls, blocks: Sequence[Block]) -> Instance:
+    def build(cls, blocks: Sequence[Block], conflicts: Mapping[str, Collection[str]] | None = None) -> Instance:
+        """``conflicts``: pairs of block names that may not share bytes although they are
+        apart in time (symmetric), added to ``neighbors``."""
         blocks = list(blocks)
         start = [b.start for b in blocks]
         end = [b.end for b in blocks]
@@ -46,6 +49,14 @@ class Instance:
             row = (starts <= end[i]) & (ends >= start[i])
             row[i] = False
             neighbors.append(np.flatnonzero(row).tolist())
+        separable = True
+        if conflicts:
+            index = {b.name: k for k, b in enumerate(blocks)}
+            for k, b in enumerate(blocks):
+                extra = {index[o] for o in conflicts.get(b.name, ()) if o in index} - set(neighbors[k])
+                if extra:
+                    neighbors[k] = sorted(set(neighbors[k]) | extra)
+                    separable = False
         coords = sorted(set(start) | {e + 1 for e in end})
         sec_lo = [bisect_left(coords, s) for s in start]
         sec_hi = [bisect_left(coords, e + 1) for e in end]
@@ -59,6 +70,7 @@ class Instance:
             sec_lo=sec_lo,
             sec_hi=sec_hi,
             section_count=max(len(coords) - 1, 0),
+            separable=separable,
         )
 
     @cached_property

@@ -98,7 +98,7 @@ class CapacitySearch:
         if not unplaced:
             return True
         cuts, sec_lo = self.cuts, self.inst.sec_lo
-        points = [s + 1 for s in range(lo, hi - 1) if cuts[s] == 0]
+        points = [s + 1 for s in range(lo, hi - 1) if cuts[s] == 0] if self.inst.separable else []
         if not points:
             return self._dfs(unplaced, lo, hi, 0, -1)
         bounds = [lo, *points, hi]
@@ -163,7 +163,7 @@ class CapacitySearch:
             for s in range(lo, hi - 1):
                 cuts[s] -= 1
                 if not cuts[s]:
-                    split = True
+                    split = inst.separable
             if ok and (self._split(unplaced, plo, phi) if split else self._dfs(unplaced, plo, phi, off, rank[i])):
                 return True
             for s in range(lo, hi - 1):

@@ -1,0 +1,92 @@
+"""Which transients may share memory without a new cross-queue wait.
+
+Work on different queues that the graph does not order overlaps in time, whatever the
+pass indices say. The synchronisation phase makes a resource that reuses another's memory
+wait, at the first use of each of its cells, for the last use of each cell of the earlier
+occupant on every other queue. That wait costs nothing only where the pass already waits
+for that queue at that point or later (a data hand-off between the queues): the semaphore
+wait is then the same one, its stage mask widened. ``cross_queue_conflicts`` lists the
+pairs of transients, disjoint in pass index, where it would not be: the placement treats
+them as overlapping in time, so aliasing never adds a semaphore wait the ``dedicated``
+policy lacks (tests/compile/test_alias_queues.py checks it on random multi-queue graphs).
+
+The dedicated plan's waits are recomputed here the way ``sync`` derives them: a cell whose
+previous use was on another queue waits for that use.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Sequence
+
+from rgraph.ir.graph import cells
+from rgraph.spec.specialize import PassSpec
+
+
+def direct_waits(passes: Sequence[PassSpec]) -> list[dict[str, int]]:
+    """Per pass: queue -> latest pass index it waits for in the dedicated plan."""
+    last: dict[tuple, tuple[str, int]] = {}
+    out: list[dict[str, int]] = []
+    for i, p in enumerate(passes):
+        waits: dict[str, int] = {}
+        for a in p.accesses:
+            for c in cells(a):
+                prev = last.get(c)
+                if prev is not None and prev[0] != p.queue and prev[1] != i:
+                    waits[prev[0]] = max(waits.get(prev[0], -1), prev[1])
+                last[c] = (p.queue, i)
+        out.append(waits)
+    return out
+
+
+def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str]) -> dict[str, set[str]]:
+    """Pairs of ``candidates`` (symmetric) that may not share memory although one ends before
+    the other starts: sharing would add a cross-queue wait. Empty for one-queue graphs."""
+    if len({p.queue for p in passes}) < 2:
+        return {}
+    wanted = set(candidates)
+    firsts: dict[str, set[tuple[int, str]]] = {}  # resource -> (first pass of a cell, its queue)
+    ends: dict[tuple, tuple[int, str]] = {}  # cell -> (last pass, queue)
+    seen: set[tuple] = set()
+    span: dict[str, list[int]] = {}
+    for i, p in enumerate(passes):
+        for a in p.accesses:
+            if a.resource not in wanted:
+                continue
+            s = span.setdefault(a.resource, [i, i])
+            s[1] = i
+            for c in cells(a):
+                if c not in seen:
+                    seen.add(c)
+                    firsts.setdefault(a.resource, set()).add((i, p.queue))
+                ends[c] = (i, p.queue)
+    lasts: dict[str, dict[str, int]] = {}  # resource -> queue -> last pass of a cell ending there
+    for c, (i, q) in ends.items():
+        per = lasts.setdefault(c[0], {})
+        per[q] = max(per.get(q, -1), i)
+    waits = direct_waits(passes)
+    queues_first = {r: {q for _, q in f} for r, f in firsts.items()}
+    out: dict[str, set[str]] = {}
+    names = sorted(span, key=lambda r: span[r][0])
+    for r in names:
+        r_first = span[r][0]
+        for p in names:
+            if span[p][1] >= r_first:
+                if span[p][0] >= r_first:
+                    break
+                continue  # overlapping in pass index: already apart
+            p_lasts = lasts[p]
+            if len(p_lasts) == 1 and queues_first[r] == set(p_lasts):
+                continue  # one queue throughout: a pipeline barrier suffices
+            if _adds_wait(p_lasts, firsts[r], waits):
+                out.setdefault(r, set()).add(p)
+                out.setdefault(p, set()).add(r)
+    return out
+
+
+def _adds_wait(p_lasts: dict[str, int], r_firsts: set[tuple[int, str]], waits: list[dict[str, int]]) -> bool:
+    for v, qv in r_firsts:
+        have = waits[v]
+        for q, j in p_lasts.items():
+            if q != qv and have.get(q, -1) < j:
+                return True
+    return False

@@ -61,6 +61,11 @@ def too_dense(blocks: Sequence[Block], time_budget_s: float) -> bool:
     return overlapping_pairs(blocks) > max(MIN_GREEDY_PAIRS, time_budget_s * PAIRS_PER_SECOND)
 
 
+#: Budget, in dives, from which the bound itself is tried first (about half of it then
+#: remains for the bisection).
+LB_FIRST_DIVES = 6
+
+
 @dataclass
 class ClassResult:
     offsets: list[int]
@@ -84,13 +89,15 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
     if budget < inst.n:
         return best  # too little to finish even one dive of the search
     preorders = Preorders(inst)
-    # The bound first: tight capacities prune hardest and, once a block splits the rest in
-    # time, the search solves the parts one by one, so the bound is often reached in a
-    # few dives (MiniMalloc F and G in under 6,000 nodes).
-    found, spent, proven = search_capacity(inst, preorders, lb, budget, DIVES_PER_CAPACITY)
-    budget -= spent
-    if found is not None:
-        return ClassResult(found, inst.peak(found), lb, f"search:{lb}")
+    # The bound first when the budget affords it: tight capacities prune hardest and, once
+    # a block splits the rest in time, the search solves the parts one by one, so the bound
+    # is often reached in a few dives (MiniMalloc C and F in under 6,000 nodes).
+    proven = False
+    if budget >= LB_FIRST_DIVES * DIVE_NODES * inst.n:
+        found, spent, proven = search_capacity(inst, preorders, lb, budget, DIVES_PER_CAPACITY)
+        budget -= spent
+        if found is not None:
+            return ClassResult(found, inst.peak(found), lb, f"search:{lb}")
     # Bisection between the highest capacity given up on and the best peak found; once it
     # closes, start again from the lower bound with twice the dives per capacity.
     low, dives, infeasible = lb, DIVES_PER_CAPACITY, lb if proven else lb - 1  # infeasible: proven too small

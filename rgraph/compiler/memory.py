@@ -8,6 +8,7 @@ allocation each.
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -167,7 +168,9 @@ def alias_sources(placement: Placement, memory: Mapping[str, ResourceMemory]) ->
     """For each resource, the earlier resources whose memory it reuses and that it must wait for.
 
     An earlier overlapping resource is skipped when a later one, itself overlapping both,
-    already waited for it (the chain covers it)."""
+    already waited for it (the chain covers it). Earlier occupants are visited latest first
+    and the walk stops once one that started after them holds all of the resource's bytes,
+    so a long chain of reuses costs a few steps per resource, not the whole history."""
     by_heap: dict[int, list[str]] = {}
     for name, (heap, _) in placement.offsets.items():
         by_heap.setdefault(heap, []).append(name)
@@ -176,23 +179,31 @@ def alias_sources(placement: Placement, memory: Mapping[str, ResourceMemory]) ->
         if len(names) < 2:
             continue
         ordered = sorted(names, key=lambda n: (memory[n].first, n))
-        for i, r in enumerate(ordered):
-            r_lo, r_hi = _range(placement, memory, r)
-            preds = [
-                p for p in ordered[:i]
-                if memory[p].last < memory[r].first and _overlaps((r_lo, r_hi), _range(placement, memory, p))
-            ]
+        by_last = sorted(names, key=lambda n: (memory[n].last, n))
+        lasts = [memory[n].last for n in by_last]
+        for r in ordered:
+            r_first = memory[r].first
+            r_rng = _range(placement, memory, r)
+            visited: list[tuple[int, tuple[int, int]]] = []  # (first, byte range) of earlier occupants
+            stop = -1  # occupants that ended before this first are covered by one holding all of r
             keep = []
-            for p in preds:
-                p_rng = _intersect(_range(placement, memory, p), (r_lo, r_hi))
-                covered = any(
-                    q != p and memory[p].last < memory[q].first and _contains(_range(placement, memory, q), p_rng)
-                    for q in preds
-                )
-                if not covered:
+            for k in range(bisect_left(lasts, r_first) - 1, -1, -1):
+                p = by_last[k]
+                p_last = lasts[k]
+                if p_last < stop:
+                    break
+                p_rng = _range(placement, memory, p)
+                if not _overlaps(r_rng, p_rng):
+                    continue
+                part = _intersect(p_rng, r_rng)
+                if not any(first > p_last and _contains(rng, part) for first, rng in visited):
                     keep.append(p)
+                p_first = memory[p].first
+                visited.append((p_first, p_rng))
+                if _contains(p_rng, r_rng):
+                    stop = max(stop, p_first)
             if keep:
-                out[r] = keep
+                out[r] = sorted(keep, key=lambda n: (memory[n].first, n))
     return out
 
 

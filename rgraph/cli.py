@@ -12,7 +12,7 @@ import sys
 from collections.abc import Sequence
 
 from rgraph import __version__
-from rgraph.commands import COMMAND_MODULES
+from rgraph.commands import COMMAND_HELP, COMMAND_MODULES
 from rgraph.errors import RGraphError
 
 
@@ -23,11 +23,17 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """Every command's parser; with ``only`` (a command name), only that command's module is
+    imported and the others get a stub parser with their help line (fast ``--help``)."""
     parser = _Parser(prog="rgraph", description="A declarative render-graph compiler for Vulkan.")
     parser.add_argument("--version", action="version", version=f"rgraph {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser, metavar="COMMAND")
     for name in COMMAND_MODULES:
+        command = name.replace("_", "-")
+        if only is not None and command != only:
+            sub.add_parser(command, help=COMMAND_HELP[command])
+            continue
         try:
             module = importlib.import_module(f"rgraph.commands.{name}")
         except ModuleNotFoundError as exc:
@@ -53,7 +59,9 @@ def subcommand_parser(parser: argparse.ArgumentParser, name: str) -> argparse.Ar
 def main(argv: Sequence[str] | None = None) -> int:
     from rgraph.spec.paths import allow_outside
 
-    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    command = next((a for a in argv if not a.startswith("-")), "")
+    parser = build_parser(only=command)
     args, extra = parser.parse_known_args(argv)
     if extra:
         (subcommand_parser(parser, args.command) or parser).error(f"unrecognized arguments: {' '.join(extra)}")

@@ -1,9 +1,13 @@
 """Median compile time (parsed spec -> plan) for random graphs of 250 .. 16k passes.
 
     .venv/bin/python benchmarks/compile_scaling.py [--sizes 250,1000,4000,16000] [--policy aliased]
+        [--chain 10000] [--side-effects 5000]
 
-Prints one row per size and the growth exponent fitted on log(time) vs log(passes).
-Target (issue 2): 1,000 passes in at most 16 ms; exponent at most 1.15.
+Prints one row per size and the growth exponent fitted on log(time) vs log(passes), then
+two structured graphs: a chain (pass i reads buffer b_i and writes b_{i+1}: every buffer
+reuses the memory of the one before) and one with N side-effect buffers (each written by
+its own pass, all kept as outputs). Target (issue 19): 1,000 random passes in at most
+16 ms; exponent at most 1.15; the 10,000-resource chain in at most 1 s.
 """
 
 from __future__ import annotations
@@ -37,10 +41,49 @@ def measure(passes: int, policy: str, repeats: int) -> tuple[float, int, int]:
     return statistics.median(times), len(plan.passes), plan.stats.barriers
 
 
+def chain_yaml(count: int) -> str:
+    """Pass i reads b_i and writes b_{i+1} (pass 0 writes b_1); b_count is the output."""
+    lines = ["rgraph: 1", "name: chain", "resources:"]
+    lines += [f"  b{i}: {{kind: buffer, bytes: 256}}" for i in range(1, count + 1)]
+    lines.append("passes:")
+    lines.append("  p0: {kind: compute, writes: {b1: storage_write}}")
+    lines += [f"  p{i}: {{kind: compute, reads: {{b{i}: storage_read}}, writes: {{b{i + 1}: storage_write}}}}"
+              for i in range(1, count)]
+    lines.append(f"outputs: [b{count}]")
+    return "\n".join(lines) + "\n"
+
+
+def side_effects_yaml(count: int) -> str:
+    """``count`` passes, each writing its own buffer, every buffer an output."""
+    lines = ["rgraph: 1", "name: side_effects", "resources:"]
+    lines += [f"  s{i}: {{kind: buffer, bytes: 256}}" for i in range(count)]
+    lines.append("passes:")
+    lines += [f"  p{i}: {{kind: compute, writes: {{s{i}: storage_write}}}}" for i in range(count)]
+    lines.append("outputs: [" + ", ".join(f"s{i}" for i in range(count)) + "]")
+    return "\n".join(lines) + "\n"
+
+
+def measure_text(text: str, policy: str, repeats: int) -> tuple[float, int]:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "g.yaml"
+        path.write_text(text)
+        spec = frontend(path, size=(16, 16)).spec
+    times = []
+    plan = None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        plan = compile_plan(spec, policy=policy)
+        times.append(time.perf_counter() - start)
+    assert plan is not None
+    return statistics.median(times), len(plan.passes)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--sizes", default="250,1000,4000,16000")
     parser.add_argument("--policy", default="aliased")
+    parser.add_argument("--chain", type=int, default=10000, help="resources of the chain graph (0: skip)")
+    parser.add_argument("--side-effects", type=int, default=5000, help="side-effect buffers (0: skip)")
     args = parser.parse_args()
     sizes = [int(s) for s in args.sizes.split(",")]
     rows = []
@@ -54,6 +97,11 @@ def main() -> None:
     mx, my = statistics.fmean(xs), statistics.fmean(ys)
     slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys, strict=True)) / sum((x - mx) ** 2 for x in xs)
     print(f"growth exponent: {slope:.2f}  (policy {args.policy})")
+    for label, count, text in (("chain", args.chain, chain_yaml), ("side-effect buffers", args.side_effects,
+                                                                      side_effects_yaml)):
+        if count:
+            median, executed = measure_text(text(count), args.policy, repeats=3)
+            print(f"{label} of {count}: {executed} passes, median {median * 1e3:.1f} ms")
 
 
 if __name__ == "__main__":

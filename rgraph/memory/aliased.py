@@ -83,7 +83,9 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
         if best is None or peak < best.peak:
             best = ClassResult(offsets, peak, lb, f"greedy:{name}")
     assert best is not None
-    if best.peak <= lb or inst.n == 0:
+    if best.peak <= lb or inst.n == 0 or not inst.separable:
+        # Conflicts beyond time overlaps (cross-queue pairs) leave the time bound out of
+        # reach: the search could only burn its budget proving nothing, so greedy it is.
         return best
     budget = node_budget_for(inst, time_budget_s)
     if budget < inst.n:

@@ -139,7 +139,18 @@ def compile_graph_plan(
     before every pass, one queue, no semaphores), for comparison.
     ``split`` (``rgraph.compiler.multi_device.Split``) makes a multi-device plan (FORMAT.md 6).
     """
-    front = frontend(graph, scene_path, params, size)
+    return plan_for_frontend(frontend(graph, scene_path, params, size), policy, memory, profile, extra_outputs, sync)
+
+
+def plan_for_frontend(
+    front: Frontend,
+    policy: str | None = None,
+    memory: MemoryRequirementsProvider | None = None,
+    profile: str | None = None,
+    extra_outputs: Sequence[str] = (),
+    sync: str = "normal",
+) -> Plan:
+    """The rest of ``compile_graph_plan`` once the graph is loaded and specialised."""
     spec = with_outputs(front.spec, extra_outputs)
     provider = memory
     profile_name = None

@@ -20,18 +20,20 @@ def test_help_table_matches_every_command_module() -> None:
     assert set(full) == {m.replace("_", "-") for m in COMMAND_MODULES}
 
 
-def test_top_level_help_imports_no_command_module() -> None:
+def _run_main(argv: list[str]) -> list[str]:
+    """stdout lines of ``rgraph.cli.main(argv)`` in a fresh interpreter, then the imported
+    ``rgraph.commands.*`` modules as the last line."""
     code = ("import sys; from rgraph.cli import main\n"
-            "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            f"try:\n    main({argv!r})\nexcept SystemExit:\n    pass\n"
             "print(sorted(m for m in sys.modules if m.startswith('rgraph.commands.')))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.strip().splitlines()[-1] == "[]"
-    assert "compile a graph into a plan JSON" in out
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.splitlines()
+
+
+def test_top_level_help_imports_no_command_module() -> None:
+    lines = _run_main(["--help"])
+    assert lines[-1] == "[]"
+    assert any("compile a graph into a plan JSON" in line for line in lines)
 
 
 def test_a_command_imports_only_its_own_module() -> None:
-    code = ("import sys; from rgraph.cli import main\n"
-            "main(['graphs'])\n"
-            "print(sorted(m for m in sys.modules if m.startswith('rgraph.commands.')))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.strip().splitlines()[-1] == "['rgraph.commands.graphs']"
+    assert _run_main(["graphs"])[-1] == "['rgraph.commands.graphs']"

@@ -16,6 +16,7 @@ previous use was on another queue waits for that use.
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from collections.abc import Collection, Sequence
 
 from rgraph.ir.graph import cells
@@ -64,29 +65,26 @@ def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str
         per = lasts.setdefault(c[0], {})
         per[q] = max(per.get(q, -1), i)
     waits = direct_waits(passes)
-    queues_first = {r: {q for _, q in f} for r, f in firsts.items()}
+    # Per queue q: the resources with a cell last used on q, by that last use. Sharing with a
+    # later r adds a wait iff some cell of r first used on another queue does not already
+    # wait for q at or after it: a range of this order, found by bisection.
+    by_queue: dict[str, list[tuple[int, str]]] = {}
+    for name, per in lasts.items():
+        for q, j in per.items():
+            by_queue.setdefault(q, []).append((j, name))
+    for rows in by_queue.values():
+        rows.sort()
+    keys = {q: [j for j, _ in rows] for q, rows in by_queue.items()}
     out: dict[str, set[str]] = {}
-    names = sorted(span, key=lambda r: span[r][0])
-    for r in names:
+    for r in sorted(span):
         r_first = span[r][0]
-        for p in names:
-            if span[p][1] >= r_first:
-                if span[p][0] >= r_first:
-                    break
-                continue  # overlapping in pass index: already apart
-            p_lasts = lasts[p]
-            if len(p_lasts) == 1 and queues_first[r] == set(p_lasts):
-                continue  # one queue throughout: a pipeline barrier suffices
-            if _adds_wait(p_lasts, firsts[r], waits):
-                out.setdefault(r, set()).add(p)
-                out.setdefault(p, set()).add(r)
+        for q, rows in by_queue.items():
+            have = [waits[v].get(q, -1) for v, qv in firsts[r] if qv != q]
+            if not have:
+                continue  # r starts on q only: a pipeline barrier orders it
+            lo, hi = bisect_right(keys[q], min(have)), bisect_left(keys[q], r_first)
+            for _, p in rows[lo:hi]:
+                if span[p][1] < r_first:
+                    out.setdefault(r, set()).add(p)
+                    out.setdefault(p, set()).add(r)
     return out
-
-
-def _adds_wait(p_lasts: dict[str, int], r_firsts: set[tuple[int, str]], waits: list[dict[str, int]]) -> bool:
-    for v, qv in r_firsts:
-        have = waits[v]
-        for q, j in p_lasts.items():
-            if q != qv and have.get(q, -1) < j:
-                return True
-    return False

@@ -139,7 +139,8 @@ def compile_graph_plan(
     before every pass, one queue, no semaphores), for comparison.
     ``split`` (``rgraph.compiler.multi_device.Split``) makes a multi-device plan (FORMAT.md 6).
     """
-    return plan_for_frontend(frontend(graph, scene_path, params, size), policy, memory, profile, extra_outputs, sync)
+    return plan_for_frontend(frontend(graph, scene_path, params, size), policy, memory, profile, extra_outputs, sync,
+                             schedule)
 
 
 def plan_for_frontend(
@@ -149,6 +150,7 @@ def plan_for_frontend(
     profile: str | None = None,
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
+    schedule: str = DEFAULT_SCHEDULE,
 ) -> Plan:
     """The rest of ``compile_graph_plan`` once the graph is loaded and specialised."""
     spec = with_outputs(front.spec, extra_outputs)

@@ -5,7 +5,7 @@ the graph's structure (Unity's render graph) or by compiling once and re-running
 (Daxa). ``PlanCache.plan(...)`` takes the arguments of ``compile_graph_plan``; its key is
 what the plan depends on: the graph file and every file it includes and its scene (by
 content: a SHA-256 of each, re-read only when a file's size or modification time changed),
-the params, the output size, the policy, the schedule, the device profile (or the identity of the live
+the params, the output size, the policy, the schedule, the camera, the device profile (or the identity of the live
 memory-requirements provider), extra outputs and the sync mode. A hit returns the same
 ``Plan`` object (plans are immutable); anything else compiles and replaces the entry.
 """
@@ -67,10 +67,11 @@ class PlanCache:
         extra_outputs: Sequence[str] = (),
         sync: str = "normal",
         schedule: str = DEFAULT_SCHEDULE,
+        camera: int = 0,
     ) -> Plan:
         key = (str(Path(resolve_graph(str(graph))).resolve()), None if scene_path is None else str(Path(scene_path).resolve()),
                tuple(sorted((params or {}).items())), tuple(size), policy, profile,
-               None if memory is None else id(memory), tuple(extra_outputs), sync, schedule)
+               None if memory is None else id(memory), tuple(extra_outputs), sync, schedule, camera)
         entry = self._entries.get(key)
         if entry is not None and self._unchanged(entry):
             self._entries.move_to_end(key)
@@ -78,7 +79,7 @@ class PlanCache:
             return entry.plan
         self.misses += 1
         front = frontend(graph, scene_path, params, size)
-        plan = plan_for_frontend(front, policy, memory, profile, extra_outputs, sync, schedule)
+        plan = plan_for_frontend(front, policy, memory, profile, extra_outputs, sync, schedule, camera)
         paths = list(dict.fromkeys([*front.source.files, front.source.path,
                                     *([front.scene.path] if front.scene is not None and front.scene.path else [])]))
         self._entries[key] = _Entry([_File(Path(p), _stamp(Path(p)), _digest(Path(p))) for p in paths], plan)

@@ -140,7 +140,7 @@ def compile_graph_plan(
     ``split`` (``rgraph.compiler.multi_device.Split``) makes a multi-device plan (FORMAT.md 6).
     """
     return plan_for_frontend(frontend(graph, scene_path, params, size), policy, memory, profile, extra_outputs, sync,
-                             schedule)
+                             schedule, camera)
 
 
 def plan_for_frontend(
@@ -151,6 +151,7 @@ def plan_for_frontend(
     extra_outputs: Sequence[str] = (),
     sync: str = "normal",
     schedule: str = DEFAULT_SCHEDULE,
+    camera: int = 0,
 ) -> Plan:
     """The rest of ``compile_graph_plan`` once the graph is loaded and specialised."""
     spec = with_outputs(front.spec, extra_outputs)

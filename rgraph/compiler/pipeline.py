@@ -140,7 +140,7 @@ def compile_graph_plan(
     ``split`` (``rgraph.compiler.multi_device.Split``) makes a multi-device plan (FORMAT.md 6).
     """
     return plan_for_frontend(frontend(graph, scene_path, params, size), policy, memory, profile, extra_outputs, sync,
-                             schedule, camera)
+                             schedule, camera, split)
 
 
 def plan_for_frontend(
@@ -152,6 +152,7 @@ def plan_for_frontend(
     sync: str = "normal",
     schedule: str = DEFAULT_SCHEDULE,
     camera: int = 0,
+    split: Any = None,
 ) -> Plan:
     """The rest of ``compile_graph_plan`` once the graph is loaded and specialised."""
     spec = with_outputs(front.spec, extra_outputs)

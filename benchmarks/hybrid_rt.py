@@ -76,6 +76,7 @@ def measure(scene: str, camera: int, size: tuple[int, int], frames: int, depth: 
 
 def prim_bits_of(path: Path, size: tuple[int, int], camera: int) -> int:
     from rgraph.passes.raytrace_hybrid import prim_bits
+
     from rgraph.scene.build import load_scene_data
 
     return prim_bits(load_scene_data(path, size, camera))

@@ -13,9 +13,9 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph.check import hazards as hz
-from rgraph.jsonloc import PathPart
 from rgraph.check.plan import PlanShapeError
 from rgraph.errors import quote
+from rgraph.jsonloc import PathPart
 
 #: Larger than any device's memory (the largest GPUs have a few hundred GiB): 4 TiB.
 MAX_BYTES = 1 << 42
@@ -62,7 +62,8 @@ def check_layout(raw: dict[str, Any]) -> list[hz.Hazard]:
 
 
 def _check_passes(raw: dict[str, Any]) -> None:
-    devices = raw.get("devices", 1)
+    multi = raw.get("multi_device")
+    devices = multi.get("devices", 1) if isinstance(multi, dict) else raw.get("devices", 1)
     if isinstance(devices, list):
         devices = len(devices)
     if isinstance(devices, bool) or not isinstance(devices, int) or not 1 <= devices <= MAX_DEVICES:

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph.check import vocab
-from rgraph.jsonloc import PathPart, format_path
 from rgraph.errors import quote
+from rgraph.jsonloc import PathPart, format_path
 
 Rect = tuple[int, int, int, int]  # mip begin, mip end, layer begin, layer end (half-open)
 LIFETIMES = ("transient", "persistent", "imported", "output")

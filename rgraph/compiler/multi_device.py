@@ -37,6 +37,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from rgraph.errors import RGraphError
+from rgraph.plan.devices import COMPOSITE_IMPL, DOWNLOAD_IMPL, DRAWS, PROBE_INDEX, SCISSOR, UPLOAD_IMPL  # noqa: F401
 from rgraph.spec.specialize import AccessSpec, PassSpec, ResourceSpec, Spec
 
 if TYPE_CHECKING:
@@ -44,12 +45,6 @@ if TYPE_CHECKING:
 
 SPLITS = ("sort-first", "sort-last")
 BALANCES = ("static", "dynamic")
-SCISSOR = "rgraph.scissor"
-DRAWS = "rgraph.draws"
-PROBE_INDEX = "rgraph.probe_index"
-DOWNLOAD_IMPL = "rgraph.multi.download"
-UPLOAD_IMPL = "rgraph.multi.upload"
-COMPOSITE_IMPL = "rgraph.multi.depth_composite"
 LOCAL_USAGES = frozenset({"color_attachment", "color_attachment_blend", "depth_attachment", "depth_read"})
 
 

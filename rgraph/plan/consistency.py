@@ -49,10 +49,9 @@ PLAN_ONLY_USAGES = ("accel_scratch",)
 
 def _vocabulary(plan: Plan) -> Iterator[Problem]:
     """Pass kinds, usages and formats are the closed vocabularies of FORMAT.md."""
+    from rgraph.memory_requirements import ACCEL_BUFFER_USAGES
     from rgraph.spec.vocabulary import PASS_KINDS
     from rgraph.spec.vocabulary import USAGES as GRAPH_USAGES
-
-    from rgraph.memory_requirements import ACCEL_BUFFER_USAGES
 
     usages = (*GRAPH_USAGES, *PLAN_ONLY_USAGES)
     resource_usages = (*usages, *sorted(ACCEL_BUFFER_USAGES - set(usages)))  # + trace_indirect (a device address)

@@ -20,6 +20,13 @@ from typing import Any
 from rgraph.plan.model import Access, Barrier, Plan, PlanPass, Signal, Stats, Wait
 
 SUFFIX = "@"
+# Pass params and impl names a multi-device plan carries (shared by the compiler and the runtime).
+SCISSOR = "rgraph.scissor"
+DRAWS = "rgraph.draws"
+PROBE_INDEX = "rgraph.probe_index"
+DOWNLOAD_IMPL = "rgraph.multi.download"
+UPLOAD_IMPL = "rgraph.multi.upload"
+COMPOSITE_IMPL = "rgraph.multi.depth_composite"
 
 
 def rename(name: str, device: int) -> str:

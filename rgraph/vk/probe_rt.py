@@ -9,8 +9,6 @@ Ray queries are never used.
 
 from __future__ import annotations
 
-from typing import Any
-
 from rgraph.vk.accel import AccelSet
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk

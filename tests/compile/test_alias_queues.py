@@ -61,7 +61,7 @@ def test_a_consumer_waits_for_the_pass_it_needs_and_that_pass_signals(tmp_path: 
     """g1 needs only c1's a2: it waits for c1's own signal, not the end of the compute
     chain, and the runtime ends a batch after every signalling pass. (Had c2 also read a2,
     g1 would wait for c2: the compute queue releases ownership after its last use.)"""
-    from rgraph.vk.executor import make_batches
+    from rgraph.vk.lower.batches import make_batches
 
     path = tmp_path / "chain.yaml"
     path.write_text(CHAIN)

@@ -1,14 +1,13 @@
 """The allocator experiment's graph and ``mesh_lines`` pass: layout, camera, and real runs on lavapipe."""
 
 from __future__ import annotations
-from locations import ROOT
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from rgraph.compiler.pipeline import compile_graph, frontend
 from rgraph.spec.scene import load_scene

@@ -1,11 +1,11 @@
 """MiniMalloc trace reading, the ``rgraph place`` command and the timeline drawing."""
 
 from __future__ import annotations
-from locations import ROOT
 
 from pathlib import Path
 
 import pytest
+from locations import ROOT
 
 from rgraph.cli import main
 from rgraph.errors import RGraphError

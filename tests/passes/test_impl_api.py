@@ -1,13 +1,11 @@
 """The pass-implementation API end to end on lavapipe: registry, setup helpers, inputs, outputs."""
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import impl_fixtures.passes  # noqa: F401 -- registers test_scale and test_blit
 import numpy as np
 import pytest
+from locations import TESTS
 
 from rgraph import impl
 from rgraph.compiler.pipeline import compile_graph

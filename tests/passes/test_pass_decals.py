@@ -6,12 +6,10 @@ and float64 may disagree about inside/outside (reported by the reference as ``ed
 """
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import TESTS
 from rgraph.passes import decals_ref as ref
 from rgraph.passes.screenspace_ref import Camera, render_depth
 

@@ -15,12 +15,10 @@ the normal from the r8g8b8a8 normal_sss, ~2e-3 rad quantization, and float16 sto
 """
 
 from __future__ import annotations
-from locations import ROOT, TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT, TESTS
 from rgraph.passes import forward_ref as ref
 from rgraph.passes import ibl_ref
 

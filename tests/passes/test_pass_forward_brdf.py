@@ -11,13 +11,12 @@ case is the roughness-0 mirror peak, ~1e-4 relative).
 """
 
 from __future__ import annotations
-from locations import TESTS
 
 import itertools
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import TESTS
 from rgraph.passes import forward_ref as ref
 
 from rgraph.compiler.pipeline import compile_graph

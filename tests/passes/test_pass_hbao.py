@@ -7,12 +7,10 @@ float64 trigonometry); ``ao`` within 2/255 of the reference upsample of the GPU'
 """
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import TESTS
 from rgraph.passes import hbao_ref as ref
 from rgraph.passes.screenspace_ref import Camera, render_depth
 

@@ -11,12 +11,10 @@ Tolerances:
 """
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import TESTS
 from rgraph.passes import ibl_ref
 
 from rgraph.compiler.pipeline import compile_graph

@@ -7,12 +7,10 @@ lights 1e-6 relative to the distance from the camera (+1e-6).
 """
 
 from __future__ import annotations
-from locations import ROOT, TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT, TESTS
 from rgraph.passes import scene_ref
 from ruamel.yaml import YAML
 

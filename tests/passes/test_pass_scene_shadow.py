@@ -8,12 +8,10 @@ than half the taps.
 """
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import TESTS
 from rgraph.passes import scene_ref
 
 from rgraph.compiler.pipeline import compile_graph

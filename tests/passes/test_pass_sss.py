@@ -7,12 +7,10 @@ width must be the identity bit for bit; a constant image must stay constant.
 """
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import TESTS
 from rgraph.passes import sss_ref as ref
 from rgraph.passes.screenspace_ref import Camera, render_depth
 

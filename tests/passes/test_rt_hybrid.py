@@ -14,7 +14,12 @@ from rgraph.resources import builtin_passes
 from rgraph.vk.errors import VulkanUnavailable
 
 builtin_passes()
-from rgraph.passes.raytrace_hybrid import decode_visibility, instance_materials, needs_secondary_rays, prim_bits  # noqa: E402,E501
+from rgraph.passes.raytrace_hybrid import (  # noqa: E402,E501
+    decode_visibility,
+    instance_materials,
+    needs_secondary_rays,
+    prim_bits,
+)
 
 SCENE = ROOT / "graphs" / "scenes" / "rt_tiny.yaml"
 

@@ -6,9 +6,9 @@ import pytest
 from vkplans import PlanBuilder
 
 from rgraph.memory_requirements import ProfileMemoryRequirements, fit_image_rule, predict_image
+from rgraph.probe.check import compare_image
 from rgraph.probe.simulate import simulate
 from rgraph.probe.values import codec, seed
-from rgraph.probe.check import compare_image
 
 
 @pytest.mark.parametrize("fmt", ["R8G8B8A8_UNORM", "R8G8B8A8_SRGB", "R16G16B16A16_SFLOAT", "R32_UINT",

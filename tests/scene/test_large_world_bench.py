@@ -7,15 +7,14 @@ origin, and the vectorized camera-relative matrices are bit for bit what the run
 """
 
 from __future__ import annotations
-from locations import ROOT
 
 import importlib.util
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 BENCH = ROOT / "benchmarks" / "large_world.py"
 

@@ -1,12 +1,10 @@
 """Scene build from scene files: counts, bundled cct variants, deformation, large worlds."""
 
 from __future__ import annotations
-from locations import ROOT
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from rgraph.scene import packing
 from rgraph.scene.build import build_scene, load_scene_data

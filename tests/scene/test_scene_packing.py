@@ -1,12 +1,10 @@
 """CPU packing mirrors shaders/scene/scene.glsl: block sizes from SPIR-V reflection, values in place."""
 
 from __future__ import annotations
-from locations import ROOT
-
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from rgraph.scene import packing
 from rgraph.scene.build import load_scene_data

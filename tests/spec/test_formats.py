@@ -1,12 +1,11 @@
 """Tests of the generated Vulkan format table and its lookup API."""
 
 from __future__ import annotations
-from locations import ROOT
 
 import importlib.util
-from pathlib import Path
 
 import pytest
+from locations import ROOT
 
 from rgraph import formats
 from rgraph.formats import table

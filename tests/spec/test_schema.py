@@ -1,7 +1,7 @@
 """The checked-in JSON Schema matches the models; bundled graphs carry the modeline."""
 
+
 from locations import ROOT
-from pathlib import Path
 
 from rgraph.commands.schema import schema_text
 from rgraph.resources import bundled_graphs

@@ -1,11 +1,9 @@
 """Sweep settings (knob parsing, one-at-a-time and grid expansion, extremes) and Pareto fronts."""
 
 from __future__ import annotations
-from locations import TESTS
-
-from pathlib import Path
 
 import pytest
+from locations import TESTS
 
 from rgraph.errors import RGraphError
 from rgraph.resources import resolve_graph

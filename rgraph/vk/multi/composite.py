@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from rgraph.compiler.multi_device import COMPOSITE_IMPL
 from rgraph.impl import PassImpl, register
+from rgraph.plan.devices import COMPOSITE_IMPL
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding
 

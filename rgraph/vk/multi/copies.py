@@ -1,4 +1,4 @@
-"""The copy passes of multi-device plans (``rgraph.compiler.multi_device``): a band or whole
+"""The copy passes of multi-device plans (the compiler's multi-device transformation): a band or whole
 image into a buffer on the sending device, and a buffer into the band on the receiving one.
 
 ``params.rect = [x, y, w, h]`` is the region (mip 0, every layer of the access), packed
@@ -10,8 +10,8 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph import formats
-from rgraph.compiler.multi_device import DOWNLOAD_IMPL, UPLOAD_IMPL
 from rgraph.impl import PassImpl, register
+from rgraph.plan.devices import DOWNLOAD_IMPL, UPLOAD_IMPL
 from rgraph.vk import names
 from rgraph.vk.loader import vk
 

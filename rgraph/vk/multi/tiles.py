@@ -8,9 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from rgraph.plan.devices import SCISSOR  # noqa: F401 (re-exported for the runtime)
 from rgraph.vk.loader import vk
-
-SCISSOR = "rgraph.scissor"  # as rgraph.compiler.multi_device.SCISSOR (no compiler import on the hot path)
 
 
 def scissor_rect(plan_pass: dict[str, Any], width: int, height: int) -> Any:

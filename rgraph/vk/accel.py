@@ -22,7 +22,7 @@ from rgraph.vk.accel_sizes import build_flags, instances_geometry, query, triang
 from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
-from rgraph.vk.resources import SHARED, HostBuffer, ResourceSet, memory_type
+from rgraph.vk.resources import SHARED, HostBuffer, ResourceSet
 from rgraph.vk.rt_device import device_address, proc
 
 INPUT_USAGE = 0x80000 | names.SHADER_DEVICE_ADDRESS  # ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY
@@ -73,19 +73,9 @@ class AddressBuffer:
 
     @classmethod
     def create(cls, device: Device, size: int, usage: int) -> AddressBuffer:
-        v = vk()
-        size = max(int(size), 16)
-        info = v.VkBufferCreateInfo(size=size, usage=usage | names.SHADER_DEVICE_ADDRESS,
-                                    sharingMode=v.VK_SHARING_MODE_EXCLUSIVE)
-        handle = v.vkCreateBuffer(device.handle, info, None)
-        req = v.vkGetBufferMemoryRequirements(device.handle, handle)
-        want = v.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | v.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-        flags = v.VkMemoryAllocateFlagsInfo(flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
-        memory = v.vkAllocateMemory(device.handle, v.VkMemoryAllocateInfo(
-            pNext=flags, allocationSize=req.size, memoryTypeIndex=memory_type(device, req.memoryTypeBits, want)), None)
-        v.vkBindBufferMemory(device.handle, handle, memory, 0)
-        mapped = v.vkMapMemory(device.handle, memory, 0, size, 0)
-        return cls(HostBuffer(device, handle, memory, size, mapped), buffer_address(device, handle))
+        host = HostBuffer.create(device, max(int(size), 16), usage | names.SHADER_DEVICE_ADDRESS,
+                                 allocate_flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
+        return cls(host, buffer_address(device, host.handle))
 
     def destroy(self) -> None:
         self.host.destroy()

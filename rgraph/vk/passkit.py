@@ -98,6 +98,15 @@ class PassParams(dict):
         return super().__contains__(name)
 
 
+def descriptor_types() -> dict[str, int]:
+    """Binding kind (``Binding.kind``) -> VkDescriptorType, for every pass runtime."""
+    v = vk()
+    return {"sampled": v.VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+            "storage_image": v.VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+            "storage_buffer": v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+
+
 class PassSetup:
     """Everything an implementation may use to prepare itself; see ``rgraph.impl``."""
 
@@ -215,10 +224,7 @@ class PassSetup:
         """A set layout and one descriptor set per frame-in-flight set, written once."""
         v = vk()
         dev = self.device.handle
-        types = {"sampled": v.VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                 "storage_image": v.VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-                 "storage_buffer": v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                 "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+        types = descriptor_types()
         for b in bindings:
             if b.kind not in types:
                 raise ExecutionError(f"pass {self.name!r}: descriptor kind {b.kind!r} not one of {DESCRIPTOR_KINDS}")

@@ -20,7 +20,7 @@ from rgraph.vk import names
 from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
-from rgraph.vk.passkit import PassSetup
+from rgraph.vk.passkit import PassSetup, descriptor_types
 from rgraph.vk.probe_glsl import ProbeShaders, generate
 from rgraph.vk.record_context import RecordContext
 from rgraph.vk.resources import HostBuffer, Resource
@@ -95,10 +95,7 @@ class Probe(PassImpl):
         dev = self.device.handle
         sh = self.shaders
         assert sh is not None
-        kinds = {"sampled": v.VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                 "storage_image": v.VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-                 "storage_buffer": v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                 "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+        kinds = descriptor_types()
         layout_bindings = [v.VkDescriptorSetLayoutBinding(
             binding=b.binding, descriptorType=kinds[b.kind], descriptorCount=1, stageFlags=v.VK_SHADER_STAGE_ALL)
             for b in sh.bindings]

@@ -12,7 +12,7 @@ from __future__ import annotations
 from rgraph.vk.accel import AccelSet
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
-from rgraph.vk.passkit import PassSetup
+from rgraph.vk.passkit import PassSetup, descriptor_types
 from rgraph.vk.probe import PROBE, Probe, compile_glsl
 from rgraph.vk.probe_rt_glsl import generate_rt
 from rgraph.vk.record_context import RecordContext
@@ -104,10 +104,7 @@ class RayTraceProbe(Probe):
     def _prepare_rt(self) -> None:
         v = vk()
         dev = self.device.handle
-        kinds = {"sampled": v.VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                 "storage_image": v.VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-                 "storage_buffer": v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                 "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+        kinds = descriptor_types()
         accel_type = v.VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR
         bindings = [(b.binding, kinds[b.kind]) for b in self.shaders.bindings]
         bindings += [(b, accel_type) for b, _ in self.rt.accel_bindings]

@@ -61,7 +61,8 @@ class HostBuffer:
     mapped: Any
 
     @classmethod
-    def create(cls, device: Device, size: int, usage: int) -> HostBuffer:
+    def create(cls, device: Device, size: int, usage: int, allocate_flags: int = 0) -> HostBuffer:
+        """``allocate_flags``: VkMemoryAllocateFlags (e.g. device address) for its memory."""
         v = vk()
         size = max(int(size), 4)
         info = v.VkBufferCreateInfo(size=size, usage=usage, sharingMode=v.VK_SHARING_MODE_EXCLUSIVE)
@@ -69,8 +70,9 @@ class HostBuffer:
         req = v.vkGetBufferMemoryRequirements(device.handle, handle)
         want = v.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | v.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
         index = memory_type(device, req.memoryTypeBits, want)
-        memory = v.vkAllocateMemory(device.handle, v.VkMemoryAllocateInfo(allocationSize=req.size,
-                                                                         memoryTypeIndex=index), None)
+        chain = {"pNext": v.VkMemoryAllocateFlagsInfo(flags=allocate_flags)} if allocate_flags else {}  # alive until the call returns
+        memory = v.vkAllocateMemory(device.handle, v.VkMemoryAllocateInfo(
+            allocationSize=req.size, memoryTypeIndex=index, **chain), None)
         v.vkBindBufferMemory(device.handle, handle, memory, 0)
         mapped = v.vkMapMemory(device.handle, memory, 0, size, 0)
         return cls(device, handle, memory, size, mapped)

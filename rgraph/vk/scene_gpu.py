@@ -63,6 +63,7 @@ class SceneGPU:
         self._pool = None
         self.set_layout = None
         self._sets: list[Any] = []
+        self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
         self.deform: Any = None  # rgraph.vk.scene_deform.DeformGPU when the scene has deformable meshes
         try:
             self._build(submit_once)
@@ -209,9 +210,12 @@ class SceneGPU:
         """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished)."""
         data = self.data
         self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame))
-        self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
-        if data.decals:
-            self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
+        camera = data.camera(frame).position.tobytes()
+        if self._camera_written[frame_set] != camera:  # camera-relative tables change with the camera only
+            self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
+            if data.decals:
+                self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
+            self._camera_written[frame_set] = camera
         if self.deform is not None:
             self.deform.write(data.seconds(frame), frame_set)
 

@@ -103,6 +103,14 @@ class DeformGPU:
         for part in self.parts:
             part.deformer.write_positions(seconds, cur[part.base:part.base + part.data.vertex_count])
 
+    def positions_at(self, seconds: float) -> np.ndarray:
+        """Every deformable vertex's position at ``seconds``, (total, 3) float32, a new array
+        (the logic thread's state: ``rgraph.vk.runtime.logic``)."""
+        out = np.empty((self.total, 3), dtype=np.float32)
+        for part in self.parts:
+            part.deformer.write_positions(seconds, out[part.base:part.base + part.data.vertex_count])
+        return out
+
     def write_states(self, frame_set: int, prev: np.ndarray | None, cur: np.ndarray | None, alpha: float) -> None:
         """Logic states (``(total, 3)`` float32 each; None: unchanged since this set's last write)
         and the interpolation weight ``alpha`` in [0, 1] (0: prev, 1: cur)."""

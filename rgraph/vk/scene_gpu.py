@@ -64,6 +64,9 @@ class SceneGPU:
         self.set_layout = None
         self._sets: list[Any] = []
         self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
+        self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread (attach_logic)
+        self._ticks_written: list[tuple[int, int] | None] = [None] * sets
+        self.alpha_range = [1.0, 0.0]
         self.deform: Any = None  # rgraph.vk.scene_deform.DeformGPU when the scene has deformable meshes
         try:
             self._build(submit_once)
@@ -209,15 +212,42 @@ class SceneGPU:
     def update(self, frame: int, frame_set: int) -> None:
         """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished)."""
         data = self.data
-        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame))
+        logic = self.logic
+        if logic is None:
+            seconds = data.seconds(frame)
+        else:  # between the logic thread's last two states
+            prev, cur = logic.latest()
+            alpha = logic.alpha()
+            seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
+            self.alpha_range[0] = min(self.alpha_range[0], alpha)
+            self.alpha_range[1] = max(self.alpha_range[1], alpha)
+        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame, seconds))
         camera = data.camera(frame).position.tobytes()
         if self._camera_written[frame_set] != camera:  # camera-relative tables change with the camera only
             self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
             if data.decals:
                 self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
             self._camera_written[frame_set] = camera
-        if self.deform is not None:
-            self.deform.write(data.seconds(frame), frame_set)
+        if self.deform is None:
+            return
+        if logic is None:
+            self.deform.write(seconds, frame_set)
+            return
+        ticks = (prev.tick, cur.tick)
+        fresh = self._ticks_written[frame_set] != ticks  # copy the states once per set and tick
+        self.deform.write_states(frame_set, prev.value if fresh else None, cur.value if fresh else None, alpha)
+        self._ticks_written[frame_set] = ticks
+
+    def attach_logic(self, logic: Any) -> None:
+        """Take scene time and deformable positions from ``logic`` (a started-on-demand
+        ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step``)."""
+        self.logic = logic
+        self._ticks_written = [None] * self.sets
+        self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
+
+    def logic_step(self, seconds: float) -> Any:
+        """One logic tick at scene time ``seconds``: the deformable positions (None: none)."""
+        return self.deform.positions_at(seconds) if self.deform is not None else None
 
     def record_deform(self, cb: Any, frame_set: int) -> None:
         """The deformable vertices' compute pass and its barriers (nothing without deformable meshes)."""

@@ -56,14 +56,18 @@ def probe_only(plan: dict) -> dict:
     return {**plan, "passes": [{**p, "impl": None} for p in plan["passes"]]}
 
 
-def frame_cpu_us(gpu: rgraph.Gpu, plan: dict, frames: int, one_call_per_queue: bool = True) -> dict[str, Any]:
+def frame_cpu_us(gpu: rgraph.Gpu, plan: dict, frames: int, one_call_per_queue: bool = True,
+                 logic_hz: float | None = None) -> dict[str, Any]:
     """Per frame (microseconds, frame start to next frame start): blocked in the fence wait,
-    each Vulkan call, and Python (the rest); ``calls``: vkQueueSubmit2 calls per frame."""
+    each Vulkan call, and Python (the rest); ``calls``: vkQueueSubmit2 calls per frame;
+    ``render_thread``/``logic``: the run's timings of them (thread CPU time per frame)."""
     marks: list[float] = []
-    with gpu.load(plan, one_call_per_queue=one_call_per_queue) as exe:
-        exe.run(frames, marks=marks)
+    with gpu.load(plan, one_call_per_queue=one_call_per_queue, logic_hz=logic_hz) as exe:
+        timings = exe.run(frames, marks=marks).timings
         calls = len(exe.executor.submit_calls[0])
-    return frame_parts(marks, calls)
+    parts = frame_parts(marks, calls)
+    parts["render_thread"], parts["logic"] = timings.get("render_thread"), timings.get("logic")
+    return parts
 
 
 def frame_parts(marks: list[float], calls: int, skip: int = 10) -> dict[str, Any]:
@@ -157,6 +161,8 @@ def main() -> None:
     parser.add_argument("--policy", default=None, help="memory placement policy (default: the compiler's)")
     parser.add_argument("--passes", choices=("probe", "real"), default="probe",
                         help="probe: every pass by the probe (the runtime's own cost); real: the graph's passes")
+    parser.add_argument("--logic-hz", type=float, default=None,
+                        help="scene logic on its own thread at this rate (rgraph run --logic-hz)")
     parser.add_argument("--compare-sync", metavar="WxH", help="compare normal and --sync naive plans at this size")
     parser.add_argument("--rounds", type=int, default=3,
                         help="rounds of the CPU measurement and of --compare-sync (default 3)")
@@ -174,10 +180,11 @@ def measure(gpu: rgraph.Gpu, args: argparse.Namespace) -> None:
     plan, device, is_gpu = compile_for_device(gpu, (w, h), args.policy)
     if args.passes == "probe":
         plan = probe_only(plan)
-    parts = frame_cpu_us(gpu, plan, args.frames)
+    parts = frame_cpu_us(gpu, plan, args.frames, logic_hz=args.logic_hz)
     passes = len(plan["passes"])
     print(f"device: {device}")
-    print(f"surgery {w}x{h} ({args.passes} passes): {passes} passes, "
+    logic = f", logic thread at {args.logic_hz:g} Hz" if args.logic_hz else ""
+    print(f"surgery {w}x{h} ({args.passes} passes{logic}): {passes} passes, "
           f"{sum(len(p['barriers']) for p in plan['passes'])} barriers")
     print(f"frame wall time, main thread ({len(parts['frame'])} frames): {_summary(parts['frame'])}")
     print(f"  blocked in vkWaitForFences (GPU still busy):       {_summary(parts['gpu_wait'])}")
@@ -189,6 +196,13 @@ def measure(gpu: rgraph.Gpu, args: argparse.Namespace) -> None:
         print(f"      {name + ':':<47}{_summary(parts[name])}")
     calls = f"      vkQueueSubmit2 ({parts['calls']} calls per frame):"
     print(f"{calls:<53}{_summary(parts['submit'])}")
+    render = parts["render_thread"] or {}
+    print(f"  render thread CPU time (time.thread_time, driver calls included): "
+          f"{render.get('cpu_us_per_frame', 0.0):.1f} us per frame; host updates {render.get('update_us', 0.0):.1f} us median")
+    if parts["logic"]:
+        lg = parts["logic"]
+        print(f"  logic thread: {lg['ticks']} ticks at {lg['hz']:g} Hz (measured {lg['measured_hz'] or 0:.1f} Hz, "
+              f"{lg['late_ticks']} late), median tick {lg['tick_us'] or 0:.1f} us, alpha in {lg['alpha_range']}")
     if args.passes == "real":
         print("  per-frame host updates, each timed alone (median):")
         for name, us in update_costs(gpu, plan, min(args.frames, 500)).items():
@@ -197,7 +211,8 @@ def measure(gpu: rgraph.Gpu, args: argparse.Namespace) -> None:
     for r in range(args.rounds):  # same process: rounds alternate one call per queue / per run of batches
         for mode in ("per run", "per queue") if r % 2 == 0 else ("per queue", "per run"):
             if r or mode == "per run":
-                rounds[mode].append(frame_cpu_us(gpu, plan, args.frames, one_call_per_queue=mode == "per queue"))
+                rounds[mode].append(frame_cpu_us(gpu, plan, args.frames, one_call_per_queue=mode == "per queue",
+                                                 logic_hz=args.logic_hz))
     for mode, measured in rounds.items():
         python = [statistics.median(m["python"]) for m in measured]
         runtime = [statistics.median(m["runtime"]) for m in measured]

@@ -1,12 +1,16 @@
 """The deformable meshes on the GPU: the CPU writes positions, a compute pass the vertices.
 
-Per frame-in-flight set: a host-visible *state* buffer (``alpha``, then two position states
-of every deformable vertex, float32: the previous logic state and the current one), written
-by the CPU; a device-local vertex buffer (position, normal: ``packing.VERTEX_BYTES``) that the
-scene's draws bind, and a device-local tangent buffer (vec4: xyz, w the bitangent's sign),
-both written by ``shaders/scene/deform_normals.comp``. Shared and uploaded once: the smoothing
-topology (``rgraph.scene.smoothing``: groups, the CSR group -> triangles, indices), UVs and
-the rest normals (the fallback).
+Host-visible, written by the CPU: a *ring* of ``SLOTS`` position states (every deformable
+vertex, float32), and per frame-in-flight set a 16-byte *header* (``alpha``, the previous and
+the current state's slot). Without a logic thread, set s's frame writes its positions into slot
+s (header: alpha 1, slots s, s). With one (``rgraph.vk.runtime.logic``) the logic thread writes
+each tick's positions into a free slot (``write_slot``: not the published pair, not a pair a
+frame in flight reads; all under ``lock``) and the render thread writes only the header.
+Device-local, per set: the vertex buffer (position, normal: ``packing.VERTEX_BYTES``) the
+scene's draws bind and a tangent buffer (vec4: xyz, w the bitangent's sign), both written by
+``shaders/scene/deform_normals.comp``. Shared and uploaded once: the smoothing topology
+(``rgraph.scene.smoothing``: groups, the CSR group -> triangles, indices), UVs and the rest
+normals (the fallback).
 
 ``record(cb, s)`` goes at the start of the frame's first batch that uses the scene on the
 graphics queue (``rgraph.vk.runtime.commands``): a barrier (earlier draws' vertex reads before
@@ -16,6 +20,7 @@ before vertex input and shader reads of the rest of the frame).
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,6 +37,7 @@ from rgraph.vk.shaders import compile_shader, find_shader
 SHADER = "scene/deform_normals.comp"
 GROUP_SIZE = 64
 HEADER_BYTES = 16
+SLOTS = 8  # >= 2 sets x 2 slots in flight + the published pair + the one being written
 TANGENT_BYTES = 16
 PUSH_BYTES = 16
 
@@ -81,45 +87,60 @@ class DeformGPU:
         shared += [np.concatenate(uvs).astype(np.float32).tobytes(), np.concatenate(fallback).astype(np.float32).tobytes()]
         self.shared = [device_buffer(len(b), storage) for b in shared]
         upload(list(zip(self.shared, shared, strict=True)))
-        self.state_bytes = HEADER_BYTES + 2 * 3 * 4 * self.total
-        self.states = [host_buffer(self.state_bytes, storage) for _ in range(sets)]
+        self.ring_bytes = SLOTS * 3 * 4 * self.total
+        self.ring = host_buffer(self.ring_bytes, storage)
+        self.headers = [host_buffer(HEADER_BYTES, storage) for _ in range(sets)]
         self.vertex_buffers = [device_buffer(self.total * packing.VERTEX_BYTES,
                                              storage | v.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT) for _ in range(sets)]
         self.tangent_buffers = [device_buffer(self.total * TANGENT_BYTES, storage) for _ in range(sets)]
-        # numpy views of the mapped state: alpha, prev (total, 3), cur (total, 3)
-        self.views = []
-        for buf in self.states:
-            flat = np.frombuffer(buf.mapped, dtype=np.float32, count=self.state_bytes // 4)
-            self.views.append((flat[:1], flat[4:4 + 3 * self.total].reshape(-1, 3),
-                               flat[4 + 3 * self.total:].reshape(-1, 3)))
-        for alpha, _prev, _cur in self.views:
-            alpha[0] = 1.0
+        # numpy views of the mapped memory: the ring (SLOTS, total, 3); per set (alpha, slots)
+        self.slots = np.frombuffer(self.ring.mapped, dtype=np.float32, count=self.ring_bytes // 4).reshape(
+            SLOTS, self.total, 3)
+        self.header_views = []
+        for buf in self.headers:
+            f = np.frombuffer(buf.mapped, dtype=np.float32, count=4)
+            self.header_views.append((f, f.view(np.uint32)))
+        self.lock = threading.Lock()  # the logic thread's too (LogicThread(lock=...)): slots change hands under it
+        self.in_use: list[tuple[int, int]] = [(s, s) for s in range(sets)]  # per set: the slots its frame reads
+        for s in range(sets):
+            self.set_header(s, 1.0, s, s)
         self._make_pipeline()
 
     # ----------------------------------------------------------------- per frame (host)
     def write(self, seconds: float, frame_set: int) -> None:
-        """The deformed positions at ``seconds`` as the current state (alpha stays 1)."""
-        _alpha, _prev, cur = self.views[frame_set]
+        """Without a logic thread: the positions at ``seconds`` into slot ``frame_set`` (its header
+        stays alpha 1, slots (frame_set, frame_set))."""
+        self.write_positions(frame_set, seconds)
+
+    def write_positions(self, slot: int, seconds: float) -> None:
+        cur = self.slots[slot]
         for part in self.parts:
             part.deformer.write_positions(seconds, cur[part.base:part.base + part.data.vertex_count])
 
-    def positions_at(self, seconds: float) -> np.ndarray:
-        """Every deformable vertex's position at ``seconds``, (total, 3) float32, a new array
-        (the logic thread's state: ``rgraph.vk.runtime.logic``)."""
-        out = np.empty((self.total, 3), dtype=np.float32)
-        for part in self.parts:
-            part.deformer.write_positions(seconds, out[part.base:part.base + part.data.vertex_count])
-        return out
+    def write_slot(self, seconds: float, published: Any) -> int:
+        """The logic thread's tick: the positions at ``seconds`` into a slot that no frame set
+        reads (``in_use``) and ``published()`` (the slots a frame may still take) does not
+        name; its index. Slots in use and published: at most 6 of ``SLOTS``."""
+        with self.lock:
+            busy = {*(st.value for st in published()), *(x for pair in self.in_use for x in pair)}
+            slot = next(k for k in range(SLOTS) if k not in busy)
+        self.write_positions(slot, seconds)
+        return slot
 
-    def write_states(self, frame_set: int, prev: np.ndarray | None, cur: np.ndarray | None, alpha: float) -> None:
-        """Logic states (``(total, 3)`` float32 each; None: unchanged since this set's last write)
-        and the interpolation weight ``alpha`` in [0, 1] (0: prev, 1: cur)."""
-        a, p, c = self.views[frame_set]
-        if prev is not None:
-            p[...] = prev
-        if cur is not None:
-            c[...] = cur
-        a[0] = alpha
+    def take(self, frame_set: int, states: Any) -> tuple[Any, Any]:
+        """``states()`` (the logic's (prev, cur), values = slots), marked in use by
+        ``frame_set`` in one step (its previous pair is free: its fence was waited)."""
+        with self.lock:
+            prev, cur = states()
+            self.in_use[frame_set] = (prev.value, cur.value)
+        return prev, cur
+
+    def set_header(self, frame_set: int, alpha: float, prev: int, cur: int) -> None:
+        """Set ``frame_set``'s frame mixes slots ``prev`` and ``cur`` with weight ``alpha`` (1: cur)."""
+        f, u = self.header_views[frame_set]
+        f[0] = alpha
+        u[1] = prev
+        u[2] = cur
 
     # ----------------------------------------------------------------- recording
     def record(self, cb: Any, frame_set: int) -> None:
@@ -152,7 +173,7 @@ class DeformGPU:
         v = vk()
         dev = self.device.handle
         ssbo = v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
-        count = 9
+        count = 10
         bindings = [v.VkDescriptorSetLayoutBinding(binding=b, descriptorType=ssbo, descriptorCount=1,
                                                    stageFlags=v.VK_SHADER_STAGE_COMPUTE_BIT) for b in range(count)]
         self.set_layout = self._own("vkDestroyDescriptorSetLayout", v.vkCreateDescriptorSetLayout(
@@ -163,7 +184,8 @@ class DeformGPU:
         self.descriptor_sets = list(v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
             descriptorPool=pool, descriptorSetCount=self.sets, pSetLayouts=[self.set_layout] * self.sets)))
         for s in range(self.sets):
-            buffers = [(self.states[s].handle, self.state_bytes), *((b.handle, b.size) for b in self.shared),
+            buffers = [(self.headers[s].handle, HEADER_BYTES), (self.ring.handle, self.ring_bytes),
+                       *((b.handle, b.size) for b in self.shared),
                        (self.vertex_buffers[s].handle, self.vertex_buffers[s].size),
                        (self.tangent_buffers[s].handle, self.tangent_buffers[s].size)]
             infos = [v.VkDescriptorBufferInfo(buffer=h, offset=0, range=size) for h, size in buffers]

@@ -65,7 +65,7 @@ class SceneGPU:
         self._sets: list[Any] = []
         self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread (attach_logic)
-        self._ticks_written: list[tuple[int, int] | None] = [None] * sets
+        self.ticks_taken: list[tuple[int, int] | None] = [None] * sets  # per set: the logic ticks its frame mixes
         self.alpha_range = [1.0, 0.0]
         self.deform: Any = None  # rgraph.vk.scene_deform.DeformGPU when the scene has deformable meshes
         try:
@@ -216,7 +216,7 @@ class SceneGPU:
         if logic is None:
             seconds = data.seconds(frame)
         else:  # between the logic thread's last two states
-            prev, cur = logic.latest()
+            prev, cur = logic.latest() if self.deform is None else self.deform.take(frame_set, logic.latest)
             alpha = logic.alpha()
             seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
             self.alpha_range[0] = min(self.alpha_range[0], alpha)
@@ -233,21 +233,23 @@ class SceneGPU:
         if logic is None:
             self.deform.write(seconds, frame_set)
             return
-        ticks = (prev.tick, cur.tick)
-        fresh = self._ticks_written[frame_set] != ticks  # copy the states once per set and tick
-        self.deform.write_states(frame_set, prev.value if fresh else None, cur.value if fresh else None, alpha)
-        self._ticks_written[frame_set] = ticks
+        self.deform.set_header(frame_set, alpha, prev.value, cur.value)  # the logic wrote the slots
+        self.ticks_taken[frame_set] = (prev.tick, cur.tick)
 
     def attach_logic(self, logic: Any) -> None:
         """Take scene time and deformable positions from ``logic`` (a started-on-demand
-        ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step``)."""
+        ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step`` and whose lock is
+        ``deform.lock``)."""
         self.logic = logic
-        self._ticks_written = [None] * self.sets
+        self.ticks_taken = [None] * self.sets
         self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
 
     def logic_step(self, seconds: float) -> Any:
-        """One logic tick at scene time ``seconds``: the deformable positions (None: none)."""
-        return self.deform.positions_at(seconds) if self.deform is not None else None
+        """One logic tick at scene time ``seconds`` (the logic thread): the deformable positions
+        written into a free ring slot; the slot (None: no deformable meshes)."""
+        if self.deform is None:
+            return None
+        return self.deform.write_slot(seconds, self.logic.published)
 
     def record_deform(self, cb: Any, frame_set: int) -> None:
         """The deformable vertices' compute pass and its barriers (nothing without deformable meshes)."""

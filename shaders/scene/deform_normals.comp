@@ -7,33 +7,33 @@
 
 layout(local_size_x = 64) in;
 
-// host-written per frame set: header.x = alpha; state_pos = prev positions (3 floats per
-// vertex, pc.total vertices), then the current ones
-layout(set = 0, binding = 0, std430) readonly buffer State { vec4 header; float state_pos[]; };
-layout(set = 0, binding = 1, std430) readonly buffer Groups { uint group_of[]; };
-layout(set = 0, binding = 2, std430) readonly buffer Offsets { uint offsets[]; };
-layout(set = 0, binding = 3, std430) readonly buffer Triangles { uint triangles[]; };
-layout(set = 0, binding = 4, std430) readonly buffer Indices { uint indices[]; };  // 3 per triangle
-layout(set = 0, binding = 5, std430) readonly buffer Uvs { vec2 uvs[]; };
-layout(set = 0, binding = 6, std430) readonly buffer Fallback { float fallback[]; };  // rest normals
-layout(set = 0, binding = 7, std430) writeonly buffer Vertices { float vertices[]; };  // position, normal
-layout(set = 0, binding = 8, std430) writeonly buffer Tangents { vec4 tangents[]; };
+// host-written: per frame set which two ring slots to mix (alpha 1: exactly the current one)
+layout(set = 0, binding = 0, std430) readonly buffer Header { float alpha; uint prev_slot; uint cur_slot; };
+layout(set = 0, binding = 1, std430) readonly buffer Ring { float ring_pos[]; };  // slots of pc.total vertices
+layout(set = 0, binding = 2, std430) readonly buffer Groups { uint group_of[]; };
+layout(set = 0, binding = 3, std430) readonly buffer Offsets { uint offsets[]; };
+layout(set = 0, binding = 4, std430) readonly buffer Triangles { uint triangles[]; };
+layout(set = 0, binding = 5, std430) readonly buffer Indices { uint indices[]; };  // 3 per triangle
+layout(set = 0, binding = 6, std430) readonly buffer Uvs { vec2 uvs[]; };
+layout(set = 0, binding = 7, std430) readonly buffer Fallback { float fallback[]; };  // rest normals
+layout(set = 0, binding = 8, std430) writeonly buffer Vertices { float vertices[]; };  // position, normal
+layout(set = 0, binding = 9, std430) writeonly buffer Tangents { vec4 tangents[]; };
 
 layout(push_constant) uniform Push {
     uint first;  // the mesh's first vertex
     uint count;  // its vertices
-    uint total;  // deformable vertices of the scene (the state's stride)
+    uint total;  // deformable vertices of the scene (a ring slot's size)
     float scale; // a power of two: positions * scale are about unit size
 } pc;
 
 const float REL = 1e-5;
 
 vec3 position(uint v) {
-    float a = header.x;
-    uint o = 3u * (pc.total + v);
-    precise vec3 p0 = vec3(state_pos[3u * v], state_pos[3u * v + 1u], state_pos[3u * v + 2u]);
-    precise vec3 p1 = vec3(state_pos[o], state_pos[o + 1u], state_pos[o + 2u]);
-    precise vec3 p = p0 * (1.0 - a) + p1 * a;  // alpha 1: exactly p1
+    uint o0 = 3u * (prev_slot * pc.total + v);
+    uint o1 = 3u * (cur_slot * pc.total + v);
+    precise vec3 p0 = vec3(ring_pos[o0], ring_pos[o0 + 1u], ring_pos[o0 + 2u]);
+    precise vec3 p1 = vec3(ring_pos[o1], ring_pos[o1 + 1u], ring_pos[o1 + 2u]);
+    precise vec3 p = p0 * (1.0 - alpha) + p1 * alpha;  // alpha 1: exactly p1
     return p;
 }
 

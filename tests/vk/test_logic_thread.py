@@ -140,21 +140,26 @@ def test_rgraph_run_logic_hz_is_validation_clean_and_reports_the_render_thread(c
 
 
 def test_logic_states_reach_the_gpu_interpolated():
-    """The deformable state buffers hold the logic's last two states and alpha (0..1)."""
+    """The logic thread writes each tick into a free ring slot; a frame's header names the two
+    slots it mixes and alpha (0..1); slots in use by a frame are never overwritten."""
     with rgraph.open_device(validate=True, verbose=False) as gpu:
         plan = rgraph.compile("surgery", size=(32, 24), device=gpu)
         exe = gpu.load(plan, logic_hz=240)
         exe.run(6)
         scene = exe.executor.scene_gpu
-        prev, cur = exe.executor.logic.latest()
+        deform = scene.deform
         s = (exe.executor.frames_done - 1) % 2
-        alpha, p, c = scene.deform.views[s]
-        assert 0.0 <= float(alpha[0]) <= 1.0
-        assert scene._ticks_written[s] is not None
-        ticks = scene._ticks_written[s]
-        assert ticks[1] <= cur.tick and ticks[0] <= ticks[1]
-        np.testing.assert_allclose(c, scene.deform.positions_at(ticks[1] / 240), atol=1e-7)
-        np.testing.assert_allclose(p, scene.deform.positions_at(ticks[0] / 240), atol=1e-7)
+        f, u = deform.header_views[s]
+        alpha, prev_slot, cur_slot = float(f[0]), int(u[1]), int(u[2])
+        assert 0.0 <= alpha <= 1.0 and (prev_slot, cur_slot) == deform.in_use[s]
+        prev_tick, cur_tick = scene.ticks_taken[s]
+        assert prev_tick <= cur_tick <= exe.executor.logic.latest()[1].tick
+        (part,) = deform.parts
+        for slot, tick in ((prev_slot, prev_tick), (cur_slot, cur_tick)):
+            expected = part.deformer.positions(tick / 240)
+            np.testing.assert_allclose(deform.slots[slot], expected, rtol=0, atol=1e-7)
+        busy = [x for pair in deform.in_use for x in pair]
+        assert len(set(busy) | {st.value for st in exe.executor.logic.published()}) <= 6
         assert [str(m) for m in exe.close()] == []
 
 

@@ -84,7 +84,8 @@ def gpu_runs():
                 deform = DeformGPU(gpu.device, 1, parts, device_buffer=local.buffer, host_buffer=host,
                                    upload=lambda ups: local.upload(submit, ups))
                 for alpha in (1.0, 1.0, 0.25):
-                    deform.write_states(0, prev, cur, alpha)
+                    deform.slots[2], deform.slots[5] = prev, cur  # any two ring slots
+                    deform.set_header(0, alpha, 2, 5)
                     submit("graphics", lambda cb: deform.record(cb, 0))
                     src = (v.VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, v.VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT)
                     verts = np.frombuffer(local.read(submit, deform.vertex_buffers[0], *src), dtype=np.float32)

@@ -11,7 +11,8 @@ A logic thread that falls more than ``max_catch_up`` ticks behind (a slow step, 
 machine) moves its schedule instead of bursting: those ticks count as ``late``, scene time
 stays continuous. An exception in ``step`` stops the thread and is kept in ``error``; the
 frame loop raises it (``rgraph.vk.errors.ExecutionError``). ``clock`` and ``wait`` are
-injectable (tests drive time themselves).
+injectable (tests drive time themselves); ``lock`` is held while a state is published (the
+scene takes it to read a state and mark it in use in one step).
 """
 
 from __future__ import annotations
@@ -47,13 +48,15 @@ class LogicThread:
     always has two states), then ticks on a daemon thread until ``stop``."""
 
     def __init__(self, step: Callable[[float], Any], hz: float, *, clock: Callable[[], float] = time.perf_counter,
-                 wait: Callable[[float], None] | None = None, max_catch_up: int = 4) -> None:
+                 wait: Callable[[float], None] | None = None, max_catch_up: int = 4,
+                 lock: Any = None) -> None:
         if not hz > 0 or not math.isfinite(hz):
             raise ValueError(f"logic rate must be a positive number of Hz, not {hz}")
         self.step = step
         self.hz = float(hz)
         self.clock = clock
         self.max_catch_up = max_catch_up
+        self.lock = lock if lock is not None else threading.Lock()  # held while a state is published
         self._stop = threading.Event()
         self._wait = wait if wait is not None else self._stop.wait
         self._thread: threading.Thread | None = None
@@ -73,6 +76,10 @@ class LogicThread:
         states = self._states
         assert states is not None, "LogicThread.start first"
         return states
+
+    def published(self) -> tuple[LogicState, ...]:
+        """The states a frame may still take (none before tick 0)."""
+        return self._states or ()
 
     def alpha(self, now: float | None = None) -> float:
         return interpolation_alpha(self.clock() if now is None else now, self.latest()[1].wall, self.hz)
@@ -119,8 +126,9 @@ class LogicThread:
         if len(self.tick_seconds) > 4096:
             del self.tick_seconds[:2048]
         state = LogicState(self.tick, self.tick / self.hz, self.clock(), value)
-        prev = self._states[1] if self._states is not None else state
-        self._states = (prev, state)
+        with self.lock:
+            prev = self._states[1] if self._states is not None else state
+            self._states = (prev, state)
         self.tick += 1
         self.ticks += 1
 

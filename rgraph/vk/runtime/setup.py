@@ -68,7 +68,9 @@ def attach_logic(ex: Any, hz: float) -> None:
     from rgraph.vk.runtime.logic import LogicThread
 
     try:
-        ex.logic = LogicThread(ex.scene_gpu.logic_step if ex.scene_gpu is not None else (lambda _s: None), hz)
+        scene = ex.scene_gpu
+        lock = scene.deform.lock if scene is not None and scene.deform is not None else None
+        ex.logic = LogicThread(scene.logic_step if scene is not None else (lambda _s: None), hz, lock=lock)
     except ValueError as exc:
         raise ExecutionError(str(exc)) from None
     if ex.scene_gpu is not None:

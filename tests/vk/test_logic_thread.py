@@ -207,3 +207,11 @@ def test_failing_logic_and_interrupts_shut_down_cleanly(monkeypatch):
         assert not exe.executor.logic.running
         assert [str(m) for m in exe.close()] == []
         assert [str(m) for m in gpu.close()] == []
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "nan", "fast", "1e9"])
+def test_bad_logic_rates_are_one_line_errors(value, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "surgery", "--logic-hz", value])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert exc.value.code == 2 and "--logic-hz" in err[-1] and "Traceback" not in "".join(err)

@@ -29,6 +29,7 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
 from rgraph.vk.resources import HostBuffer
+from rgraph.vk.runtime.logic import interpolation_alpha
 
 BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS = range(5)
 
@@ -217,7 +218,7 @@ class SceneGPU:
             seconds = data.seconds(frame)
         else:  # between the logic thread's last two states
             prev, cur = logic.latest() if self.deform is None else self.deform.take(frame_set, logic.latest)
-            alpha = logic.alpha()
+            alpha = interpolation_alpha(logic.clock(), cur.wall, logic.hz)
             seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
             self.alpha_range[0] = min(self.alpha_range[0], alpha)
             self.alpha_range[1] = max(self.alpha_range[1], alpha)

@@ -81,9 +81,6 @@ class LogicThread:
         """The states a frame may still take (none before tick 0)."""
         return self._states or ()
 
-    def alpha(self, now: float | None = None) -> float:
-        return interpolation_alpha(self.clock() if now is None else now, self.latest()[1].wall, self.hz)
-
     @property
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()

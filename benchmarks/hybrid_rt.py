@@ -38,7 +38,7 @@ SIZES = {"full": (1280, 720), "small": (64, 36)}
 #: the visibility-buffer passes (t_b ends with the last of them): hardware raster or compute
 GBUFFER_PASSES = ("gbuffer", "vis_clear", "vis_depth", "vis_depth_tiles", "vis_id", "vis_id_tiles")
 RASTER_GRAPH = "rt_hybrid_raster"
-WARMUP_S = 0.3  # seconds of frames of every plan before timing (GPU clocks ramp up)
+WARMUP_S = 0.3  # seconds of frames of every plan before timing (GPU clocks ramp up); rgraph.api.WARMUP_S
 CHUNK = 5       # frames per timed run; the plans alternate run by run
 
 
@@ -208,7 +208,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--size", default="full", help="full (1280x720), small (64x36) or WxH")
     parser.add_argument("--frames", type=int, default=None, help="timed frames per plan (default 50; small: 2)")
     parser.add_argument("--warmup", type=float, default=None,
-                        help=f"seconds of untimed frames of every plan first (default {WARMUP_S}; small: 0)")
+                        help=f"seconds of untimed frames of every plan first (default: {WARMUP_S} on a GPU, "
+                             "0 on a CPU device: Gpu.default_warmup_s)")
     parser.add_argument("--chunk", type=int, default=CHUNK, help="frames per timed run (plans alternate)")
     parser.add_argument("--no-raster", action="store_true", help="skip the hardware-raster hybrid variant")
     parser.add_argument("--scenes", default=",".join(SCENES))
@@ -220,7 +221,6 @@ def main(argv: list[str] | None = None) -> int:
     size = SIZES.get(args.size) or tuple(int(v) for v in args.size.lower().split("x"))
     small = args.size == "small"
     frames = args.frames or (2 if small else 50)
-    warmup = args.warmup if args.warmup is not None else (0.0 if small else WARMUP_S)
     raster = not args.no_raster and (ROOT / "graphs" / f"{RASTER_GRAPH}.yaml").exists()
     scenes = [s for s in args.scenes.split(",") if s]
     rows: list[dict[str, Any]] = []
@@ -231,6 +231,7 @@ def main(argv: list[str] | None = None) -> int:
         from rgraph.api import open_device
 
         with open_device(validate=False, verbose=False) as gpu:  # one device for every plan of the run
+            warmup = args.warmup if args.warmup is not None else gpu.default_warmup_s
             for scene in scenes:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,

@@ -4,7 +4,7 @@ by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
 
 - ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1, overflow 0);
 - ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen
-  box exceeds ``rt.vis_big_pixels`` append a job per 16x16 tile to ``vis_jobs`` (capacity from its
+  box exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile they may cover to ``vis_jobs`` (capacity from its
   size, at most 65535 = the guaranteed maxComputeWorkGroupCount[0]); on overflow the thread
   rasterizes its box itself;
 - ``rt_vis_depth_tiles``: a workgroup per job (indirect dispatch over ``vis_args``);
@@ -25,7 +25,7 @@ from .raytrace_hybrid import prim_bits
 from .raytrace_standalone import pack_tables
 from .rt_model import camera_basis
 
-TILE = 16
+TILE = 32  # pixels per side of a tile job (shaders/rt/visraster.glsl)
 MAX_JOBS = 65535  # maxComputeWorkGroupCount[0] is at least this on every device
 GROUP = 64        # threads per workgroup of the per-triangle passes
 CLIP_FRACTION = 1e-3  # the bounding boxes' clip plane: this share of the camera's near distance

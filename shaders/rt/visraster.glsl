@@ -40,7 +40,7 @@ layout(push_constant) uniform Raster {
 } frame;
 
 #ifndef TILE
-#define TILE 16
+#define TILE 32  // pixels per side of a tile job (a 16x16 workgroup, 2x2 pixels per thread)
 #endif
 
 struct Tri {
@@ -108,15 +108,37 @@ bool setup_triangle(uint t, out Tri tri) {
     return tri.box.x <= tri.box.z && tri.box.y <= tri.box.w;
 }
 
-// Whether pixel px's centre ray hits the triangle (inclusive edges); its depth key.
-bool cover(Tri tri, ivec2 px, out uint key) {
+vec3 pixel_ray(ivec2 px) {  // camera_ray of shade.glsl before normalizing
     float sx = (2.0 * (float(px.x) + 0.5) / float(frame.info.x) - 1.0) * frame.right.w * frame.up.w;
     float sy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(frame.info.y)) * frame.right.w;
     precise vec3 d = frame.forward.xyz + sx * frame.right.xyz + sy * frame.up.xyz;
+    return d;
+}
+
+// Whether pixel px's centre ray hits the triangle (inclusive edges); its depth key.
+bool cover(Tri tri, ivec2 px, out uint key) {
+    precise vec3 d = pixel_ray(px);
     precise float e0 = dot(d, tri.c0), e1 = dot(d, tri.c1), e2 = dot(d, tri.c2);
     precise float w = dot(tri.n, d);
     key = floatBitsToUint(w);
     return e0 >= -tri.eps.x && e1 >= -tri.eps.y && e2 >= -tri.eps.z && w > 0.0 && !isinf(w);
 }
 
+// false only if no pixel centre of the rectangle lo..hi (inclusive) is covered: the edge values
+// are affine in the pixel coordinates, so their maxima over it are at its corners.
+bool rect_may_cover(Tri tri, ivec2 lo, ivec2 hi) {
+    vec3 m = vec3(-1e38);
+    for (int k = 0; k < 4; ++k) {
+        vec3 d = pixel_ray(ivec2((k & 1) != 0 ? hi.x : lo.x, (k & 2) != 0 ? hi.y : lo.y));
+        m = max(m, vec3(dot(d, tri.c0), dot(d, tri.c1), dot(d, tri.c2)));
+    }
+    return all(greaterThanEqual(m, -2.0 * tri.eps));
+}
+
 uint pixels_of(Tri tri) { return uint(tri.box.z - tri.box.x + 1) * uint(tri.box.w - tri.box.y + 1); }
+
+// The tiles of the triangle's box that it may cover (the jobs of a big triangle), k = 0, 1, ...
+bool tile_job(Tri tri, ivec2 t) {
+    ivec2 lo = max(t * TILE, tri.box.xy), hi = min(t * TILE + (TILE - 1), tri.box.zw);
+    return rect_may_cover(tri, lo, hi);
+}

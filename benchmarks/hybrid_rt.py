@@ -10,9 +10,11 @@ then the timed frames run in alternating chunks (``--chunk`` frames of each in t
 rotating), so a clock change hits every plan alike; medians over the chunks' medians.
 
 Per scene and camera: stand-alone frame T (graphs/rt_standalone.yaml, the GPU span of the frame);
-the hybrid frame t (its GPU span), split at the end of the raster visibility buffer: t_b = frame
-start -> G-buffer end (the sky pass, tiny and independent of it, included), t_a = G-buffer end ->
-frame end (ray reset/classification, shading with shadow rays, indirect secondary rays); t_a / T,
+the hybrid frame t (graphs/rt_hybrid.yaml: compute visibility buffer; its GPU span), split at
+the end of the visibility buffer: t_b = frame start -> visibility buffer end (the sky pass, tiny
+and independent of it, included), t_a = the rest (ray reset/classification, shading with shadow
+rays, indirect secondary rays); the ``raster`` columns are the same for
+graphs/rt_hybrid_raster.yaml (hardware-raster visibility buffer; ``--no-raster`` skips it); t_a / T,
 t / T; all medians of GPU timestamps over ``--frames`` frames. (Each pass's own timestamp pair
 starts at TOP_OF_PIPE before its barriers, so it overlaps the previous pass still draining:
 summing per-pass times double-counts; the per-pass medians are kept in the JSON as ``passes``.)
@@ -125,7 +127,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
     params = {"rt.max_depth": str(depth)}
-    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility"))}
+    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_args"))}
     if raster:
         graphs["raster"] = (RASTER_GRAPH, ())
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=params,
@@ -140,6 +142,9 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
+    if "vis_args" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
+        jobs = np.frombuffer(out["vis_args"].tobytes()[:16], dtype=np.uint32)
+        row.update(vis_jobs=int(jobs[0]), vis_overflow=bool(jobs[3]))
     if raster:
         row.update(_hybrid_columns(runs["raster"]["timings"], T, runs["raster"]["outputs"], alone["outputs"], "raster_"))
     return row

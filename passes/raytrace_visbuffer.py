@@ -4,7 +4,7 @@ by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
 
 - ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1, overflow 0);
 - ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen
-  box exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile they may cover to ``vis_jobs`` (capacity from its
+  box exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs`` (capacity from its
   size, at most 65535 = the guaranteed maxComputeWorkGroupCount[0]); on overflow the thread
   rasterizes its box itself;
 - ``rt_vis_depth_tiles``: a workgroup per job (indirect dispatch over ``vis_args``);

@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Compute visibility buffer, one thread per triangle (rt/visraster.glsl). MODE_ID undefined: the
 // depth pass (atomicMax of the key); triangles whose box exceeds BIG_PIXELS append one job per
-// TILE x TILE tile they may cover for rt/vistiles.comp (a workgroup per job, so walls and floors do not
+// TILE x TILE tile of their box for rt/vistiles.comp (a workgroup per job, so walls and floors do not
 // serialize on one thread). When the job list is full (JOB_CAPACITY) the reservation is undone,
 // args.overflow is set and the thread rasterizes its box itself. MODE_ID: the id pass (atomicMax
 // of the id where the key equals the stored one); big triangles are left to the tile jobs unless
@@ -39,17 +39,13 @@ void main() {
 #ifdef MODE_ID
         if (args.overflow == 0u) return;
 #else
-        ivec4 tiles = tri.box / TILE;
-        uint n = 0u;  // tiles the triangle may cover (a tile outside one of its edges is skipped)
-        for (int ty = tiles.y; ty <= tiles.w; ++ty)
-            for (int tx = tiles.x; tx <= tiles.z; ++tx) n += tile_job(tri, ivec2(tx, ty)) ? 1u : 0u;
-        if (n == 0u) return;
+        ivec4 tiles = tri.box / TILE;  // every tile of the box: a per-tile test here would run serially
+        uint n = uint(tiles.z - tiles.x + 1) * uint(tiles.w - tiles.y + 1);
         uint first = atomicAdd(args.job_count, n);
         if (first + n <= JOB_CAPACITY) {
             uint k = first;
             for (int ty = tiles.y; ty <= tiles.w; ++ty)
-                for (int tx = tiles.x; tx <= tiles.z; ++tx)
-                    if (tile_job(tri, ivec2(tx, ty))) jobs[k++] = uvec2(t, (uint(ty) << 16) | uint(tx));
+                for (int tx = tiles.x; tx <= tiles.z; ++tx) jobs[k++] = uvec2(t, (uint(ty) << 16) | uint(tx));
             return;
         }
         // Full: undo (a reservation made while one is pending also fails, so the list stays

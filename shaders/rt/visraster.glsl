@@ -124,21 +124,4 @@ bool cover(Tri tri, ivec2 px, out uint key) {
     return e0 >= -tri.eps.x && e1 >= -tri.eps.y && e2 >= -tri.eps.z && w > 0.0 && !isinf(w);
 }
 
-// false only if no pixel centre of the rectangle lo..hi (inclusive) is covered: the edge values
-// are affine in the pixel coordinates, so their maxima over it are at its corners.
-bool rect_may_cover(Tri tri, ivec2 lo, ivec2 hi) {
-    vec3 m = vec3(-1e38);
-    for (int k = 0; k < 4; ++k) {
-        vec3 d = pixel_ray(ivec2((k & 1) != 0 ? hi.x : lo.x, (k & 2) != 0 ? hi.y : lo.y));
-        m = max(m, vec3(dot(d, tri.c0), dot(d, tri.c1), dot(d, tri.c2)));
-    }
-    return all(greaterThanEqual(m, -2.0 * tri.eps));
-}
-
 uint pixels_of(Tri tri) { return uint(tri.box.z - tri.box.x + 1) * uint(tri.box.w - tri.box.y + 1); }
-
-// The tiles of the triangle's box that it may cover (the jobs of a big triangle), k = 0, 1, ...
-bool tile_job(Tri tri, ivec2 t) {
-    ivec2 lo = max(t * TILE, tri.box.xy), hi = min(t * TILE + (TILE - 1), tri.box.zw);
-    return rect_may_cover(tri, lo, hi);
-}

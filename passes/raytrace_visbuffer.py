@@ -2,7 +2,8 @@
 same r32_uint ids as the hardware raster ``rt_gbuffer`` (graphs/rt_hybrid_raster.yaml), formed
 by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
 
-- ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1, overflow 0);
+- ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1, overflow 0), and
+  ``ray_args`` = (0, 1, 1) when the pass writes it (one pass fewer than ``rt_reset_rays``);
 - ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen
   box exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs`` (capacity from its
   size, at most 65535 = the guaranteed maxComputeWorkGroupCount[0]); on overflow the thread
@@ -138,9 +139,14 @@ class VisIdTiles(VisTiles):
 class VisClear(PassImpl):
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
-        self.sets = setup.descriptors([Binding(5, "storage_image", "vis_depth"), Binding(6, "storage_image", "visibility"),
-                                       Binding(7, "storage_buffer", "vis_args")])
-        self.pipeline = setup.compute_pipeline("rt/visclear.comp", [self.sets.layout])
+        bindings = [Binding(5, "storage_image", "vis_depth"), Binding(6, "storage_image", "visibility"),
+                    Binding(7, "storage_buffer", "vis_args")]
+        reset = setup.has("ray_args")  # also reset the compacted ray list (instead of rt_reset_rays)
+        if reset:
+            bindings.append(Binding(9, "storage_buffer", "ray_args"))
+        self.sets = setup.descriptors(bindings)
+        self.pipeline = setup.compute_pipeline("rt/visclear.comp", [self.sets.layout],
+                                               defines={"RESET_RAYS": 1} if reset else None)
         w, h = setup.extent_of("visibility")
         self.groups = (-(-w // 8), -(-h // 8))
 

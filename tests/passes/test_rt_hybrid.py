@@ -67,12 +67,14 @@ def test_no_reflective_or_refractive_materials_culls_the_secondary_rays(tmp_path
                      .replace("refractive: 0.9, ", ""))
     plan = compile_graph("rt_hybrid", scene_path=scene, size=(16, 16))
     culled = {c["pass"]: c["reason"] for c in plan["culled"]}
-    assert set(culled) == {"reset_rays", "classify", "secondary"}
+    assert set(culled) == {"classify", "secondary"}
     assert all(reason == "scene has none of reflective_materials, refractive_materials" for reason in culled.values())
     assert {p["name"] for p in plan["passes"]} == {"build_as", "sky", "vis_clear", "vis_depth", "vis_depth_tiles",
                                                    "vis_id", "vis_id_tiles", "shade"}
     full = compile_graph("rt_hybrid", scene_path=SCENE, size=(16, 16))
     assert not full["culled"]
+    raster = compile_graph("rt_hybrid_raster", scene_path=scene, size=(16, 16))
+    assert {c["pass"] for c in raster["culled"]} == {"reset_rays", "classify", "secondary"}
 
 
 # A grazing view: the camera and a point light inside a thin box (the old rt_gallery camera 4),

@@ -127,7 +127,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
     params = {"rt.max_depth": str(depth)}
-    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_args"))}
+    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs"))}
     if raster:
         graphs["raster"] = (RASTER_GRAPH, ())
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=params,
@@ -142,9 +142,9 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
-    if "vis_args" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
-        jobs = np.frombuffer(out["vis_args"].tobytes()[:16], dtype=np.uint32)
-        row.update(vis_jobs=int(jobs[0]), vis_overflow=bool(jobs[3]))
+    if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
+        header = np.frombuffer(out["vis_jobs"].tobytes()[:8], dtype=np.uint32)
+        row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
     if raster:
         row.update(_hybrid_columns(runs["raster"]["timings"], T, runs["raster"]["outputs"], alone["outputs"], "raster_"))
     return row

@@ -2,13 +2,14 @@
 same r32_uint ids as the hardware raster ``rt_gbuffer`` (graphs/rt_hybrid_raster.yaml), formed
 by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
 
-- ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1, overflow 0), and
-  ``ray_args`` = (0, 1, 1) when the pass writes it (one pass fewer than ``rt_reset_rays``);
-- ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen
-  box exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs`` (capacity from its
-  size, at most 65535 = the guaranteed maxComputeWorkGroupCount[0]); on overflow the thread
-  rasterizes its box itself;
-- ``rt_vis_depth_tiles``: a workgroup per job (indirect dispatch over ``vis_args``);
+- ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1), the job list's
+  count and overflow flag (``vis_jobs`` header) 0, and ``ray_args`` = (0, 1, 1) when the pass
+  writes it (one pass fewer than ``rt_reset_rays``);
+- ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen box
+  exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs``
+  (capacity (bytes - 16) / 8, at most 8 x 65535) and raise ``vis_args``' group count; on
+  overflow the thread rasterizes its box itself;
+- ``rt_vis_depth_tiles``: 8 jobs per 16x16 workgroup (indirect dispatch over ``vis_args``);
 - ``rt_vis_id`` / ``rt_vis_id_tiles``: the same, writing the id where the key is the stored one.
 """
 
@@ -27,7 +28,9 @@ from .raytrace_standalone import pack_tables
 from .rt_model import camera_basis
 
 TILE = 32  # pixels per side of a tile job (shaders/rt/visraster.glsl)
-MAX_JOBS = 65535  # maxComputeWorkGroupCount[0] is at least this on every device
+JOBS_PER_GROUP = 8
+MAX_JOBS = 65535 * JOBS_PER_GROUP  # maxComputeWorkGroupCount[0] is at least 65535 on every device
+JOB_HEADER = 16  # vis_jobs: count, overflow flag, padding, then (triangle, tile) pairs
 GROUP = 64        # threads per workgroup of the per-triangle passes
 CLIP_FRACTION = 1e-3  # the bounding boxes' clip plane: this share of the camera's near distance
 
@@ -62,7 +65,6 @@ class VisPass(PassImpl):
     shader = "rt/visraster.comp"
     mode_id = False
     uses_args = True   # binding 7 in the shader
-    uses_jobs = True   # binding 8
 
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
@@ -80,15 +82,15 @@ class VisPass(PassImpl):
             bindings.append(Binding(6, "storage_image", "visibility"))
         if self.uses_args:
             bindings.append(Binding(7, "storage_buffer", "vis_args"))
-        if self.uses_jobs:
-            bindings.append(Binding(8, "storage_buffer", "vis_jobs"))
+        bindings.append(Binding(8, "storage_buffer", "vis_jobs"))
         self.sets = setup.descriptors(bindings)
-        capacity = min(MAX_JOBS, int(setup.resource_plan("vis_jobs")["bytes"]) // 8)
+        capacity = min(MAX_JOBS, (int(setup.resource_plan("vis_jobs")["bytes"]) - JOB_HEADER) // 8)
         big = int(setup.param("rt.vis_big_pixels", 256))
         if capacity < 1 or big < 1:
-            raise ValueError(f"pass {setup.name!r}: vis_jobs must hold a job (8 bytes) and rt.vis_big_pixels be >= 1")
+            raise ValueError(f"pass {setup.name!r}: vis_jobs must hold a job (16 + 8 bytes) and rt.vis_big_pixels be >= 1")
         defines: dict[str, object] = {"PRIM_BITS": prim_bits(self.data), "BIG_PIXELS": f"{big}u",
-                                      "JOB_CAPACITY": f"{capacity}u", "TILE": TILE}
+                                      "JOB_CAPACITY": f"{capacity}u", "TILE": TILE,
+                                      "JOBS_PER_GROUP": f"{JOBS_PER_GROUP}u"}
         if self.mode_id:
             defines["MODE_ID"] = 1
         self.pipeline = setup.compute_pipeline(self.shader, [self.sets.layout], defines=defines, push_constant_bytes=64)
@@ -102,7 +104,7 @@ class VisPass(PassImpl):
 
 
 class VisTiles(VisPass):
-    """The big triangles' tile jobs: a workgroup each, dispatched indirectly from vis_args."""
+    """The big triangles' tile jobs: 8 per workgroup, dispatched indirectly from vis_args."""
 
     shader = "rt/vistiles.comp"
     uses_args = False
@@ -122,7 +124,7 @@ class VisDepth(VisPass):
 @register("rt_vis_id")
 class VisId(VisPass):
     mode_id = True
-    uses_jobs = False
+    uses_args = False
 
 
 @register("rt_vis_depth_tiles")
@@ -140,7 +142,7 @@ class VisClear(PassImpl):
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
         bindings = [Binding(5, "storage_image", "vis_depth"), Binding(6, "storage_image", "visibility"),
-                    Binding(7, "storage_buffer", "vis_args")]
+                    Binding(7, "storage_buffer", "vis_args"), Binding(8, "storage_buffer", "vis_jobs")]
         reset = setup.has("ray_args")  # also reset the compacted ray list (instead of rt_reset_rays)
         if reset:
             bindings.append(Binding(9, "storage_buffer", "ray_args"))

@@ -23,8 +23,8 @@
 // Two passes, 32-bit image atomics only: depth (atomicMax of the key) then id (where the key
 // equals the stored one, atomicMax of the id: ties between triangles resolve to the larger id,
 // deterministic). Both evaluate the key with the same `precise` code, so they agree bit for bit.
-// The screen bounding box only bounds the pixels tested: from the triangle clipped at
-// z >= forward.w (tiny; the coverage test decides), one pixel of margin, clamped to the screen.
+// The screen bounding box only bounds the pixels tested (screen_box: the triangle clipped to the
+// view frustum, near plane z >= forward.w, tiny: the coverage test decides).
 #include "rt/tables.glsl"
 #include "rt/gbuffer.glsl"
 
@@ -60,14 +60,53 @@ uint instance_of(uint t) {  // the largest i with tri_start[i] <= t
     return lo;
 }
 
-vec2 screen_of(vec3 q) {  // continuous pixel coordinates (pixel i's centre at i) of a point with z > 0
-    float z = dot(q, frame.forward.xyz);
-    float sx = dot(q, frame.right.xyz) / z, sy = dot(q, frame.up.xyz) / z;
-    return vec2((sx / (frame.right.w * frame.up.w) + 1.0) * 0.5 * float(frame.info.x) - 0.5,
-                (1.0 - sy / frame.right.w) * 0.5 * float(frame.info.y) - 0.5);
+float plane_side(int k, vec3 q, vec2 slope) {  // >= 0: inside plane k of the widened view frustum
+    return k == 0 ? q.z - frame.forward.w : k == 1 ? slope.x * q.z - q.x : k == 2 ? slope.x * q.z + q.x
+         : k == 3 ? slope.y * q.z - q.y : slope.y * q.z + q.y;
 }
 
-void extend(inout vec4 b, vec2 s) { b = vec4(min(b.xy, s), max(b.zw, s)); }
+// The pixels whose centres the triangle may cover: the box of its part inside the view frustum
+// (widened by a pixel; near plane z >= forward.w) projected, one more pixel of margin, clamped
+// to the screen (Sutherland-Hodgman over 5 planes, at most 8 vertices; a triangle inside every
+// plane skips it). Crossing or surrounding triangles thus get their on-screen box, not the whole
+// screen. `precise`: every pass computes the same box (the big/small split and tile origins).
+bool screen_box(vec3 p0, vec3 p1, vec3 p2, out ivec4 box) {
+    box = ivec4(0, 0, -1, -1);
+    precise vec2 slope = vec2(frame.right.w * frame.up.w * (1.0 + 2.0 / float(frame.info.x)),
+                              frame.right.w * (1.0 + 2.0 / float(frame.info.y)));
+    precise vec3 q[8];
+    q[0] = vec3(dot(p0, frame.right.xyz), dot(p0, frame.up.xyz), dot(p0, frame.forward.xyz));
+    q[1] = vec3(dot(p1, frame.right.xyz), dot(p1, frame.up.xyz), dot(p1, frame.forward.xyz));
+    q[2] = vec3(dot(p2, frame.right.xyz), dot(p2, frame.up.xyz), dot(p2, frame.forward.xyz));
+    int n = 3;
+    for (int k = 0; k < 5; ++k) {
+        bool all_in = true;
+        for (int i = 0; i < n; ++i) all_in = all_in && plane_side(k, q[i], slope) >= 0.0;
+        if (all_in) continue;
+        precise vec3 r[8];
+        int m = 0;
+        for (int i = 0; i < n; ++i) {
+            vec3 a = q[i], b = q[i + 1 < n ? i + 1 : 0];
+            precise float fa = plane_side(k, a, slope), fb = plane_side(k, b, slope);
+            if (fa >= 0.0 && m < 8) r[m++] = a;
+            if ((fa >= 0.0) != (fb >= 0.0) && m < 8) r[m++] = a + (fa / (fa - fb)) * (b - a);
+        }
+        n = m;
+        for (int i = 0; i < n; ++i) q[i] = r[i];
+        if (n == 0) return false;  // wholly outside the view
+    }
+    precise vec4 b = vec4(1e30, 1e30, -1e30, -1e30);
+    for (int i = 0; i < n; ++i) {
+        precise vec2 sxy = q[i].xy / max(q[i].z, frame.forward.w);
+        precise vec2 s = vec2((sxy.x / (frame.right.w * frame.up.w) + 1.0) * 0.5 * float(frame.info.x) - 0.5,
+                              (1.0 - sxy.y / frame.right.w) * 0.5 * float(frame.info.y) - 0.5);
+        b = vec4(min(b.xy, s), max(b.zw, s));
+    }
+    vec2 hi = vec2(frame.info.xy) - 1.0;
+    b = vec4(clamp(floor(b.xy) - 1.0, vec2(-1.0), hi + 1.0), clamp(ceil(b.zw) + 1.0, vec2(-1.0), hi + 1.0));
+    box = ivec4(max(b.xy, vec2(0.0)), min(b.zw, hi));
+    return box.x <= box.z && box.y <= box.w;
+}
 
 // Setup of global triangle t; false when it covers no pixel (degenerate, behind, off screen).
 bool setup_triangle(uint t, out Tri tri) {
@@ -88,24 +127,7 @@ bool setup_triangle(uint t, out Tri tri) {
     precise vec3 nh = n / h;
     precise vec3 eps = 1e-6 * vec3(length(c0), length(c1), length(c2));
     tri.c0 = c0; tri.c1 = c1; tri.c2 = c2; tri.n = nh; tri.eps = eps;
-    // bounding box of the part in front of z = forward.w
-    float zc = frame.forward.w;
-    vec3 p[3] = vec3[3](p0, p1, p2);
-    float z[3] = float[3](dot(p0, frame.forward.xyz), dot(p1, frame.forward.xyz), dot(p2, frame.forward.xyz));
-    vec4 b = vec4(1e30, 1e30, -1e30, -1e30);
-    for (int i = 0; i < 3; ++i) {
-        int j = (i + 1) % 3;
-        if (z[i] >= zc) extend(b, screen_of(p[i]));
-        if ((z[i] >= zc) != (z[j] >= zc)) {
-            float a = (zc - z[i]) / (z[j] - z[i]);
-            extend(b, screen_of(mix(p[i], p[j], a)));
-        }
-    }
-    if (b.x > b.z) return false;  // wholly behind the clip plane
-    vec2 hi = vec2(frame.info.xy) - 1.0;
-    b = vec4(clamp(floor(b.xy) - 1.0, vec2(-1.0), hi + 1.0), clamp(ceil(b.zw) + 1.0, vec2(-1.0), hi + 1.0));
-    tri.box = ivec4(max(b.xy, vec2(0.0)), min(b.zw, hi));
-    return tri.box.x <= tri.box.z && tri.box.y <= tri.box.w;
+    return screen_box(p0, p1, p2, tri.box);
 }
 
 vec3 pixel_ray(ivec2 px) {  // camera_ray of shade.glsl before normalizing
@@ -122,6 +144,17 @@ bool cover(Tri tri, ivec2 px, out uint key) {
     precise float w = dot(tri.n, d);
     key = floatBitsToUint(w);
     return e0 >= -tri.eps.x && e1 >= -tri.eps.y && e2 >= -tri.eps.z && w > 0.0 && !isinf(w);
+}
+
+// false only if no pixel centre of the rectangle lo..hi (inclusive) is covered: the edge values
+// are affine in the pixel coordinates, so their maxima over it are at its corners.
+bool rect_may_cover(Tri tri, ivec2 lo, ivec2 hi) {
+    vec3 m = vec3(-1e38);
+    for (int k = 0; k < 4; ++k) {
+        vec3 d = pixel_ray(ivec2((k & 1) != 0 ? hi.x : lo.x, (k & 2) != 0 ? hi.y : lo.y));
+        m = max(m, vec3(dot(d, tri.c0), dot(d, tri.c1), dot(d, tri.c2)));
+    }
+    return all(greaterThanEqual(m, -2.0 * tri.eps - 1e-6 * abs(m)));
 }
 
 uint pixels_of(Tri tri) { return uint(tri.box.z - tri.box.x + 1) * uint(tri.box.w - tri.box.y + 1); }

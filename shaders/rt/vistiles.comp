@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // Compute visibility buffer, big triangles: the (triangle, tile) jobs appended by the depth pass
 // of rt/visraster.comp, JOBS_PER_GROUP per 16x16 workgroup (indirect dispatch: the group count
-// that pass set); per job the first thread sets the triangle up once for the group, then each
+// that pass set); per job the first thread sets the triangle up once for the group and drops the
+// job when the tile lies outside one of the triangle's edges (corner test), then each
 // thread does (TILE / 16)^2 pixels of the TILE x TILE tile (tiles counted from the triangle's box
 // corner). MODE_ID as there; the same setup and coverage code, so the same keys.
 #include "rt/visraster.glsl"
@@ -22,9 +23,12 @@ void main() {
     uint first = gl_WorkGroupID.x * JOBS_PER_GROUP, last = min(first + JOBS_PER_GROUP, job_count);
     for (uint j = first; j < last; ++j) {  // uniform over the group
         uvec2 job = jobs[j];
-        if (gl_LocalInvocationIndex == 0u) {
+        ivec2 tile = ivec2(job.y & 0xFFFFu, job.y >> 16) * TILE;
+        if (gl_LocalInvocationIndex == 0u) {  // set up once; skip tiles outside an edge (slivers' boxes are mostly those)
             Tri t;
-            group_ok = setup_triangle(job.x, t);
+            bool ok = setup_triangle(job.x, t);
+            ivec2 lo = t.box.xy + tile;
+            group_ok = ok && rect_may_cover(t, lo, min(lo + (TILE - 1), t.box.zw));
             group_tri = t;
         }
         barrier();
@@ -32,7 +36,7 @@ void main() {
         bool ok = group_ok;
         barrier();  // the next job's setup overwrites the shared copy
         if (!ok) continue;
-        ivec2 origin = tri.box.xy + ivec2(job.y & 0xFFFFu, job.y >> 16) * TILE + ivec2(gl_LocalInvocationID.xy);
+        ivec2 origin = tri.box.xy + tile + ivec2(gl_LocalInvocationID.xy);
         for (int k = 0; k < (TILE / 16) * (TILE / 16); ++k) {
             ivec2 px = origin + 16 * ivec2(k % (TILE / 16), k / (TILE / 16));
             if (any(greaterThan(px, tri.box.zw))) continue;

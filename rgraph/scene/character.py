@@ -1,6 +1,6 @@
 """The procedural skinned character: a humanoid skeleton of up to 256 bones and its mesh.
 
-The bone template, in priority order (parents first; ``bones: N`` keeps the first N): pelvis
+The bone template, in priority order (parents first; ``bones: N`` keeps the first N, then sorted by depth): pelvis
 (the root), 4 spine bones, neck, head, legs (thigh, shin, foot, toe), arms (clavicle, upper
 arm, forearm, hand), 5 three-bone fingers per hand (53 bones so far), then hair strands of 4
 bones hanging from the head until N is reached. Metres, +Y up, facing +Z, 1.78 m tall, T-pose.
@@ -14,7 +14,7 @@ per vertex, weights as 8-bit unorm summing to exactly 255). About 6,000 triangle
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -118,9 +118,20 @@ def _bone_capsule(bone: Bone) -> tuple[MeshData, np.ndarray]:
     return MeshData(pos, m.normals @ rot.T, m.indices), u
 
 
+def _depth_sorted(bones: list[Bone]) -> list[Bone]:
+    """The bones in order of depth (stable), parents renumbered: every level of the hierarchy is
+    a contiguous range, which forward kinematics slices without copies."""
+    depth: list[int] = []
+    for b in bones:
+        depth.append(0 if b.parent < 0 else depth[b.parent] + 1)
+    order = sorted(range(len(bones)), key=lambda k: depth[k])
+    new = {old: k for k, old in enumerate(order)}
+    return [replace(bones[k], parent=new[bones[k].parent] if bones[k].parent >= 0 else -1) for k in order]
+
+
 def build_rig(count: int) -> Rig:
     """The character with ``count`` bones (module docstring)."""
-    bones = template(count)
+    bones = _depth_sorted(template(count))
     skeleton = Skeleton(np.array([b.parent for b in bones]), np.array([b.head for b in bones]))
     parts, joints, weights = [], [], []
     for k, bone in enumerate(bones):

@@ -30,7 +30,8 @@ class Skeleton:
 
     parents: np.ndarray
     heads: np.ndarray
-    levels: list[tuple[np.ndarray, np.ndarray]] = field(init=False, repr=False, compare=False)
+    levels: list[tuple[slice | np.ndarray, np.ndarray]] = field(init=False, repr=False, compare=False)
+    depths: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         parents = np.asarray(self.parents, dtype=np.int64)
@@ -39,10 +40,15 @@ class Skeleton:
         depth = np.zeros(len(parents), dtype=np.int64)
         for b, p in enumerate(parents):
             depth[b] = 0 if p < 0 else depth[p] + 1
-        levels = [(np.nonzero(depth == d)[0], parents[depth == d]) for d in range(int(depth.max(initial=-1)) + 1)]
+        levels = []
+        for d in range(int(depth.max(initial=-1)) + 1):
+            bones = np.nonzero(depth == d)[0]
+            contiguous = bones[-1] - bones[0] + 1 == len(bones)  # depth-sorted skeletons: a view, no copy
+            levels.append((slice(int(bones[0]), int(bones[-1]) + 1) if contiguous else bones, parents[depth == d]))
         object.__setattr__(self, "parents", parents)
         object.__setattr__(self, "heads", np.asarray(self.heads, dtype=np.float64).reshape(-1, 3))
         object.__setattr__(self, "levels", levels)
+        object.__setattr__(self, "depths", depth)
 
     @property
     def bones(self) -> int:
@@ -108,7 +114,10 @@ def forward_kinematics(skeleton: Skeleton, local: Pose) -> Pose:
             continue
         pq, ps = q[:, parents], s[parents]
         q[:, bones] = qmul(pq, lq)
-        t[:, bones] = t[:, parents] + ps * qrot(pq, lt)
+        rotated = qrot(pq, lt)
+        rotated *= ps
+        rotated += t[:, parents]
+        t[:, bones] = rotated
         s[bones] = ps * ls
     return Pose(q, t, s)
 

@@ -274,9 +274,15 @@ def segments(count=6, major=0.01, minor=0.002, spacing=0.008, sides=12, segments
 
 SHAPES: dict[str, Callable[..., MeshData]] = {
     "box": box, "sphere": sphere, "capsule": capsule, "cylinder": cylinder, "tube": tube, "torus": torus,
-    "plane": plane, "neck": neck, "blob": blob, "segments": segments,
+    "plane": plane, "neck": neck, "blob": blob, "segments": segments, "character": lambda: _character(),
 }
 CLOSED_SHAPES = tuple(s for s in SHAPES if s != "plane")
+
+
+def _character() -> MeshData:
+    from rgraph.scene.character import character  # the rig imports this module
+
+    return character()
 
 
 def make_shape(shape: str, params: dict | None = None, seed: int = 0) -> MeshData:

@@ -42,6 +42,7 @@ class SkinGPU:
 
         v = vk()
         self.data, self.sets, self.logic_hz = data, sets, float(logic_hz)
+        self.meshes = list(rigid_bases)
         self.bones = data.bone_count
         self.slots = 2 * sets  # every other set holds at most two, this one needs two
         self._buffers: list[HostBuffer] = []

@@ -14,6 +14,9 @@
 #define RGRAPH_SKINNING_GLSL
 
 #define DRAW_SKINNED 2u
+#ifndef SKIN_ALPHA
+#define SKIN_ALPHA skin_frame.alpha  // the interpolation factor (a test shader may override it)
+#endif
 
 layout(set = 0, binding = 5, std430) readonly buffer SkinVertices { uvec2 skin_vertices[]; };
 layout(set = 0, binding = 6, std430) readonly buffer Bones { uvec4 bones[]; };
@@ -39,7 +42,7 @@ SkinBone skin_unpack(uvec4 u) {
 SkinBone skin_bone(uint entry) {
     SkinBone a = skin_unpack(bones[skin_frame.previous + entry]);
     SkinBone b = skin_unpack(bones[skin_frame.current + entry]);
-    float alpha = skin_frame.alpha;
+    float alpha = SKIN_ALPHA;
     vec4 q1 = dot(a.q, b.q) < 0.0 ? -b.q : b.q;
     vec4 q = a.q + alpha * (q1 - a.q);
     float len2 = dot(q, q);

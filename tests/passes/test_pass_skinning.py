@@ -113,6 +113,29 @@ def test_gpu_skinning_matches_the_reference(tmp_path, alpha):
 
 
 @pytest.mark.vulkan
+def test_gpu_interpolates_along_the_shortest_arc(tmp_path, monkeypatch):
+    """Odd logic states store every quaternion negated (the same rotations): interpolating
+    without the sign flip would swing the long way round."""
+    from rgraph.scene.animation import Animator
+
+    plain = Animator.state
+
+    def flipped(self, tick, hz=60.0):
+        packed = plain(self, tick, hz)
+        if tick % 2:
+            packed = packed.copy()
+            packed[..., 4:8] = -packed[..., 4:8]
+        return packed
+
+    monkeypatch.setattr(Animator, "state", flipped)
+    _data, mesh, out = _run(tmp_path, bones=64, frames=2)  # frame 1: states -1 (flipped) -> 0 at 0.5
+    want = _reference(mesh, 1, None)[0]
+    assert np.abs(_gpu(mesh, out)[0] - want).max() < 2e-5
+    monkeypatch.setattr(Animator, "state", plain)
+    assert np.abs(_reference(mesh, 1, None)[0] - want).max() < 1e-9  # the same poses either way
+
+
+@pytest.mark.vulkan
 def test_animation_advances_between_logic_states(tmp_path):
     # 30 Hz logic, 60 Hz frames: frame 1 is halfway from state -1 to 0, frame 2 is state 0 -> 1 at 0
     got = {}

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from rgraph.scene.shapes import MeshData, capsule, merge
+from rgraph.scene.shapes import MeshData, capsule, merge, sphere
 from rgraph.scene.skinning import MAX_BONES, Skeleton
 
 X, Y, Z = np.eye(3)
@@ -107,7 +107,10 @@ def _bone_capsule(bone: Bone) -> tuple[MeshData, np.ndarray]:
     head, tail = np.asarray(bone.head, dtype=np.float64), np.asarray(bone.tail, dtype=np.float64)
     axis = tail - head
     length = float(np.linalg.norm(axis))
-    m = capsule(radius=bone.radius, height=max(length - 2 * bone.radius, 0.0), segments=bone.segments, rings=2 if bone.segments > 4 else 1)
+    rings = 2 if bone.segments > 4 else 1
+    body = length - 2 * bone.radius
+    m = (capsule(radius=bone.radius, height=body, segments=bone.segments, rings=rings) if body > 0.2 * bone.radius
+         else sphere(radius=bone.radius, segments=bone.segments, rings=2 * rings + 1))  # short, fat bones
     y = axis / length
     x = np.cross(y, Z if abs(y[2]) < 0.9 else X)
     x /= np.linalg.norm(x)

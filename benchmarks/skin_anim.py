@@ -7,6 +7,7 @@ interpolates - and, with ``--write``, its copy into mapped memory's stand-in (a 
 Float32 (the logic path). Target: well under 16.7 ms (one 60 Hz tick) for 1,024 x 256.
 
     python -m benchmarks.skin_anim [--characters 1024] [--bones 256] [--ticks 60] [--warmup 5] [--write]
+        [--threads 1,2,4,8]
 """
 
 from __future__ import annotations
@@ -49,6 +50,18 @@ def measure(characters: int, bones: int, ticks: int, warmup: int, write: bool) -
     return {s: statistics.median(v) for s, v in times.items()}
 
 
+def threaded(characters: int, bones: int, ticks: int, warmup: int, threads: int) -> float:
+    """Median ms of ``Animator.state`` (all stages) with ``threads`` chunks of characters."""
+    anim = Animator(build_rig(bones), characters, seed=1)
+    got = []
+    for tick in range(warmup + ticks):
+        t0 = time.perf_counter()
+        anim.state(tick, threads=threads)
+        if tick >= warmup:
+            got.append(1e3 * (time.perf_counter() - t0))
+    return statistics.median(got)
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--characters", type=int, default=1024)
@@ -56,6 +69,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--ticks", type=int, default=60)
     ap.add_argument("--warmup", type=int, default=5)
     ap.add_argument("--write", action="store_true", help="also copy the packed state (4 MiB at 1024 x 256)")
+    ap.add_argument("--threads", default="1,2,4,8", help="Animator.state with these thread counts (comma list)")
     a = ap.parse_args(argv)
     rig = build_rig(a.bones)
     ms = measure(a.characters, a.bones, a.ticks, a.warmup, a.write)
@@ -65,6 +79,9 @@ def main(argv: list[str] | None = None) -> None:
     print("median ms per tick: " + ", ".join(f"{s} {ms[s]:.2f}" for s in STAGES))
     budget = 1e3 / LOGIC_HZ
     print(f"tick budget at {LOGIC_HZ:.0f} Hz: {budget:.2f} ms; used {100 * ms['total'] / budget:.0f}%")
+    for n in (int(x) for x in a.threads.split(",") if x):
+        t = threaded(a.characters, a.bones, a.ticks, a.warmup, n)
+        print(f"Animator.state, {n} thread(s): {t:.2f} ms per tick ({100 * t / budget:.0f}% of the budget)")
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ study's two bone textures.
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,10 +51,12 @@ class Animator:
     def bones(self) -> int:
         return self.rig.skeleton.bones
 
-    def local_pose(self, seconds: float) -> Pose:
-        """Local transforms (component-major, B bones x C characters) at ``seconds``."""
-        c, b, f = self.characters, self.bones, self.dtype
-        cycle = (self.omega * seconds + self.phase) % (2.0 * np.pi)  # (C,) float64, then float32
+    def local_pose(self, seconds: float, chars: slice = slice(None)) -> Pose:
+        """Local transforms (component-major, B bones x C characters) at ``seconds``, of the
+        characters ``chars`` (all by default)."""
+        b, f = self.bones, self.dtype
+        cycle = (self.omega[chars] * seconds + self.phase[chars]) % (2.0 * np.pi)  # (C,) float64, then float32
+        c = len(cycle)
         angle = self._amp.astype(f)[:, None] * np.sin(cycle.astype(f)[None, :] + self._bone_phase.astype(f)[:, None])
         q = axis_angle(self._axes.astype(f), angle)
         t = np.empty((3, b, c), dtype=f)
@@ -63,13 +66,36 @@ class Animator:
         s[0] = 1.0 + 0.01 * np.sin(2.0 * cycle)
         return Pose(q, t, s)
 
-    def skinning(self, seconds: float) -> Pose:
+    def skinning(self, seconds: float, chars: slice = slice(None)) -> Pose:
         """Skinning transforms (rest object space -> posed) at ``seconds``."""
-        return skin_transforms(self.rig.skeleton, forward_kinematics(self.rig.skeleton, self.local_pose(seconds)))
+        local = self.local_pose(seconds, chars)
+        return skin_transforms(self.rig.skeleton, forward_kinematics(self.rig.skeleton, local))
 
-    def state(self, tick: int, hz: float = LOGIC_HZ) -> np.ndarray:
-        """Logic state ``tick``: packed bones (B, C, 8) float16 at ``t = tick / hz``."""
-        return pack_bones(self.skinning(tick / hz))
+    def state(self, tick: int, hz: float = LOGIC_HZ, threads: int = 1) -> np.ndarray:
+        """Logic state ``tick``: packed bones (B, C, 8) float16 at ``t = tick / hz``; with
+        ``threads`` > 1 the characters are split into that many chunks evaluated on a thread
+        pool (NumPy releases the GIL inside its array loops)."""
+        n = max(1, min(int(threads), self.characters // 64 or 1))
+        if n == 1:
+            return pack_bones(self.skinning(tick / hz))
+        out = np.empty((self.bones, self.characters, 8), dtype=np.float16)
+        edges = np.linspace(0, self.characters, n + 1).astype(int)
+        chunks = [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+
+        def run(chars: slice) -> None:
+            out[:, chars] = pack_bones(self.skinning(tick / hz, chars))
+
+        list(_pool(n).map(run, chunks))
+        return out
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+
+
+def _pool(n: int) -> ThreadPoolExecutor:
+    if n not in _POOLS:
+        _POOLS[n] = ThreadPoolExecutor(n, thread_name_prefix="rgraph-skin")
+    return _POOLS[n]
 
 
 def logic_tick(seconds: float, hz: float = LOGIC_HZ) -> tuple[int, float]:

@@ -173,3 +173,8 @@ def test_states_advance_and_logic_ticks():
     assert logic_tick(1.0 / 60.0)[0] == 1  # frame 1 at 60 Hz is tick 1, not 0.99999
     k, alpha = logic_tick(1.0 / 60.0, 30.0)
     assert k == 0 and alpha == pytest.approx(0.5)
+
+
+def test_threaded_state_is_bit_identical():
+    anim = Animator(build_rig(32), 200, seed=4)
+    assert np.array_equal(anim.state(9, threads=3).view(np.uint16), anim.state(9).view(np.uint16))

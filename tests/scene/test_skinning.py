@@ -178,3 +178,19 @@ def test_states_advance_and_logic_ticks():
 def test_threaded_state_is_bit_identical():
     anim = Animator(build_rig(32), 200, seed=4)
     assert np.array_equal(anim.state(9, threads=3).view(np.uint16), anim.state(9).view(np.uint16))
+
+
+@pytest.mark.parametrize("mesh, message", [
+    ("{shape: box, material: body, skinned: {bones: 12}}", "5:5: error: skinned meshes must be 'shape: character'"),
+    ("{shape: character, material: body, skinned: {bones: 300}}", "5:57: error: 'bones'"),
+    ("{shape: character, material: body, deformable: true, skinned: {}}", "either skinned or deformable"),
+])
+def test_bad_skinned_keys_are_one_line_errors(tmp_path, mesh, message):
+    from rgraph.errors import RGraphError
+    from rgraph.spec.scene import load_scene
+
+    p = tmp_path / "bad.yaml"
+    p.write_text(f"scene: 1\nmaterials:\n  body: {{base_color: [0.7, 0.5, 0.4]}}\nmeshes:\n  - {mesh}\n")
+    with pytest.raises(RGraphError) as info:
+        load_scene(p)
+    assert message in str(info.value) and "\n" not in str(info.value)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rgraph.scene.character import Rig
-from rgraph.scene.skinning import Pose, axis_angle, forward_kinematics, pack_bones, skin_transforms
+from rgraph.scene.skinning import Pose, axis_angle, forward_kinematics, pack_bones
 
 LOGIC_HZ = 60.0
 
@@ -66,24 +66,24 @@ class Animator:
         s[0] = 1.0 + 0.01 * np.sin(2.0 * cycle)
         return Pose(q, t, s)
 
-    def skinning(self, seconds: float, chars: slice = slice(None)) -> Pose:
-        """Skinning transforms (rest object space -> posed) at ``seconds``."""
-        local = self.local_pose(seconds, chars)
-        return skin_transforms(self.rig.skeleton, forward_kinematics(self.rig.skeleton, local))
+    def pose(self, seconds: float, chars: slice = slice(None)) -> Pose:
+        """Object-space joint transforms (rest joint frame -> posed) at ``seconds``: what a logic
+        state holds; ``skin_transforms`` of it maps rest vertices (the GPU does that per vertex)."""
+        return forward_kinematics(self.rig.skeleton, self.local_pose(seconds, chars))
 
     def state(self, tick: int, hz: float = LOGIC_HZ, threads: int = 1) -> np.ndarray:
-        """Logic state ``tick``: packed bones (B, C, 8) float16 at ``t = tick / hz``; with
+        """Logic state ``tick``: packed joint transforms (B, C, 8) float16 at ``t = tick / hz``; with
         ``threads`` > 1 the characters are split into that many chunks evaluated on a thread
         pool (NumPy releases the GIL inside its array loops)."""
         n = max(1, min(int(threads), self.characters // 64 or 1))
         if n == 1:
-            return pack_bones(self.skinning(tick / hz))
+            return pack_bones(self.pose(tick / hz))
         out = np.empty((self.bones, self.characters, 8), dtype=np.float16)
         edges = np.linspace(0, self.characters, n + 1).astype(int)
         chunks = [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
 
         def run(chars: slice) -> None:
-            out[:, chars] = pack_bones(self.skinning(tick / hz, chars))
+            out[:, chars] = pack_bones(self.pose(tick / hz, chars))
 
         list(_pool(n).map(run, chunks))
         return out

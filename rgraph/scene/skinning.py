@@ -7,7 +7,9 @@ component-major (``q`` is (4, B, C)) so that every operation is a few whole-arra
 (its head) is ``Skeleton.heads[b]`` in object space, so its inverse bind is a translation.
 
 Packed bones (``shaders/scene/skinning.glsl``): 8 half floats = 16 bytes = one ``uvec4`` per
-bone: ``(t.x, t.y, t.z, s, q.x, q.y, q.z, q.w)``, bone-major (entry ``b * C + c``). Values are clamped to the half range
+bone: ``(t.x, t.y, t.z, s, q.x, q.y, q.z, q.w)``, bone-major (entry ``b * C + c``). Logic states
+hold the joint transforms (forward kinematics' output); the vertex shader applies the inverse
+bind (``p - head``) after interpolating, so joints move along straight lines between states. Values are clamped to the half range
 (``HALF_MAX``), the scale to ``[0, HALF_MAX]``; a non-finite input is a ValueError (never a NaN
 on the GPU). Interpolation (:func:`interpolate`, identical on the GPU): lerp of ``t`` and ``s``,
 normalised lerp of ``q`` along the shortest arc (``q1`` negated when ``dot(q0, q1) < 0``).

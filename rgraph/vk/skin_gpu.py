@@ -3,10 +3,12 @@
 - binding 5 ``SkinVertices``: per vertex of the rigid vertex buffer (indexed by
   ``gl_VertexIndex``), 4 joint indices (uint8) and 4 weights (unorm8) as a ``uvec2``; written
   once (zeros outside skinned meshes). A 16-byte placeholder when the scene has no skinning.
-- binding 6 ``Bones``: a ring of logic-state slots, each the packed bones of every skinned
-  instance (rgraph.scene.skinning: 16 bytes per bone, bone-major per mesh). Each logic state
-  is packed and written once, into a slot no frame in flight reads; the study's "two bone
-  textures" are the two slots a frame set names.
+- binding 6 ``Bones``: a header, then a ring of logic-state slots. Header: per scene mesh
+  (``Draw.info.y``) a ``uvec4`` whose x is the first entry of that mesh's rest joint positions
+  (``head``, float32 bits in xyz), then those heads. A slot: the packed joint transforms of
+  every skinned instance (rgraph.scene.skinning: 16 bytes per bone, bone-major per mesh). Each
+  logic state is packed and written once, into a slot no frame in flight reads; the study's
+  "two bone textures" are the two slots a frame set names.
 - binding 7 ``SkinFrame`` (per frame set, std140): ``(alpha, previous slot's first entry,
   current slot's first entry, 0)``; the vertex shader interpolates previous -> current.
 
@@ -58,14 +60,32 @@ class SkinGPU:
                 table[rows, 0] = rig.joints.astype(np.uint32) @ (1 << np.arange(0, 32, 8, dtype=np.uint32))
                 table[rows, 1] = rig.weights.astype(np.uint32) @ (1 << np.arange(0, 32, 8, dtype=np.uint32))
             self.vertices.write(table.tobytes())
-        self.bones_bytes = max(self.slots * self.bones * BONE_BYTES, 16)
+        header = self._header(data)
+        self.header = len(header)  # entries before the first slot
+        self.bones_bytes = max((self.header + self.slots * self.bones) * BONE_BYTES, 16)
         self.ring = self._buffer(device, self.bones_bytes, storage)
+        self.ring.write(header.tobytes())
         self.frames = [self._buffer(device, SKIN_FRAME_BYTES, uniform) for _ in range(sets)]
         for buf in self.frames:
             buf.write(bytes(SKIN_FRAME_BYTES))
         self._slot_tick: list[int | None] = [None] * self.slots
         self._held: list[tuple[int, int]] = [(-1, -1)] * sets  # slots each set's frame reads
         self._states: dict[int, np.ndarray] = {}
+
+    @staticmethod
+    def _header(data: SceneData) -> np.ndarray:
+        """(entries, 4) uint32: per scene mesh its heads' first entry, then every skinned mesh's heads."""
+        if not data.bone_count:
+            return np.zeros((0, 4), dtype=np.uint32)
+        table = np.zeros((len(data.meshes), 4), dtype=np.uint32)
+        heads, entry = [], len(data.meshes)
+        for k, mesh in enumerate(data.meshes):
+            if mesh.animator is not None:
+                h = mesh.animator.rig.skeleton.heads.astype(np.float32)
+                table[k, 0] = entry
+                heads.append(np.concatenate([h, np.zeros((len(h), 1), np.float32)], axis=1).view(np.uint32))
+                entry += len(h)
+        return np.concatenate([table, *heads])
 
     def _buffer(self, device: Device, size: int, usage: int) -> HostBuffer:
         buf = HostBuffer.create(device, size, usage)
@@ -98,8 +118,8 @@ class SkinGPU:
             return self._slot_tick.index(tick)
         busy = {s for k, held in enumerate(self._held) if k != frame_set for s in held} | {keep}
         slot = next(s for s in range(self.slots) if s not in busy)
-        self.ring.mapped[slot * self.bones * BONE_BYTES:(slot + 1) * self.bones * BONE_BYTES] = \
-            memoryview(np.ascontiguousarray(self.state(tick))).cast("B")
+        start = (self.header + slot * self.bones) * BONE_BYTES
+        self.ring.mapped[start:start + self.bones * BONE_BYTES] = memoryview(np.ascontiguousarray(self.state(tick))).cast("B")
         self._slot_tick[slot] = tick
         return slot
 
@@ -112,8 +132,8 @@ class SkinGPU:
         b = self._slot_of(current, frame_set, a)
         self._held[frame_set] = (a, b)
         alpha = min(max(float(alpha), 0.0), 1.0)
-        self.frames[frame_set].write(np.array([alpha, 0.0, 0.0, 0.0], dtype=np.float32).tobytes()[:4]
-                                     + np.array([a * self.bones, b * self.bones, 0], dtype=np.uint32).tobytes())
+        first = np.array([self.header + a * self.bones, self.header + b * self.bones, 0], dtype=np.uint32)
+        self.frames[frame_set].write(np.float32(alpha).tobytes() + first.tobytes())
 
     def update(self, seconds: float, frame_set: int) -> None:
         """The frame at render time ``seconds``: states k - 1 -> k at alpha (module docstring)."""

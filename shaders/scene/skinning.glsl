@@ -3,12 +3,14 @@
 //
 // A skinned draw (Draw.info.z & 2) reads, per vertex, 4 joints (uint8) and 4 weights (unorm8)
 // from SkinVertices[vertex index]; bone b of the draw's skeleton is entry
-// info.w + b * (info.z >> 8) of a logic state. Each bone is 8 half floats (t.xyz, s, q.xyzw):
-// x -> t + s * rotate(q, x), rest object space to posed. Two logic states (the study's two bone
-// textures: slots of the Bones ring) are interpolated at SkinFrame.alpha: lerp of t and s,
-// shortest-arc normalised lerp of q (q1 negated when dot(q0, q1) < 0) - as
-// rgraph.scene.skinning.interpolate. Linear blend: the influences' transformed positions
-// weighted; normals rotated, weighted (renormalise after the normal matrix).
+// info.w + b * (info.z >> 8) of a logic state. Each bone is 8 half floats (t.xyz, s, q.xyzw), the
+// joint transform x -> t + s * rotate(q, x) (rest joint frame to posed). Two logic states (the
+// study's two bone textures: slots of the Bones ring) are interpolated at SkinFrame.alpha: lerp
+// of t and s, shortest-arc normalised lerp of q (q1 negated when dot(q0, q1) < 0) - as
+// rgraph.scene.skinning.interpolate - then the inverse bind: a rest vertex p moves to
+// t + s * rotate(q, p - head) (head: the bone's rest joint, float32, in the Bones header at
+// bones[info.y].x + b). Linear blend: the influences' results weighted; normals rotated,
+// weighted (renormalise after the normal matrix).
 
 #ifndef RGRAPH_SKINNING_GLSL
 #define RGRAPH_SKINNING_GLSL
@@ -64,11 +66,14 @@ void skin_vertex(uint vertex, uint draw_index, inout vec3 position, inout vec3 n
     uvec2 sv = skin_vertices[vertex];
     vec4 w = unpackUnorm4x8(sv.y);
     uint stride = draws[draw_index].info.z >> 8u, first = draws[draw_index].info.w;
+    uint heads = bones[draws[draw_index].info.y].x;
     vec3 p = vec3(0.0), n = vec3(0.0);
     for (uint k = 0u; k < 4u; ++k) {
         if (w[k] == 0.0) continue;
-        SkinBone b = skin_bone(first + ((sv.x >> (8u * k)) & 0xFFu) * stride);
-        p += w[k] * (b.t + b.s * skin_rotate(b.q, position));
+        uint joint = (sv.x >> (8u * k)) & 0xFFu;
+        SkinBone b = skin_bone(first + joint * stride);
+        vec3 head = uintBitsToFloat(bones[heads + joint].xyz);
+        p += w[k] * (b.t + b.s * skin_rotate(b.q, position - head));
         n += w[k] * skin_rotate(b.q, normal);
     }
     position = p;

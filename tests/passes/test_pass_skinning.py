@@ -83,10 +83,11 @@ def _reference(mesh, frame: int, alpha: float | None) -> tuple[np.ndarray, np.nd
     """(instances, V, 3) posed positions and unit normals from the half-float states, float64."""
     tick, frame_alpha = logic_tick(frame / 60.0, LOGIC_HZ)
     a, b = (unpack_bones(mesh.animator.state(k, LOGIC_HZ)) for k in (tick - 1, tick))
-    pose = interpolate(a, b, frame_alpha if alpha is None else alpha)
+    pose = interpolate(a, b, frame_alpha if alpha is None else alpha)  # joint transforms
     rig, out_p, out_n = mesh.animator.rig, [], []
     for c in range(mesh.instances):
-        skins = [ref.similarity(pose.q[:, j, c], pose.t[:, j, c], pose.s[j, c]) for j in range(rig.skeleton.bones)]
+        joints = [ref.similarity(pose.q[:, j, c], pose.t[:, j, c], pose.s[j, c]) for j in range(rig.skeleton.bones)]
+        skins = ref.skin_matrices(rig.skeleton.heads, joints)
         out_p.append(ref.skin_vertices(rig.mesh.positions, rig.joints, rig.weights_f, skins))
         n = np.stack([sum(w * skins[j][:3, :3] / pose.s[j, c] for j, w in zip(js, ws, strict=True) if w)
                       @ nv for js, ws, nv in zip(rig.joints, rig.weights_f, rig.mesh.normals, strict=True)])

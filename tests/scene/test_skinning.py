@@ -160,7 +160,7 @@ def test_float32_logic_path_within_half_precision_of_float64():
     rig = build_rig(256)
     fast, exact = Animator(rig, 8, seed=1), Animator(rig, 8, seed=1, dtype=np.float64)
     got = unpack_bones(fast.state(37))
-    want = exact.skinning(37 / 60.0)
+    want = exact.pose(37 / 60.0)
     assert np.abs(got.t - want.t).max() < 4e-3  # half spacing at 2 m is 2e-3
     assert np.abs(got.q - want.q).max() < 1e-3 and np.abs(got.s - want.s).max() < 1e-3
 

@@ -194,3 +194,32 @@ def test_bad_skinned_keys_are_one_line_errors(tmp_path, mesh, message):
     with pytest.raises(RGraphError) as info:
         load_scene(p)
     assert message in str(info.value) and "\n" not in str(info.value)
+
+
+def test_vr_skinned_scene_and_draw_packing():
+    from locations import ROOT
+
+    from rgraph.scene import packing
+    from rgraph.scene.build import load_scene_data
+
+    data = load_scene_data(ROOT / "graphs" / "scenes" / "vr_skinned.yaml", (64, 36))
+    (mesh,) = data.skinned
+    assert mesh.instances == 1024 and mesh.animator.bones == 256 and data.bone_count == 1024 * 256
+    rows = np.frombuffer(packing.draws_bytes(data, 0), dtype=np.uint32).reshape(-1, packing.DRAW_BYTES // 4)
+    info = rows[:, 32:36]
+    skinned = info[mesh.first_draw:mesh.first_draw + 1024]
+    assert np.all(skinned[:, 2] == (packing.DRAW_SKINNED | (1024 << 8)))
+    assert np.array_equal(skinned[:, 3], mesh.bone_base + np.arange(1024))
+    assert np.all(skinned[:, 1] == data.meshes.index(mesh))
+    others = np.delete(info, np.s_[mesh.first_draw:mesh.first_draw + 1024], axis=0)
+    assert np.all(others[:, 2] & packing.DRAW_SKINNED == 0) and np.all(others[:, 3] == 0)
+    # the bounds hold every pose: a character's reach around its root joint
+    pose = mesh.animator.pose(0.37)
+    from rgraph.scene.skinning import skin, skin_transforms
+
+    posed, _ = skin(mesh.data.positions, mesh.data.normals, mesh.animator.rig.joints, mesh.animator.rig.weights_f,
+                    skin_transforms(mesh.animator.rig.skeleton, pose), 5)
+    world = posed + mesh.positions[5]
+    box = mesh.world_corners()[5 * 8:6 * 8]  # instance 5's bounding box
+    assert np.all(world >= box.min(axis=0)) and np.all(world <= box.max(axis=0))
+    assert np.abs(posed - mesh.data.positions).max() > 0.02

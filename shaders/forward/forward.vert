@@ -10,9 +10,10 @@ layout(location = 2) flat out uint out_material;
 
 void main() {
     uint d = uint(gl_InstanceIndex);
-    vec3 position = scene_vertex_position(in_position, d);
+    vec3 position = in_position, normal = in_normal;
+    scene_vertex_pose(position, normal, d);
     out_world = scene_world_position(position, d).xyz;
-    out_normal = mat3(draws[d].normal_matrix) * scene_vertex_normal(in_normal, d);
+    out_normal = mat3(draws[d].normal_matrix) * normal;
     out_material = draws[d].info.x;
     gl_Position = scene_clip_position(position, d);
 }

@@ -5,7 +5,7 @@
 //   void main() { uint d = gl_InstanceIndex;
 //                 gl_Position = scene_clip_position(scene_vertex_position(in_position, d), d); ... }
 //
-// scene_vertex_position / scene_vertex_normal pose skinned draws (scene/skinning.glsl) and pass
+// scene_vertex_position / scene_vertex_pose pose skinned draws (scene/skinning.glsl) and pass
 // everything else through unchanged.
 //
 // Depth-only shaders `#define SCENE_POSITION_ONLY` before the include and use
@@ -33,11 +33,10 @@ vec3 scene_vertex_position(vec3 object_position, uint draw_index) {
                                        : object_position;
 }
 
-vec3 scene_vertex_normal(vec3 object_normal, uint draw_index) {
-    if (!skin_is_skinned(draw_index)) return object_normal;
-    vec3 p = vec3(0.0), n = object_normal;
-    skin_vertex(uint(gl_VertexIndex), draw_index, p, n);
-    return n;
+// Position and normal in one pass over the bones (the position's arithmetic is the same as
+// scene_vertex_position's, so depth-only shaders using that one match bit for bit).
+void scene_vertex_pose(inout vec3 object_position, inout vec3 object_normal, uint draw_index) {
+    if (skin_is_skinned(draw_index)) skin_vertex(uint(gl_VertexIndex), draw_index, object_position, object_normal);
 }
 
 #endif

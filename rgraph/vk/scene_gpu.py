@@ -11,6 +11,8 @@ Built once per run from ``plan["scene_source"]`` by the executor (``Executor._sc
   deformable meshes' positions (deformed on the CPU every frame); their normals and tangents
   are computed on the GPU (``rgraph.vk.scene_deform``: ``record_deform`` at the start of the
   frame's first scene batch on the graphics queue), into the vertex buffers the draws bind.
+- skinning (bindings 5-7, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights, the ring of
+  packed logic states and each set's interpolation factor.
 
 Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(frame_set)``,
 ``vertex_input`` and ``draw(rec, frame_set)``.
@@ -32,6 +34,7 @@ from rgraph.vk.resources import HostBuffer
 from rgraph.vk.runtime.logic import interpolation_alpha
 
 BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS = range(5)
+BINDING_SKIN_VERTICES, BINDING_BONES, BINDING_SKIN_FRAME = range(5, 8)  # rgraph.vk.skin_gpu
 
 
 @dataclass(frozen=True)
@@ -55,6 +58,7 @@ class SceneGPU:
         self.device = device
         self.sets = sets
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
+        self.plan_logic_hz = plan.get("logic_hz")  # skinning's logic rate (default 60 Hz)
         try:
             self.data: SceneData = load_scene_data(source, self.extent, int(plan.get("camera", 0)))
         except (OSError, ValueError) as exc:
@@ -62,6 +66,7 @@ class SceneGPU:
         self._device_local = DeviceLocal(device)
         self._host: list[HostBuffer] = []
         self._pool = None
+        self.skin = None
         self.set_layout = None
         self._sets: list[Any] = []
         self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
@@ -131,10 +136,13 @@ class SceneGPU:
         rigid_vertices, indices, calls = [], [], []
         rigid_base = deform_base = first_index = 0
         self._deform_layout: list[tuple[Any, int]] = []  # (mesh, vertex offset) in the per-set buffers
+        skinned: list[tuple[Any, int]] = []  # (mesh, first vertex in the rigid vertex buffer)
         for mesh in data.meshes:
             count = mesh.data.triangle_count * 3
             indices.append(mesh.data.indices.reshape(-1))
             if mesh.deformer is None:
+                if mesh.animator is not None:
+                    skinned.append((mesh, rigid_base))
                 rigid_vertices.append(packing.vertex_bytes(mesh.data))
                 calls.append(DrawCall(False, count, first_index, rigid_base, mesh.instances, mesh.first_draw))
                 rigid_base += mesh.data.vertex_count
@@ -159,6 +167,10 @@ class SceneGPU:
         self.scene_lights_buffer = self._device_buffer(len(scene_lights), storage)
         uploads.append((self.scene_lights_buffer, scene_lights))
         self._upload(submit_once, [(b, d) for b, d in uploads if d])
+        from rgraph.vk.skin_gpu import SkinGPU
+
+        self.skin = SkinGPU(self.device, data, self.sets, skinned, rigid_base,
+                            float(self.plan_logic_hz) if self.plan_logic_hz else 60.0)
 
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]
@@ -186,13 +198,14 @@ class SceneGPU:
         dev = self.device.handle
         ubo, ssbo = v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
         kinds = [(BINDING_FRAME, ubo), (BINDING_DRAWS, ssbo), (BINDING_MATERIALS, ssbo),
-                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo)]
+                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo), (BINDING_SKIN_VERTICES, ssbo),
+                 (BINDING_BONES, ssbo), (BINDING_SKIN_FRAME, ubo)]
         bindings = [v.VkDescriptorSetLayoutBinding(binding=b, descriptorType=t, descriptorCount=1,
                                                    stageFlags=v.VK_SHADER_STAGE_ALL) for b, t in kinds]
         self.set_layout = v.vkCreateDescriptorSetLayout(dev, v.VkDescriptorSetLayoutCreateInfo(
             bindingCount=len(bindings), pBindings=bindings), None)
-        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=self.sets),
-                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=4 * self.sets)]
+        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=2 * self.sets),
+                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=6 * self.sets)]
         self._pool = v.vkCreateDescriptorPool(dev, v.VkDescriptorPoolCreateInfo(
             maxSets=self.sets, poolSizeCount=len(sizes), pPoolSizes=sizes), None)
         self._sets = list(v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
@@ -203,6 +216,8 @@ class SceneGPU:
                        (BINDING_MATERIALS, ssbo, self.materials_buffer.handle, materials_size),
                        (BINDING_SCENE_LIGHTS, ssbo, self.scene_lights_buffer.handle, lights_size),
                        (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size)]
+            skin = [*self.skin.descriptors(), self.skin.frame_descriptor(s)]
+            sources += [(b, ubo if kind == "uniform" else ssbo, buf.handle, size) for b, kind, buf, size in skin]
             infos = [v.VkDescriptorBufferInfo(buffer=h, offset=0, range=size) for _b, _t, h, size in sources]
             writes = [v.VkWriteDescriptorSet(dstSet=self._sets[s], dstBinding=b, descriptorCount=1, descriptorType=t,
                                              pBufferInfo=[info])
@@ -229,12 +244,16 @@ class SceneGPU:
             if data.decals:
                 self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
             self._camera_written[frame_set] = camera
-        if self.deform is None:
-            return
         if logic is None:
-            self.deform.write(seconds, frame_set)
+            if self.skin is not None:
+                self.skin.update(seconds, frame_set)
+            if self.deform is not None:
+                self.deform.write(seconds, frame_set)
             return
-        self.deform.set_header(frame_set, alpha, prev.value, cur.value)  # the logic wrote the slots
+        if self.skin is not None:  # the logic thread packed these states (logic_step)
+            self.skin.show(frame_set, prev.tick, cur.tick, alpha)
+        if self.deform is not None:
+            self.deform.set_header(frame_set, alpha, prev.value, cur.value)  # the logic wrote the slots
         self.ticks_taken[frame_set] = (prev.tick, cur.tick)
 
     def attach_logic(self, logic: Any) -> None:
@@ -242,12 +261,16 @@ class SceneGPU:
         ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step`` and whose lock is
         ``deform.lock``)."""
         self.logic = logic
+        if self.skin is not None:
+            self.skin.logic_hz = float(logic.hz)  # skinning's logic ticks are this thread's
         self.ticks_taken = [None] * self.sets
         self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
 
     def logic_step(self, seconds: float) -> Any:
         """One logic tick at scene time ``seconds`` (the logic thread): the deformable positions
         written into a free ring slot; the slot (None: no deformable meshes)."""
+        if self.skin is not None and self.skin.active:  # packed here, copied by the render thread
+            self.skin.state(round(seconds * self.logic.hz))
         if self.deform is None:
             return None
         return self.deform.write_slot(seconds, self.logic.published)
@@ -300,3 +323,6 @@ class SceneGPU:
             buf.destroy()
         self._host = []
         self._device_local.destroy()
+        if self.skin is not None:
+            self.skin.destroy()
+            self.skin = None

@@ -71,12 +71,13 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
     info = plan.multi_device or {}
     print(f"rgraph: {info.get('split')} over {len(devices)} logical devices {devices}: frame {summary.frame_ms:.2f} ms "
           f"(host), device GPU ms {[round(x, 3) for x in summary.device_ms]}, readback {summary.readback_ms:.2f} ms, "
-          f"device 0 receive+frame {summary.device0_ms:.2f} ms; VK_EXT_external_memory_host offered: "
-          f"{summary.host_memory_import} (staged copy used)", file=sys.stderr)
+          f"device 0 frame {summary.device0_ms:.2f} ms; VK_EXT_external_memory_host offered: "
+          f"{summary.host_memory_import} ({summary.transfer} transfer)", file=sys.stderr)
     if args.timings:
         args.timings.write_text(json.dumps({"devices": devices, "frame_ms": summary.frame_ms,
                                             "device_ms": summary.device_ms, "readback_ms": summary.readback_ms,
-                                            "device0_ms": summary.device0_ms, **summary.timings}, indent=1,
+                                            "device0_ms": summary.device0_ms, "transfer": summary.transfer,
+                                            **summary.timings}, indent=1,
                                            sort_keys=True) + "\n")
     status = 0
     for message in messages:

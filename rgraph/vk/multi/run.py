@@ -203,7 +203,8 @@ class MultiExecutable:
             findings = [f for d, (exe, r) in enumerate(zip([self.receiver, *self.senders], [summary, *runs],
                                                            strict=True))
                         for f in span_findings(d, exe.plan, r.timings, hosts[d])]
-            samples.append(FrameSample((t3 - t0) * 1e3, spans, hosts, sent.read_ms + (t2 - t1) * 1e3, findings))
+            copy = sent.read_ms + (t2 - t1) * 1e3 if self.transfer == "staged" else 0.0
+            samples.append(FrameSample((t3 - t0) * 1e3, spans, hosts, copy, findings))
         assert summary is not None and runs is not None
         passes = [dict(summary.timings.get("passes", {}))] + [dict(r.timings.get("passes", {})) for r in runs]
         n = len(self.gpus)

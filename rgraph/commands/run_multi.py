@@ -46,8 +46,8 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
                 gpus, lambda w: compile_graph_plan(args.graph, split=replace(split, weights=w), **options),
                 args.frames)
             plan = multi.plan
-            print("rgraph: shares per frame: " + " -> ".join("/".join(f"{x:.2f}" for x in w) for w in history),
-                  file=sys.stderr)
+            print("rgraph: shares per frame: " + " -> ".join("/".join(f"{x:.2f}" for x in w) for w in history)
+                  + f"; {multi.loads} plan load(s) for {args.frames} frame(s)", file=sys.stderr)
         else:
             multi = MultiExecutable(gpus, plan)
             summary = multi.run(args.frames)

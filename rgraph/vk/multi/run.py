@@ -179,8 +179,18 @@ class MultiExecutable:
 
                 raise ExecutionError(f"device 0's plan has no receiving buffer(s) {missing}")
             self.receiver = self.gpus[0].load(self.plans[0], inputs=sent.tiles, **self._kw)
+            self.receiver.executor.frames_done = self.frames_done  # in step with the senders (seek)
         else:
             refill(self.receiver, sent.tiles)
+
+    def seek(self, frame: int) -> None:
+        """Continue at frame ``frame`` on every device (frame-dependent values, frame sets):
+        ``DynamicBalance`` switching between the executables of band layouts. Every earlier
+        frame of these executables has completed (``run`` waits for them)."""
+        self.frames_done = frame
+        for exe in [*self.senders, self.receiver]:
+            if exe is not None:
+                exe.executor.frames_done = frame
 
     def run(self, frames: int = 1) -> MultiSummary:
         samples: list[FrameSample] = []

@@ -15,6 +15,10 @@ from typing import Any
 from rgraph.commands.common import parse_params, parse_size
 
 
+def _runtime_options(args: argparse.Namespace) -> dict[str, Any]:
+    return {"transfer": getattr(args, "transfer", "auto") or "auto", "pipelined": bool(getattr(args, "pipelined", False))}
+
+
 def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -> int:
     from rgraph.api import open_device
     from rgraph.commands.multi_args import split_from_args
@@ -44,12 +48,12 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
 
             multi, summary, history = run_balanced(
                 gpus, lambda w: compile_graph_plan(args.graph, split=replace(split, weights=w), **options),
-                args.frames)
+                args.frames, **_runtime_options(args))
             plan = multi.plan
             print("rgraph: shares per frame: " + " -> ".join("/".join(f"{x:.2f}" for x in w) for w in history)
                   + f"; {multi.loads} plan load(s) for {args.frames} frame(s)", file=sys.stderr)
         else:
-            multi = MultiExecutable(gpus, plan)
+            multi = MultiExecutable(gpus, plan, **_runtime_options(args))
             summary = multi.run(args.frames)
         data = multi.read_back()
         check = args.validate if args.check_data is None else args.check_data

@@ -136,9 +136,10 @@ class DynamicBalance:
 
 
 def run_balanced(gpus: list[Any], compile_with: Callable[[tuple[float, ...] | None], Any], frames: int,
-                 damping: float = 0.5) -> tuple[DynamicBalance, Any, list[tuple[float, ...]]]:
+                 damping: float = 0.5, **multi_options: Any) -> tuple[DynamicBalance, Any, list[tuple[float, ...]]]:
     """``frames`` frames of ``DynamicBalance``: (the balancer, the last summary, shares per frame).
-    ``compile_with(weights)`` compiles the split plan for those shares (None: equal)."""
-    balance = DynamicBalance(gpus, compile_with, damping=damping)
+    ``compile_with(weights)`` compiles the split plan for those shares (None: equal);
+    ``multi_options``: ``MultiExecutable``'s (transfer, pipelined)."""
+    balance = DynamicBalance(gpus, compile_with, damping=damping, **multi_options)
     summary = balance.run(frames)
     return balance, summary, balance.history

@@ -54,13 +54,16 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
                   + f"; {multi.loads} plan load(s) for {args.frames} frame(s)", file=sys.stderr)
         else:
             multi = MultiExecutable(gpus, plan, **_runtime_options(args))
+            warm = getattr(args, "warmup", None)
+            multi.warm_up(gpus[0].default_warmup_s if warm is None else warm)
             summary = multi.run(args.frames)
+        frames = getattr(multi, "frames_done", args.frames)  # warm-up frames included (the data check counts them)
         data = multi.read_back()
         check = args.validate if args.check_data is None else args.check_data
         verdict = None
         if check and reference is not None:  # device 0's own resources (not the received buffers)
             known = {r["name"] for r in reference["resources"]}
-            verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, args.frames)
+            verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, frames)
         if args.out:
             from rgraph.png import write_output_png
 

@@ -183,6 +183,14 @@ class MultiExecutable:
         else:
             refill(self.receiver, sent.tiles)
 
+    def warm_up(self, seconds: float) -> int:
+        """Untimed frames for about ``seconds`` (``rgraph.api.Executable.warm_up``); the frames run."""
+        done, start = 0, time.perf_counter()
+        while seconds > 0 and (done == 0 or time.perf_counter() - start < seconds):
+            self.run(2)
+            done += 2
+        return done
+
     def seek(self, frame: int) -> None:
         """Continue at frame ``frame`` on every device (frame-dependent values, frame sets):
         ``DynamicBalance`` switching between the executables of band layouts. Every earlier

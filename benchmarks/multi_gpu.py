@@ -67,7 +67,13 @@ def _configs(gpus: list[Any], name: str, args: argparse.Namespace, size: tuple[i
                 print(f"multi_gpu: {name} {mode}: no VK_EXT_external_memory_host, shared skipped", file=sys.stderr)
                 continue
             for pipe in args.pipelined.split(","):
-                multi = MultiExecutable(gpus, plan, transfer=transfer, pipelined=pipe == "on")
+                try:
+                    multi = MultiExecutable(gpus, plan, transfer=transfer, pipelined=pipe == "on")
+                except Exception as exc:  # noqa: BLE001 -- one configuration refused: the others still run
+                    print(f"multi_gpu: {name} {mode} {transfer}: skipped ({exc})", file=sys.stderr)
+                    continue
+                if multi.shared_error:
+                    print(f"multi_gpu: {name} {mode}: shared allocation refused ({multi.shared_error})", file=sys.stderr)
                 configs.append(Config(name, mode, transfer, pipe == "on", multi, plan))
     return configs
 

@@ -93,3 +93,25 @@ def test_unknown_transfer_is_refused(gpus):
                               split=Split(2, "sort-first"))
     with pytest.raises(ExecutionError, match="transfer"):
         MultiExecutable(gpus, plan, transfer="teleport")
+
+
+def test_auto_falls_back_to_staged_when_the_import_is_refused(gpus, monkeypatch):
+    """A driver refusing the host-pointer import: ``auto`` runs staged (and says why), an
+    explicit ``shared`` is an ExecutionError."""
+    from rgraph.vk.multi import host_memory
+
+    def refuse(*_a, **_k):
+        raise RuntimeError("import refused")
+
+    monkeypatch.setattr(host_memory.SharedHostBuffer, "create", classmethod(lambda cls, *a, **k: refuse()))
+    plan = compile_graph_plan(PROBE_GRAPH, size=SIZE, memory=gpus[0].memory_requirements(),
+                              split=Split(2, "sort-first"))
+    multi = MultiExecutable(gpus, plan)
+    try:
+        assert multi.transfer == "staged" and "import refused" in multi.shared_error
+        assert multi.run(1).transfer == "staged"
+    finally:
+        multi.close()
+    with pytest.raises(ExecutionError, match="shared host allocation was refused"):
+        MultiExecutable(gpus, plan, transfer="shared")
+    assert _messages(gpus) == []

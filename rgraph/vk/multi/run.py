@@ -118,8 +118,19 @@ class MultiExecutable:
         self.frames_done = 0
         self._outer = ThreadPoolExecutor(max_workers=1)
         self._inner = ThreadPoolExecutor(max_workers=max(1, n - 1))
+        self.shared_error: str | None = None  # auto: why the shared allocation fell back to staged
         try:
-            external = self._share() if self.transfer == "shared" else [{} for _ in range(n)]
+            external = [{} for _ in range(n)]
+            if self.transfer == "shared":
+                try:
+                    external = self._share()
+                except Exception as exc:  # noqa: BLE001 -- a driver refusing the import: auto falls back
+                    if transfer == "shared":
+                        raise ExecutionError(f"the shared host allocation was refused: {type(exc).__name__}: "
+                                             f"{exc}") from exc
+                    for bridge in self.bridges:
+                        bridge.destroy()
+                    self.bridges, self.transfer, self.shared_error = [], "staged", f"{type(exc).__name__}: {exc}"
             self.senders = [gpus[d].load(self.plans[d], external=external[d], **self._kw) for d in range(1, n)]
             if self.transfer == "shared":
                 self.receiver = gpus[0].load(self.plans[0], external=external[0], **self._kw)

@@ -7,11 +7,11 @@ from __future__ import annotations
 from dataclasses import replace
 
 from locations import ROOT
+from multi_helpers import assert_data_ok
 
 from rgraph.api import open_device
 from rgraph.compiler.multi_device import Split
 from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
-from rgraph.probe.check import check_outputs
 from rgraph.vk.multi.balance import DynamicBalance
 
 PROBE_GRAPH = ROOT / "tests" / "multi_graphs" / "probe_split.yaml"
@@ -37,9 +37,7 @@ def test_dynamic_balance_reuses_layouts_and_keeps_frame_numbers():
             data = balance.read_back()
         finally:
             balance.close()
-        known = {r["name"] for r in reference["resources"]}
-        verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, FRAMES)
-        assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+        assert_data_ok(reference, data, FRAMES)
     finally:
         messages = [m for g in gpus for m in g.close()]
     assert messages == []

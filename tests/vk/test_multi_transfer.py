@@ -7,11 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from locations import ROOT
+from multi_helpers import assert_data_ok, validated_pair
 
-from rgraph.api import open_device
 from rgraph.compiler.multi_device import Split
 from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
-from rgraph.probe.check import check_outputs
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.multi.run import MultiExecutable, host_import_supported
 from rgraph.vk.runtime.readback import decode_outputs
@@ -23,10 +22,7 @@ FRAMES = 3
 
 @pytest.fixture(scope="module")
 def gpus():
-    pair = [open_device(validate=True, device=0, verbose=False) for _ in range(2)]
-    yield pair
-    for g in pair:
-        assert g.close() == [], "validation messages"
+    yield from validated_pair()
 
 
 def _messages(gpus):
@@ -62,9 +58,7 @@ def test_transfer_and_pipelining_keep_the_one_device_frame(gpus, mode, transfer,
     assert summary.transfer == transfer and summary.pipelined == pipelined
     assert summary.findings == []  # every device's span covers all its passes, inside its host wait
     assert len(summary.samples) == FRAMES
-    known = {r["name"] for r in reference["resources"]}
-    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, FRAMES)
-    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert_data_ok(reference, data, FRAMES)
     assert np.array_equal(ref["color"], decode_outputs(multi.plans[0], data)["color"])
     assert _messages(gpus) == []
 
@@ -82,9 +76,7 @@ def test_pipelined_runs_continue_frame_counts(gpus):
         data = multi.read_back()
     finally:
         multi.close()
-    known = {r["name"] for r in reference["resources"]}
-    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 5)
-    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert_data_ok(reference, data, 5)
     assert _messages(gpus) == []
 
 

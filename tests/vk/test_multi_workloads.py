@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from multi_helpers import validated_pair
 
 from benchmarks import multi_gpu_work as work
-from rgraph.api import open_device
 from rgraph.compiler.multi_device import Split
 from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
 from rgraph.vk.multi.run import MultiExecutable
@@ -22,10 +22,7 @@ CASES = {"pixels": (work.PIXELS, {"mg.iterations": "32"}),
 
 @pytest.fixture(scope="module")
 def gpus():
-    pair = [open_device(validate=True, device=0, verbose=False) for _ in range(2)]
-    yield pair
-    for g in pair:
-        assert g.close() == [], "validation messages"
+    yield from validated_pair()
 
 
 def _one(gpu, graph, params):

@@ -212,6 +212,11 @@ class MultiExecutable:
                 exe.executor.frames_done = frame
 
     def run(self, frames: int = 1) -> MultiSummary:
+        """``frames`` frames on every device (module docstring); every frame has completed on return."""
+        if frames < 1:
+            from rgraph.vk.errors import ExecutionError
+
+            raise ExecutionError("--frames must be at least 1")
         samples: list[FrameSample] = []
         pending = None
         summary = runs = None

@@ -5,7 +5,9 @@ workloads (``benchmarks/multi_gpu_work``): ``pixels``, a per-pixel-heavy full-sc
 (``--iterations`` per pixel; sort-first), and ``mesh``, a procedural mesh of ``--triangles``
 triangles (sort-last; the study used >= 100M). For each graph every configuration is loaded
 once: one device, then each split x transfer (``shared``: VK_EXT_external_memory_host, one
-host allocation imported by both devices; ``staged``: readback + staging) x pipelining.
+host allocation imported by both devices; ``staged``: readback + staging) x pipelining, and
+for sort-first one ``--balances dynamic`` configuration (``DynamicBalance``: bands in 8-row
+steps from measured times; ``plan_loads`` in the JSON counts its layouts).
 Measurement (``benchmarks/multi_gpu_work/measure.py``): a warm-up of ``--warmup-s`` seconds
 per configuration, then ``--rounds`` rounds alternating configurations, each round
 ``--frames`` serial frames (fenced ``run(1)``: GPU span per device, host wall) and one stream
@@ -22,7 +24,7 @@ these figures measure the machinery's overhead, and efficiency above 1/devices i
 
     python3 -m benchmarks.multi_gpu --devices 0,0 [--size 640x360] [--frames 5] [--rounds 3]
         [--warmup-s 0.3] [--graphs surgery,probe,pixels,mesh] [--splits sort-first,sort-last]
-        [--transfers shared,staged] [--pipelined off,on] [--triangles 100000000]
+        [--transfers shared,staged] [--pipelined off,on] [--balances static,dynamic] [--triangles 100000000]
         [--iterations 4096] [--validate] [--out-json P]
 """
 
@@ -75,6 +77,14 @@ def _configs(gpus: list[Any], name: str, args: argparse.Namespace, size: tuple[i
                 if multi.shared_error:
                     print(f"multi_gpu: {name} {mode}: shared allocation refused ({multi.shared_error})", file=sys.stderr)
                 configs.append(Config(name, mode, transfer, pipe == "on", multi, plan))
+        if mode == "sort-first" and "dynamic" in args.balances.split(","):
+            from rgraph.vk.multi.balance import DynamicBalance
+
+            transfer = "shared" if shared_ok and "shared" in args.transfers else "staged"
+            balance = DynamicBalance(gpus, lambda w, mode=mode: compile_graph_plan(
+                graph, size=size, memory=memory, params=params, split=Split(len(gpus), mode, "dynamic", w)),
+                transfer=transfer)
+            configs.append(Config(name, mode, transfer, False, balance, plan, balance="dynamic"))
     return configs
 
 
@@ -123,6 +133,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--splits", default=None, help="default: per graph (pixels sort-first, mesh both)")
     parser.add_argument("--transfers", default="shared,staged")
     parser.add_argument("--pipelined", default="off,on")
+    parser.add_argument("--balances", default="static,dynamic",
+                        help="dynamic: one more sort-first configuration, not pipelined, bands from measured times")
     parser.add_argument("--triangles", type=int, default=100_000_000)
     parser.add_argument("--chunks", type=int, default=64)
     parser.add_argument("--iterations", type=int, default=4096)

@@ -35,12 +35,14 @@ class Config:
     serial: list[dict[str, Any]] = field(default_factory=list)
     stream_ms: list[float] = field(default_factory=list)
     warmup: dict[str, float] = field(default_factory=dict)
+    balance: str = "static"  # dynamic: the runner is an rgraph.vk.multi.balance.DynamicBalance
 
     @property
     def label(self) -> str:
         if self.split is None:
             return "one device"
-        return f"{self.split} {self.transfer}{' pipe' if self.pipelined else ''}"
+        return (f"{self.split} {self.transfer}{' pipe' if self.pipelined else ''}"
+                f"{' dyn' if self.balance == 'dynamic' else ''}")
 
     def warm(self, seconds: float, batch: int = 2) -> None:
         t0 = time.perf_counter()
@@ -85,7 +87,9 @@ class Config:
                 "frames": len(self.serial),
                 "stream_batches": len(self.stream_ms), "warmup": self.warmup,
                 "findings": sorted({f for s in self.serial for f in s["findings"]}),
-                "cut": (self.plan.multi_device or {}).get("cut") if self.split else None}
+                "cut": (self.plan.multi_device or {}).get("cut") if self.split else None, "balance": self.balance,
+                "plan_loads": getattr(self.runner, "loads", 1),
+                "bands": [list(r) for r in getattr(self.runner, "layouts", [])[-1:]]}
 
     def close(self) -> None:
         self.runner.close()

@@ -30,3 +30,15 @@ def test_benchmark_measures_every_configuration_alike(tmp_path):
     shared = [r for r in rows if r["transfer"] == "shared"]
     assert shared and all(r["copy_ms"] == 0.0 for r in shared)
     assert all(r["copy_ms"] > 0 for r in rows if r["transfer"] == "staged")
+
+
+def test_benchmark_dynamic_balance_configuration(tmp_path):
+    out = tmp_path / "dyn.json"
+    assert multi_gpu.main(["--devices", "0,0", "--size", "48x32", "--frames", "2", "--rounds", "1",
+                           "--warmup-s", "0.05", "--graphs", "pixels", "--iterations", "8", "--transfers", "shared",
+                           "--pipelined", "off", "--validate", "--out-json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [r["config"] for r in rows] == ["one device", "sort-first shared", "sort-first shared dyn"]
+    dyn = rows[-1]
+    assert dyn["balance"] == "dynamic" and dyn["plan_loads"] >= 1 and sum(dyn["bands"][0]) == 32
+    assert dyn["findings"] == [] and dyn["frames"] == 2

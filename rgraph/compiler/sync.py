@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
@@ -30,9 +31,9 @@ PERSISTENT = ("persistent", "imported")
 PREVIOUS_FRAME = -1
 
 
-@dataclass(frozen=True)
-class State:
-    """Where a cell stands: stages/access of the last accesses that later ones must wait for."""
+class State(NamedTuple):
+    """Where a cell stands: stages/access of the last accesses that later ones must wait for.
+    (A named tuple: hashed and compared in C, as barrier group keys are many.)"""
 
     stages: frozenset[str]
     access: frozenset[str]  # writes only
@@ -40,11 +41,13 @@ class State:
     queue: str | None
 
 
-@dataclass(frozen=True)
-class BarrierKey:
+class BarrierKey(NamedTuple):
     src: State
     dst: State
     aliases: tuple[str, ...] = ()
+
+
+EMPTY: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -94,10 +97,16 @@ class _Cell:
 
     def state(self) -> State:
         if self.reads:
-            return State(frozenset().union(*(s for _, s in self.reads)), frozenset(), self.layout, self.queue)
+            return State(self.read_stages(), EMPTY, self.layout, self.queue)
         if self.write:
             return State(self.write[1], self.write[2], self.layout, self.queue)
-        return State(frozenset(), frozenset(), self.layout, self.queue)
+        return State(EMPTY, EMPTY, self.layout, self.queue)
+
+    def read_stages(self) -> frozenset[str]:
+        reads = self.reads
+        if len(reads) == 1:
+            return reads[0][1]
+        return EMPTY.union(*(s for _, s in reads))
 
 
 @dataclass(frozen=True)
@@ -290,6 +299,7 @@ class _Simulation:
         self.resources = resources
         self.out = [PassSync() for _ in passes]
         self.cells: dict[Cell, _Cell] = {}
+        self.image = {name: res.is_image for name, res in resources.items()}
 
     def run(self, start: dict[Cell, _Cell]) -> None:
         self.cells = start
@@ -307,7 +317,7 @@ class _Simulation:
                     # A semaphore wait orders only its own stages, and a barrier chains after it only
                     # through its source stages: they must meet (the swapchain-acquire pattern).
                     if not key.src.stages:
-                        key = replace(key, src=replace(key.src, stages=frozenset(s.stages)))
+                        key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
                     wait_stages |= key.src.stages
                 if key is not None:
                     groups[(c[0], key, release_at)].append(c)
@@ -328,14 +338,14 @@ class _Simulation:
         uses = self.timeline[c]
         k = cell.cursor
         cell.cursor += 1
-        prev = cell.state()
-        if self._is_image(c):
+        if self.image[c[0]]:
             has_content = cell.layout not in (None, "UNDEFINED")
         else:
             has_content = not cell.aliases and (cell.write is not None or bool(cell.reads))
         cross = cell.queue is not None and cell.queue != queue
         release_at = None
-        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue]  # aliased memory used on another queue
+        # aliased memory used on another queue
+        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue] if cell.alias_waits else []
         if cross and cell.last_pass is not None and not cell.last_in_previous_frame:
             wait_on.append((cell.queue, cell.last_pass))  # earlier frames: the runtime's frame-boundary waits
         transfer = cross and has_content
@@ -346,7 +356,7 @@ class _Simulation:
         key: BarrierKey | None = None
         if write or layout_change:
             if cell.reads:
-                src = State(prev.stages, frozenset(), cell.layout, src_queue)
+                src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
             elif cell.write:
                 src = State(cell.write[1], cell.write[2], cell.layout, src_queue)
             else:
@@ -373,7 +383,7 @@ class _Simulation:
             seen = s.stages <= cell.visible[0] and s.access <= cell.visible[1]  # e.g. last frame's barrier
             if transfer or (cell.write and k > cell.covered_until and not seen):
                 if cell.reads:  # the write is already available: chain through the reads
-                    src = State(prev.stages, frozenset(), cell.layout, src_queue)
+                    src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
                 else:
                     src = State(cell.write[1] if cell.write else frozenset(), cell.write[2] if cell.write else frozenset(), cell.layout, src_queue)
                 dst_stages, dst_access = self._group(uses, k, s.layout, queue)
@@ -392,9 +402,6 @@ class _Simulation:
         cell.last_pass = i
         cell.last_in_previous_frame = False
         return key, release_at, wait_on
-
-    def _is_image(self, c: Cell) -> bool:
-        return self.resources[c[0]].is_image
 
     @staticmethod
     def _group_end(uses: list[_Use], k: int, layout: str | None, queue: str) -> int:
@@ -422,6 +429,11 @@ class _Simulation:
 def _rectangles(groups: Mapping[tuple, list[Cell]]) -> list[Barrier]:
     """Merge cells with one barrier into mip x layer rectangles (deterministic order); a group
     key is (resource, BarrierKey, ...)."""
+    if len(groups) == 1:
+        ((res, key, *_), cs), = groups.items()
+        if len(cs) == 1:  # one cell (every buffer): its own rectangle, nothing to sort
+            _, mip, layer = cs[0]
+            return [Barrier(res, (mip, mip + 1), (layer, layer + 1), key)]
     out = [Barrier(res, mips, layers, key)
            for (res, key, *_), cs in groups.items()
            for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]

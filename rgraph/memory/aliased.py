@@ -77,11 +77,13 @@ class ClassResult:
 def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
     lb = inst.lower_bound()
     best: ClassResult | None = None
-    for name, order in orderings(inst).items():
+    for name, order in orderings(inst):
         offsets = best_fit(inst, order)
         peak = inst.peak(offsets)
         if best is None or peak < best.peak:
             best = ClassResult(offsets, peak, lb, f"greedy:{name}")
+        if best.peak <= lb:
+            break  # proven optimal: no later ordering can be strictly better
     assert best is not None
     if best.peak <= lb or inst.n == 0 or not inst.separable:
         # Conflicts beyond time overlaps (cross-queue pairs) leave the time bound out of

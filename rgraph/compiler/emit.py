@@ -22,9 +22,15 @@ if TYPE_CHECKING:
 SIGNAL_STAGES = ("ALL_COMMANDS",)
 
 
+@lru_cache(maxsize=4096)
+def _names(values: frozenset[str]) -> tuple[str, ...]:
+    """A set of stage or access names as the plan's sorted tuple (frozensets cache their hash)."""
+    return tuple(sorted(values))
+
+
 @lru_cache(maxsize=65536)
 def plan_state(st: csync.State) -> pm.State:
-    return pm.State(tuple(sorted(st.stages)), tuple(sorted(st.access)), st.layout, st.queue)
+    return pm.State(_names(st.stages), _names(st.access), st.layout, st.queue)
 
 
 @lru_cache(maxsize=65536)
@@ -57,7 +63,7 @@ def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.En
 
 
 def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
-    return MappingProxyType(dict(sorted(mapping.items())))
+    return MappingProxyType(dict(sorted(mapping.items()))) if mapping else pm.EMPTY
 
 
 def _frozen_json(value: Any) -> Any:
@@ -78,7 +84,7 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
         ps = sync.passes[i]
         accesses = tuple(
             pm.Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
-                      tuple(sorted(s.stages)), tuple(sorted(s.access)), s.layout, a.write)
+                      _names(s.stages), _names(s.access), s.layout, a.write)
             for a, s in zip(p.accesses, sync.access_sync[i], strict=True)
         )
         out.append(pm.PlanPass(
@@ -86,7 +92,7 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
             accesses=accesses,
             barriers=tuple(_barrier(b, resources) for b in ps.barriers),
             releases=tuple(_barrier(b, resources) for b in ps.releases),
-            waits=tuple(pm.Wait(w.queue, signal_values[w.signal_pass], tuple(sorted(w.stages))) for w in ps.waits),
+            waits=tuple(pm.Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits),
             signals=(pm.Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
         ))
     return tuple(out)

@@ -302,36 +302,46 @@ class _Simulation:
         self.image = {name: res.is_image for name, res in resources.items()}
 
     def run(self, start: dict[Cell, _Cell]) -> None:
-        self.cells = start
+        self.cells = cells_now = start
+        step, out = self._step, self.out
         for i, p in enumerate(self.passes):
             # acquires grouped by their release pass too, so that each acquire's rectangles equal
             # its release's (the layer pairs ownership transfers by exact subresource range)
-            groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = defaultdict(list)
-            release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] = defaultdict(list)
+            groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = {}
+            release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] = {}
             waits: dict[str, tuple[int, set[str]]] = {}
+            queue = p.queue
             for c, (s, w) in self.per_pass_cells[i].items():
-                cell = self.cells[c]
-                key, release_at, wait_on = self._step(c, cell, i, p.queue, s, w)
-                wait_stages = set(s.stages)
-                if key is not None and wait_on and key.src.queue == p.queue:
-                    # A semaphore wait orders only its own stages, and a barrier chains after it only
-                    # through its source stages: they must meet (the swapchain-acquire pattern).
-                    if not key.src.stages:
-                        key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
-                    wait_stages |= key.src.stages
+                key, release_at, wait_on = step(c, cells_now[c], i, queue, s, w)
                 if key is not None:
-                    groups[(c[0], key, release_at)].append(c)
+                    if wait_on:
+                        wait_stages = set(s.stages)
+                        if key.src.queue == queue:
+                            # A semaphore wait orders only its own stages, and a barrier chains after it
+                            # only through its source stages: they must meet (the swapchain-acquire pattern).
+                            if not key.src.stages:
+                                key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
+                            wait_stages |= key.src.stages
+                    group = (c[0], key, release_at)
+                    if group in groups:
+                        groups[group].append(c)
+                    else:
+                        groups[group] = [c]
                     if release_at is not None:
-                        release_groups[(release_at, c[0], key)].append(c)
+                        release_groups.setdefault((release_at, c[0], key), []).append(c)
+                elif wait_on:
+                    wait_stages = set(s.stages)
                 for q, j in wait_on:
                     prev = waits.get(q)
                     waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
-            self.out[i].barriers = _rectangles(groups)
-            for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
-                self.out[j].releases.extend(_rectangles({(res, key): cs}))
-            for q, (j, stages) in sorted(waits.items()):
-                self.out[i].waits.append(Wait(q, j, frozenset(stages)))
-                self.out[j].signal = True
+            out[i].barriers = _rectangles(groups) if groups else []
+            if release_groups:
+                for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
+                    out[j].releases.extend(_rectangles({(res, key): cs}))
+            if waits:
+                for q, (j, stages) in sorted(waits.items()):
+                    out[i].waits.append(Wait(q, j, frozenset(stages)))
+                    out[j].signal = True
 
     def _step(self, c: Cell, cell: _Cell, i: int, queue: str, s: Sync, write: bool):
         """Update one cell for pass ``i``; return (barrier key, release pass, (queue, wait pass))."""
@@ -429,15 +439,17 @@ class _Simulation:
 def _rectangles(groups: Mapping[tuple, list[Cell]]) -> list[Barrier]:
     """Merge cells with one barrier into mip x layer rectangles (deterministic order); a group
     key is (resource, BarrierKey, ...)."""
-    if len(groups) == 1:
-        ((res, key, *_), cs), = groups.items()
-        if len(cs) == 1:  # one cell (every buffer): its own rectangle, nothing to sort
+    out = []
+    for (res, key, *_), cs in groups.items():
+        if len(cs) == 1:  # one cell (every buffer): its own rectangle
             _, mip, layer = cs[0]
-            return [Barrier(res, (mip, mip + 1), (layer, layer + 1), key)]
-    out = [Barrier(res, mips, layers, key)
-           for (res, key, *_), cs in groups.items()
-           for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
-    return sorted(out, key=_barrier_sort_key)
+            out.append(Barrier(res, (mip, mip + 1), (layer, layer + 1), key))
+        else:
+            out += [Barrier(res, mips, layers, key)
+                    for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
+    if len(out) > 1:
+        out.sort(key=_barrier_sort_key)
+    return out
 
 
 def mip_layer_rectangles(cells: Iterable[tuple[int, int]]) -> list[tuple[tuple[int, int], tuple[int, int]]]:

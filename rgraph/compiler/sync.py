@@ -81,7 +81,7 @@ class SyncResult:
     initial: dict[str, dict[Cell, State]]
 
 
-@dataclass
+@dataclass(slots=True)
 class _Cell:
     layout: str | None
     queue: str | None
@@ -109,8 +109,7 @@ class _Cell:
         return EMPTY.union(*(s for _, s in reads))
 
 
-@dataclass(frozen=True)
-class _Use:
+class _Use(NamedTuple):
     pass_pos: int
     sync: Sync
     write: bool
@@ -374,8 +373,7 @@ class _Simulation:
             if src.stages or src.access or layout_change or transfer:
                 dst_stages, dst_access = s.stages, s.access
                 if not write:  # a transition for a read group: cover the whole group
-                    dst_stages, dst_access = self._group(uses, k, s.layout, queue)
-                    cell.covered_until = self._group_end(uses, k, s.layout, queue)
+                    dst_stages, dst_access, cell.covered_until = self._group(uses, k, s.layout, queue)
                     cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             if write:
@@ -396,8 +394,7 @@ class _Simulation:
                     src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
                 else:
                     src = State(cell.write[1] if cell.write else frozenset(), cell.write[2] if cell.write else frozenset(), cell.layout, src_queue)
-                dst_stages, dst_access = self._group(uses, k, s.layout, queue)
-                cell.covered_until = self._group_end(uses, k, s.layout, queue)
+                dst_stages, dst_access, cell.covered_until = self._group(uses, k, s.layout, queue)
                 cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             cell.reads.append((i, s.stages))
@@ -423,14 +420,18 @@ class _Simulation:
             j += 1
         return j
 
-    def _group(self, uses: list[_Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str]]:
+    def _group(self, uses: list[_Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
+        """Stages and accesses of the read group starting at use ``k``, and its last use."""
         end = self._group_end(uses, k, layout, queue)
+        if end == k:
+            only = uses[k].sync
+            return only.stages, only.access, end
         stages: set[str] = set()
         access: set[str] = set()
         for u in uses[k : end + 1]:
             stages |= u.sync.stages
             access |= u.sync.access
-        return frozenset(stages), frozenset(access)
+        return frozenset(stages), frozenset(access), end
 
     def final_states(self) -> dict[Cell, State]:
         return {c: cell.state() for c, cell in self.cells.items()}

@@ -126,13 +126,14 @@ def emit(c: Compilation) -> pm.Plan:
     assert placement is not None and culling is not None
     passes = _passes(c)
     by_name = {p.name: p for p in spec.passes}
+    used = c.memory
     st = placement.stats
     return pm.Plan(
         graph=spec.name, source=spec.source, scene=spec.scene_name, scene_source=c.spec.scene_source,
         size=tuple(spec.size), params=_frozen(spec.params), features=_frozen(spec.features),
         device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if any(p.queue == q for p in passes)),
         passes=passes,
-        culled=tuple(_culled(x.pass_name, x.reason, by_name[x.pass_name], c) for x in culling.culled),
+        culled=tuple(_culled(x.pass_name, x.reason, by_name[x.pass_name], c, used) for x in culling.culled),
         dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
         resources=_resources(c),
         heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
@@ -146,9 +147,9 @@ def emit(c: Compilation) -> pm.Plan:
     )
 
 
-def _culled(name: str, reason: str, p: PassSpec, c: Compilation) -> pm.Culled:
-    """A culled pass with the resources only culled passes used, and their bytes."""
-    only = tuple(sorted({a.resource for a in p.accesses} - set(c.memory)))
+def _culled(name: str, reason: str, p: PassSpec, c: Compilation, used: Mapping[str, Any]) -> pm.Culled:
+    """A culled pass with the resources only culled passes used (not in ``used``), and their bytes."""
+    only = tuple(sorted({a.resource for a in p.accesses if a.resource not in used}))
     return pm.Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
 
 

@@ -65,7 +65,7 @@ class Wait:
     stages: frozenset[str]
 
 
-@dataclass
+@dataclass(slots=True)
 class PassSync:
     barriers: list[Barrier] = field(default_factory=list)
     releases: list[Barrier] = field(default_factory=list)

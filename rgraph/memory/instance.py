@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 from bisect import bisect_left
-from heapq import heappop, heappush
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from heapq import heappop, heappush
 
 import numpy as np
 
 from rgraph.memory.model import Block
-
 
 #: From this many blocks, neighbours come from a sweep over start times (cost in the pairs
 #: found) instead of one numpy row per block (cost n**2, cheap per element).

@@ -82,17 +82,18 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
     out = []
     for i, p in enumerate(passes):
         ps = sync.passes[i]
-        accesses = tuple(
+        accesses = tuple([
             pm.Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
                       _names(s.stages), _names(s.access), s.layout, a.write)
             for a, s in zip(p.accesses, sync.access_sync[i], strict=True)
-        )
+        ])
         out.append(pm.PlanPass(
             name=p.name, index=i, device=0, queue=p.queue, kind=p.kind, impl=p.impl, params=_frozen(p.params),
             accesses=accesses,
-            barriers=tuple(_barrier(b, resources) for b in ps.barriers),
-            releases=tuple(_barrier(b, resources) for b in ps.releases),
-            waits=tuple(pm.Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits),
+            barriers=tuple([_barrier(b, resources) for b in ps.barriers]) if ps.barriers else (),
+            releases=tuple([_barrier(b, resources) for b in ps.releases]) if ps.releases else (),
+            waits=tuple([pm.Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits])
+            if ps.waits else (),
             signals=(pm.Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
         ))
     return tuple(out)

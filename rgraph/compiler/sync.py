@@ -50,16 +50,14 @@ class BarrierKey(NamedTuple):
 EMPTY: frozenset[str] = frozenset()
 
 
-@dataclass(frozen=True)
-class Barrier:
+class Barrier(NamedTuple):
     resource: str
     mips: tuple[int, int] | None
     layers: tuple[int, int] | None
     key: BarrierKey
 
 
-@dataclass(frozen=True)
-class Wait:
+class Wait(NamedTuple):
     queue: str
     signal_pass: int  # executed index of the pass whose signal is waited for
     stages: frozenset[str]

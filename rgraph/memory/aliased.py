@@ -47,13 +47,12 @@ def overlapping_pairs(blocks: Sequence[Block]) -> int:
     """Ordered pairs (i, j), i != j, of blocks whose lifetimes overlap: n log n, no pair lists."""
     if not blocks:
         return 0
-    starts = np.sort(np.fromiter((b.start for b in blocks), dtype=np.int64, count=len(blocks)))
-    ends = np.sort(np.fromiter((b.end for b in blocks), dtype=np.int64, count=len(blocks)))
-    # j overlaps i iff start_j <= end_i and end_j >= start_i
-    total = 0
-    for b in blocks:
-        total += int(np.searchsorted(starts, b.end, side="right")) - int(np.searchsorted(ends, b.start, side="left"))
-    return total - len(blocks)
+    starts = np.fromiter((b.start for b in blocks), dtype=np.int64, count=len(blocks))
+    ends = np.fromiter((b.end for b in blocks), dtype=np.int64, count=len(blocks))
+    # j overlaps i iff start_j <= end_i and end_j >= start_i (no j ends before it starts)
+    began = np.searchsorted(np.sort(starts), ends, side="right")
+    ended = np.searchsorted(np.sort(ends), starts, side="left")
+    return int(began.sum() - ended.sum()) - len(blocks)
 
 
 def too_dense(blocks: Sequence[Block], time_budget_s: float) -> bool:

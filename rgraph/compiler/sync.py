@@ -342,7 +342,6 @@ class _Simulation:
 
     def _step(self, c: Cell, cell: _Cell, i: int, queue: str, s: Sync, write: bool):
         """Update one cell for pass ``i``; return (barrier key, release pass, (queue, wait pass))."""
-        uses = self.timeline[c]
         k = cell.cursor
         cell.cursor += 1
         if self.image[c[0]]:
@@ -367,21 +366,21 @@ class _Simulation:
             elif cell.write:
                 src = State(cell.write[1], cell.write[2], cell.layout, src_queue)
             else:
-                src = State(frozenset(), frozenset(), cell.layout, src_queue)
+                src = State(EMPTY, EMPTY, cell.layout, src_queue)
             if src.stages or src.access or layout_change or transfer:
                 dst_stages, dst_access = s.stages, s.access
                 if not write:  # a transition for a read group: cover the whole group
-                    dst_stages, dst_access, cell.covered_until = self._group(uses, k, s.layout, queue)
+                    dst_stages, dst_access, cell.covered_until = self._group(self.timeline[c], k, s.layout, queue)
                     cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             if write:
                 cell.write = (i, s.stages, s.writes)
                 cell.reads = []
                 cell.covered_until = k
-                cell.visible = (frozenset(), frozenset())
+                cell.visible = (EMPTY, EMPTY)
             else:
                 if layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
-                    cell.write = (i, s.stages, frozenset()) if cell.layout != "UNDEFINED" else None
+                    cell.write = (i, s.stages, EMPTY) if cell.layout != "UNDEFINED" else None
                 if layout_change:
                     cell.reads = []
                 cell.reads.append((i, s.stages))
@@ -391,8 +390,8 @@ class _Simulation:
                 if cell.reads:  # the write is already available: chain through the reads
                     src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
                 else:
-                    src = State(cell.write[1] if cell.write else frozenset(), cell.write[2] if cell.write else frozenset(), cell.layout, src_queue)
-                dst_stages, dst_access, cell.covered_until = self._group(uses, k, s.layout, queue)
+                    src = State(cell.write[1] if cell.write else EMPTY, cell.write[2] if cell.write else EMPTY, cell.layout, src_queue)
+                dst_stages, dst_access, cell.covered_until = self._group(self.timeline[c], k, s.layout, queue)
                 cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             cell.reads.append((i, s.stages))

@@ -53,6 +53,8 @@ def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.En
     frame), a per-cell list for the others (docs/plan.md)."""
     if not states:
         return None
+    if len(states) == 1:
+        return plan_state(next(iter(states.values())))
     distinct = set(states.values())
     if len(distinct) == 1:
         return plan_state(next(iter(distinct)))

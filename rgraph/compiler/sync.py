@@ -178,8 +178,9 @@ def synchronize(
     needed |= {p for preds in alias_sources.values() for p in preds}
     first = _Simulation(passes, per_pass_cells, timeline, resources)
     if needed:
-        first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
-        first.run({c: fresh(c) for c in timeline if c[0] in needed})
+        if not all(c[0] in needed for c in timeline):
+            first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
+        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})
     start: dict[Cell, _Cell] = {}
     for c in timeline:
         res = resources[c[0]]
@@ -297,6 +298,15 @@ class _Simulation:
         self.out = [PassSync() for _ in passes]
         self.cells: dict[Cell, _Cell] = {}
         self.image = {name: res.is_image for name, res in resources.items()}
+
+    def run_states(self, start: dict[Cell, _Cell]) -> None:
+        """``run`` for the cells' end states only: the barriers it would derive are not kept."""
+        self.cells = cells_now = start
+        step = self._step
+        for i, p in enumerate(self.passes):
+            queue = p.queue
+            for c, (s, w) in self.per_pass_cells[i].items():
+                step(c, cells_now[c], i, queue, s, w)
 
     def run(self, start: dict[Cell, _Cell]) -> None:
         self.cells = cells_now = start

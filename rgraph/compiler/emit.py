@@ -105,10 +105,11 @@ def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
     spec, sync, placement = c.spec, c.sync, c.placement
     assert sync is not None and placement is not None
     out = []
+    outputs = set(c.spec.outputs)
     for name in sorted(c.memory):
         res, mem = spec.resources[name], c.memory[name]
         heap, offset = placement.offsets[name]
-        lifetime = "output" if (name in c.spec.outputs and res.lifetime == "transient") else res.lifetime
+        lifetime = "output" if (name in outputs and res.lifetime == "transient") else res.lifetime
         image = res.is_image
         out.append(pm.PlanResource(
             name=name, kind=res.kind, format=res.format.vk_name if res.format else None, bytes=mem.bytes,

@@ -12,8 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from rgraph.scene.animation import Animator
 from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
 from rgraph.scene.deform import FRAME_SECONDS, Deformer
+from rgraph.scene.character import build_rig
 from rgraph.scene.generate import expand_lights
 from rgraph.scene.shapes import MeshData, make_shape
 from rgraph.spec.scene import Material, SceneFile, load_scene
@@ -39,6 +41,8 @@ class SceneMesh:
     positions: np.ndarray  # (instances, 3) world float64
     deformer: Deformer | None = None
     first_draw: int = 0
+    animator: Animator | None = None  # skinned meshes: one skeleton per instance
+    bone_base: int = 0  # the first entry of this mesh's bones in a logic state (rgraph.scene.skin_states)
 
     @property
     def instances(self) -> int:
@@ -50,6 +54,10 @@ class SceneMesh:
         if self.deformer is not None:
             pad = self.deformer.max_displacement
             lo, hi = lo - pad, hi + pad
+        if self.animator is not None:  # any pose: within the rest mesh's reach around the root joint
+            root = self.animator.rig.skeleton.heads[0]
+            reach = 1.02 * float(np.linalg.norm(self.data.positions - root, axis=1).max()) + 0.05
+            lo, hi = root - reach, root + reach
         corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
         out = []
         for p in self.positions:
@@ -107,6 +115,15 @@ class SceneData:
     @property
     def deformable(self) -> list[SceneMesh]:
         return [m for m in self.meshes if m.deformer is not None]
+
+    @property
+    def skinned(self) -> list[SceneMesh]:
+        return [m for m in self.meshes if m.animator is not None]
+
+    @property
+    def bone_count(self) -> int:
+        """Bone transforms in one logic state (every skinned instance's skeleton)."""
+        return sum(m.animator.bones * m.instances for m in self.skinned)
 
     @property
     def rigid(self) -> list[SceneMesh]:
@@ -190,16 +207,24 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
     model = pick_camera(model, camera)
     material_names = list(model.materials)
     materials = [model.materials[n] for n in material_names]
-    meshes, draw = [], 0
+    meshes, draw, bones = [], 0, 0
     for i, m in enumerate(model.meshes):
+        positions = _instance_positions(m)
+        animator = None
         try:
-            data = make_shape(m.shape, dict(m.params), seed=m.seed)
+            if m.skinned is not None:
+                rig = build_rig(m.skinned.bones)
+                data = rig.mesh
+                animator = Animator(rig, len(positions), m.skinned.speed, m.skinned.amplitude, m.skinned.seed)
+            else:
+                data = make_shape(m.shape, dict(m.params), seed=m.seed)
         except (ValueError, TypeError) as exc:
             raise ValueError(f"mesh {i} ({m.shape}): {exc}") from None
         scale = np.broadcast_to(np.asarray(m.scale, dtype=np.float64), (3,)).copy()
         mesh = SceneMesh(f"{i}:{m.shape}", data, material_names.index(m.material), tuple(m.rotation), scale,
-                         _instance_positions(m), Deformer(data) if m.deformable else None, draw)
+                         positions, Deformer(data) if m.deformable else None, draw, animator, bones)
         draw += mesh.instances
+        bones += animator.bones * mesh.instances if animator is not None else 0
         meshes.append(mesh)
     lights, layer = [], 0
     for li in expand_lights(model.lights):

@@ -18,6 +18,7 @@ SCENE_LIGHT_BYTES = 64
 DECAL_BYTES = 96
 LIGHT_BYTES = 64  # the graph's `lights` buffer entries (light_setup output)
 VERTEX_BYTES = 24  # vec3 position, vec3 normal
+DRAW_SKINNED = 2  # Draw.info.z flag (1: deformable); bits 8..31: the mesh's bone stride (instances)
 
 FRAME_OFFSETS = {
     "view": 0, "proj": 64, "view_proj": 128, "inv_view_proj": 192, "inv_proj": 256, "inv_view": 320,
@@ -107,6 +108,10 @@ def _draw_table(scene: SceneData) -> tuple[np.ndarray, np.ndarray]:
         for k, (_model, normal, material, mesh, flags) in enumerate(draws):
             rows[k, 16:32] = mat(normal)
             ints[k, 32:36] = (material, mesh, flags, 0)
+        for mesh in scene.skinned:  # scene.glsl Draw.info: skinned flag, bone stride, first bone entry
+            d = slice(mesh.first_draw, mesh.first_draw + mesh.instances)
+            ints[d, 34] |= DRAW_SKINNED | (mesh.instances << 8)
+            ints[d, 35] = mesh.bone_base + np.arange(mesh.instances)
         table = (world, rows)
         scene._packed_draw_table = table  # type: ignore[attr-defined]
     return table

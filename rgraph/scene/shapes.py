@@ -272,9 +272,16 @@ def segments(count=6, major=0.01, minor=0.002, spacing=0.008, sides=12, segments
     return merge(parts)
 
 
+def character() -> MeshData:
+    """The 256-bone skinned character in its rest pose (rgraph.scene.character)."""
+    from rgraph.scene.character import character as rest  # the rig imports this module
+
+    return rest()
+
+
 SHAPES: dict[str, Callable[..., MeshData]] = {
     "box": box, "sphere": sphere, "capsule": capsule, "cylinder": cylinder, "tube": tube, "torus": torus,
-    "plane": plane, "neck": neck, "blob": blob, "segments": segments,
+    "plane": plane, "neck": neck, "blob": blob, "segments": segments, "character": character,
 }
 CLOSED_SHAPES = tuple(s for s in SHAPES if s != "plane")
 

@@ -126,8 +126,18 @@ class Instances(_Strict):
         return self
 
 
+class Skinned(_Strict):
+    """FORMAT.md 7: a procedural skeleton animated by the scene's clock (rgraph.scene.animation)."""
+
+    bones: int = Field(256, ge=1, le=256)
+    speed: float = Field(1.0, ge=0, le=100)  # animation cycles per second (each character x 0.8..1.2)
+    amplitude: float = Field(1.0, ge=0, le=10)  # multiplies the template's joint angles
+    seed: int = 0  # per-character phases and speeds
+
+
 class Mesh(_Strict):
-    shape: Literal["box", "sphere", "cylinder", "capsule", "torus", "plane", "tube", "neck", "blob", "segments"]
+    shape: Literal["box", "sphere", "cylinder", "capsule", "torus", "plane", "tube", "neck", "blob", "segments",
+                   "character"]
     params: dict[str, float | int | list[float | int]] = Field(default_factory=dict)
     material: str
     deformable: bool = False
@@ -136,6 +146,15 @@ class Mesh(_Strict):
     scale: float | Vec3 = 1.0
     instances: Instances | None = None
     seed: int = 0
+    skinned: Skinned | None = None
+
+    @model_validator(mode="after")
+    def _skinned_character(self) -> Mesh:
+        if self.skinned is not None and self.shape != "character":
+            raise ValueError(f"skinned meshes must be 'shape: character' (the procedural rig), got {self.shape!r}")
+        if self.skinned is not None and self.deformable:
+            raise ValueError("a mesh is either skinned or deformable, not both")
+        return self
 
 
 class Decal(_Strict):

@@ -8,7 +8,9 @@ Built once per run from ``plan["scene_source"]`` by the executor (``Executor._sc
   in the same command buffer (a fence wait alone does not make device writes visible);
 - per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
   uniform, the Draws and Decals storage buffers (camera-relative, float64 on the CPU), and the
-  deformable meshes' vertices (deformed on the CPU every frame).
+  deformable meshes' vertices (deformed on the CPU every frame);
+- skinning (bindings 5-7, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights, the ring of
+  packed logic states and each set's interpolation factor.
 
 Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(frame_set)``,
 ``vertex_input`` and ``draw(rec, frame_set)``.
@@ -29,6 +31,7 @@ from rgraph.vk.passkit import VertexInput
 from rgraph.vk.resources import HostBuffer, memory_type
 
 BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS = range(5)
+BINDING_SKIN_VERTICES, BINDING_BONES, BINDING_SKIN_FRAME = range(5, 8)  # rgraph.vk.skin_gpu
 
 
 @dataclass(frozen=True)
@@ -59,6 +62,7 @@ class SceneGPU:
         self.device = device
         self.sets = sets
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
+        self.plan_logic_hz = plan.get("logic_hz")  # skinning's logic rate (default 60 Hz)
         try:
             self.data: SceneData = load_scene_data(source, self.extent, int(plan.get("camera", 0)))
         except (OSError, ValueError) as exc:
@@ -66,6 +70,7 @@ class SceneGPU:
         self._device_buffers: list[_DeviceBuffer] = []
         self._host: list[HostBuffer] = []
         self._pool = None
+        self.skin = None
         self.set_layout = None
         self._sets: list[Any] = []
         try:
@@ -140,10 +145,13 @@ class SceneGPU:
         rigid_vertices, indices, calls = [], [], []
         rigid_base = deform_base = first_index = 0
         self._deform_layout: list[tuple[Any, int]] = []  # (mesh, vertex offset) in the per-set buffers
+        skinned: list[tuple[Any, int]] = []  # (mesh, first vertex in the rigid vertex buffer)
         for mesh in data.meshes:
             count = mesh.data.triangle_count * 3
             indices.append(mesh.data.indices.reshape(-1))
             if mesh.deformer is None:
+                if mesh.animator is not None:
+                    skinned.append((mesh, rigid_base))
                 rigid_vertices.append(packing.vertex_bytes(mesh.data))
                 calls.append(DrawCall(False, count, first_index, rigid_base, mesh.instances, mesh.first_draw))
                 rigid_base += mesh.data.vertex_count
@@ -168,6 +176,10 @@ class SceneGPU:
         self.scene_lights_buffer = self._device_buffer(len(scene_lights), storage)
         uploads.append((self.scene_lights_buffer, scene_lights))
         self._upload(submit_once, [(b, d) for b, d in uploads if d])
+        from rgraph.vk.skin_gpu import SkinGPU
+
+        self.skin = SkinGPU(self.device, data, self.sets, skinned, rigid_base,
+                            float(self.plan_logic_hz) if self.plan_logic_hz else 60.0)
 
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]
@@ -218,13 +230,14 @@ class SceneGPU:
         dev = self.device.handle
         ubo, ssbo = v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
         kinds = [(BINDING_FRAME, ubo), (BINDING_DRAWS, ssbo), (BINDING_MATERIALS, ssbo),
-                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo)]
+                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo), (BINDING_SKIN_VERTICES, ssbo),
+                 (BINDING_BONES, ssbo), (BINDING_SKIN_FRAME, ubo)]
         bindings = [v.VkDescriptorSetLayoutBinding(binding=b, descriptorType=t, descriptorCount=1,
                                                    stageFlags=v.VK_SHADER_STAGE_ALL) for b, t in kinds]
         self.set_layout = v.vkCreateDescriptorSetLayout(dev, v.VkDescriptorSetLayoutCreateInfo(
             bindingCount=len(bindings), pBindings=bindings), None)
-        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=self.sets),
-                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=4 * self.sets)]
+        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=2 * self.sets),
+                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=6 * self.sets)]
         self._pool = v.vkCreateDescriptorPool(dev, v.VkDescriptorPoolCreateInfo(
             maxSets=self.sets, poolSizeCount=len(sizes), pPoolSizes=sizes), None)
         self._sets = list(v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
@@ -235,6 +248,8 @@ class SceneGPU:
                        (BINDING_MATERIALS, ssbo, self.materials_buffer.handle, materials_size),
                        (BINDING_SCENE_LIGHTS, ssbo, self.scene_lights_buffer.handle, lights_size),
                        (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size)]
+            skin = [*self.skin.descriptors(), self.skin.frame_descriptor(s)]
+            sources += [(b, ubo if kind == "uniform" else ssbo, buf.handle, size) for b, kind, buf, size in skin]
             infos = [v.VkDescriptorBufferInfo(buffer=h, offset=0, range=size) for _b, _t, h, size in sources]
             writes = [v.VkWriteDescriptorSet(dstSet=self._sets[s], dstBinding=b, descriptorCount=1, descriptorType=t,
                                              pBufferInfo=[info])
@@ -252,6 +267,7 @@ class SceneGPU:
         for mesh, base in self._deform_layout:
             self.deform_buffers[frame_set].write(packing.vertex_bytes(data.deformed(mesh, frame)),
                                                  base * packing.VERTEX_BYTES)
+        self.skin.update(data.seconds(frame), frame_set)
 
     def draw(self, rec: Any, frame_set: int, share: Any = None) -> None:
         """Bind vertex and index buffers and record one drawIndexed per mesh
@@ -289,6 +305,9 @@ class SceneGPU:
         for buf in reversed(self._host):
             buf.destroy()
         self._host = []
+        if self.skin is not None:
+            self.skin.destroy()
+            self.skin = None
         for buf in reversed(self._device_buffers):
             v.vkDestroyBuffer(dev, buf.handle, None)
             v.vkFreeMemory(dev, buf.memory, None)

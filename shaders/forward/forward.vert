@@ -10,8 +10,10 @@ layout(location = 2) flat out uint out_material;
 
 void main() {
     uint d = uint(gl_InstanceIndex);
-    out_world = scene_world_position(in_position, d).xyz;
-    out_normal = mat3(draws[d].normal_matrix) * in_normal;
+    vec3 position = in_position, normal = in_normal;
+    scene_vertex_pose(position, normal, d);
+    out_world = scene_world_position(position, d).xyz;
+    out_normal = mat3(draws[d].normal_matrix) * normal;
     out_material = draws[d].info.x;
-    gl_Position = scene_clip_position(in_position, d);
+    gl_Position = scene_clip_position(position, d);
 }

@@ -8,6 +8,6 @@ layout(location = 0) flat out uint v_draw;
 
 void main() {
     uint draw = uint(gl_InstanceIndex);
-    gl_Position = scene_clip_position(in_position, draw);
+    gl_Position = scene_clip_position(scene_vertex_position(in_position, draw), draw);
     v_draw = draw;
 }

@@ -5,5 +5,6 @@
 #include "scene/scene_vertex.glsl"
 
 void main() {
-    gl_Position = scene_clip_position(in_position, uint(gl_InstanceIndex));
+    uint d = uint(gl_InstanceIndex);
+    gl_Position = scene_clip_position(scene_vertex_position(in_position, d), d);
 }

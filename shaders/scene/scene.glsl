@@ -52,7 +52,10 @@ layout(set = 0, binding = 0, std140) uniform Frame {
 struct Draw {
     mat4 model;           //   0  object -> camera-relative world
     mat4 normal_matrix;   //  64  inverse-transpose of model's 3x3 (in a mat4; use mat3(normal_matrix))
-    uvec4 info;           // 128  (material index, mesh index, flags: 1 = deformable, 0)
+    uvec4 info;           // 128  (material index, mesh index, flags, first bone entry)
+                          //      flags: 1 = deformable, 2 = skinned (scene/skinning.glsl); bits 8..31 of a
+                          //      skinned draw: its mesh's bone stride (instances); w: its skeleton's first
+                          //      bone entry in a logic state (bone b at w + b * stride)
 };
 layout(set = 0, binding = 1, std430) readonly buffer Draws { Draw draws[]; };
 

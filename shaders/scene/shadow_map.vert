@@ -10,6 +10,7 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-    gl_Position = frame.shadow_view_proj[pc.shadow.x] * scene_world_position(in_position, uint(gl_InstanceIndex));
+    uint d = uint(gl_InstanceIndex);
+    gl_Position = frame.shadow_view_proj[pc.shadow.x] * scene_world_position(scene_vertex_position(in_position, d), d);
     gl_Layer = pc.shadow.y;
 }

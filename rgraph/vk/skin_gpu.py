@@ -1,0 +1,146 @@
+"""Skinning data on the GPU: set 0 bindings 5-7 of ``shaders/scene/scene.glsl`` (owned by SceneGPU).
+
+- binding 5 ``SkinVertices``: per vertex of the rigid vertex buffer (indexed by
+  ``gl_VertexIndex``), 4 joint indices (uint8) and 4 weights (unorm8) as a ``uvec2``; written
+  once (zeros outside skinned meshes). A 16-byte placeholder when the scene has no skinning.
+- binding 6 ``Bones``: a header, then a ring of logic-state slots. Header: per scene mesh
+  (``Draw.info.y``) a ``uvec4`` whose x is the first entry of that mesh's rest joint positions
+  (``head``, float32 bits in xyz), then those heads. A slot: the packed joint transforms of
+  every skinned instance (rgraph.scene.skinning: 16 bytes per bone, bone-major per mesh). Each
+  logic state is packed and written once, into a slot no frame in flight reads; the study's
+  "two bone textures" are the two slots a frame set names.
+- binding 7 ``SkinFrame`` (per frame set, std140): ``(alpha, previous slot's first entry,
+  current slot's first entry, 0)``; the vertex shader interpolates previous -> current.
+
+Logic time: frame ``f`` shows ``interpolate(state k - 1, state k, alpha)`` with
+``(k, alpha) = logic_tick(f / 60 s, logic_hz)`` (rgraph.scene.animation); the logic rate is
+``plan["logic_hz"]`` (default 60). A logic thread can publish states through
+:meth:`SkinGPU.show` instead.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from rgraph.scene.animation import LOGIC_HZ, logic_tick
+from rgraph.scene.build import SceneData
+from rgraph.scene.skinning import BONE_BYTES
+from rgraph.vk.device import Device
+from rgraph.vk.resources import HostBuffer
+
+SKIN_VERTEX_BYTES = 8
+SKIN_FRAME_BYTES = 16
+
+
+class SkinGPU:
+    """See the module docstring. ``rigid_bases``: (mesh, first vertex in the rigid vertex
+    buffer) of every skinned mesh; ``rigid_vertices``: that buffer's vertex count."""
+
+    def __init__(self, device: Device, data: SceneData, sets: int, rigid_bases: list[tuple[Any, int]],
+                 rigid_vertices: int, logic_hz: float = LOGIC_HZ) -> None:
+        from rgraph.vk.loader import vk
+
+        v = vk()
+        self.data, self.sets, self.logic_hz = data, sets, float(logic_hz)
+        self.meshes = list(rigid_bases)
+        self.bones = data.bone_count
+        self.slots = 2 * sets  # every other set holds at most two, this one needs two
+        self._buffers: list[HostBuffer] = []
+        storage, uniform = v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
+        active = self.bones > 0
+        self.vertex_bytes = rigid_vertices * SKIN_VERTEX_BYTES if active else 16
+        self.vertices = self._buffer(device, self.vertex_bytes, storage)
+        if active:
+            table = np.zeros((rigid_vertices, 2), dtype=np.uint32)
+            for mesh, base in rigid_bases:
+                rig = mesh.animator.rig
+                rows = slice(base, base + mesh.data.vertex_count)
+                table[rows, 0] = rig.joints.astype(np.uint32) @ (1 << np.arange(0, 32, 8, dtype=np.uint32))
+                table[rows, 1] = rig.weights.astype(np.uint32) @ (1 << np.arange(0, 32, 8, dtype=np.uint32))
+            self.vertices.write(table.tobytes())
+        header = self._header(data)
+        self.header = len(header)  # entries before the first slot
+        self.bones_bytes = max((self.header + self.slots * self.bones) * BONE_BYTES, 16)
+        self.ring = self._buffer(device, self.bones_bytes, storage)
+        self.ring.write(header.tobytes())
+        self.frames = [self._buffer(device, SKIN_FRAME_BYTES, uniform) for _ in range(sets)]
+        for buf in self.frames:
+            buf.write(bytes(SKIN_FRAME_BYTES))
+        self._slot_tick: list[int | None] = [None] * self.slots
+        self._held: list[tuple[int, int]] = [(-1, -1)] * sets  # slots each set's frame reads
+        self._states: dict[int, np.ndarray] = {}
+
+    @staticmethod
+    def _header(data: SceneData) -> np.ndarray:
+        """(entries, 4) uint32: per scene mesh its heads' first entry, then every skinned mesh's heads."""
+        if not data.bone_count:
+            return np.zeros((0, 4), dtype=np.uint32)
+        table = np.zeros((len(data.meshes), 4), dtype=np.uint32)
+        heads, entry = [], len(data.meshes)
+        for k, mesh in enumerate(data.meshes):
+            if mesh.animator is not None:
+                h = mesh.animator.rig.skeleton.heads.astype(np.float32)
+                table[k, 0] = entry
+                heads.append(np.concatenate([h, np.zeros((len(h), 1), np.float32)], axis=1).view(np.uint32))
+                entry += len(h)
+        return np.concatenate([table, *heads])
+
+    def _buffer(self, device: Device, size: int, usage: int) -> HostBuffer:
+        buf = HostBuffer.create(device, size, usage)
+        self._buffers.append(buf)
+        return buf
+
+    @property
+    def active(self) -> bool:
+        return self.bones > 0
+
+    def descriptors(self) -> list[tuple[int, str, Any, int]]:
+        """(binding, kind, buffer, range) for SceneGPU's descriptor writes."""
+        return [(5, "storage", self.vertices, self.vertex_bytes), (6, "storage", self.ring, self.bones_bytes)]
+
+    def frame_descriptor(self, frame_set: int) -> tuple[int, str, Any, int]:
+        return (7, "uniform", self.frames[frame_set], SKIN_FRAME_BYTES)
+
+    def state(self, tick: int) -> np.ndarray:
+        """Logic state ``tick``: every skinned mesh's packed bones, concatenated (cached: two)."""
+        got = self._states.get(tick)
+        if got is None:
+            parts = [m.animator.state(tick, self.logic_hz).reshape(-1, 8) for m in self.data.skinned]
+            got = np.concatenate(parts) if len(parts) > 1 else parts[0]
+            self._states = {k: s for k, s in self._states.items() if k >= tick - 1}
+            self._states[tick] = got
+        return got
+
+    def _slot_of(self, tick: int, frame_set: int, keep: int) -> int:
+        if tick in self._slot_tick:
+            return self._slot_tick.index(tick)
+        busy = {s for k, held in enumerate(self._held) if k != frame_set for s in held} | {keep}
+        slot = next(s for s in range(self.slots) if s not in busy)
+        start = (self.header + slot * self.bones) * BONE_BYTES
+        self.ring.mapped[start:start + self.bones * BONE_BYTES] = memoryview(np.ascontiguousarray(self.state(tick))).cast("B")
+        self._slot_tick[slot] = tick
+        return slot
+
+    def show(self, frame_set: int, previous: int, current: int, alpha: float) -> None:
+        """Frame set ``frame_set`` (its last frame finished) draws logic states ``previous`` ->
+        ``current`` at ``alpha`` in [0, 1]."""
+        if not self.active:
+            return
+        a = self._slot_of(previous, frame_set, -1)
+        b = self._slot_of(current, frame_set, a)
+        self._held[frame_set] = (a, b)
+        alpha = min(max(float(alpha), 0.0), 1.0)
+        first = np.array([self.header + a * self.bones, self.header + b * self.bones, 0], dtype=np.uint32)
+        self.frames[frame_set].write(np.float32(alpha).tobytes() + first.tobytes())
+
+    def update(self, seconds: float, frame_set: int) -> None:
+        """The frame at render time ``seconds``: states k - 1 -> k at alpha (module docstring)."""
+        tick, alpha = logic_tick(seconds, self.logic_hz)
+        self.show(frame_set, tick - 1, tick, alpha)
+
+    def destroy(self) -> None:
+        for buf in reversed(self._buffers):
+            buf.destroy()
+        self._buffers = []

@@ -27,7 +27,7 @@ void visit(Tri tri, ivec2 px) {
     uint key;
     if (!cover(tri, px, key)) return;
 #ifdef MODE_ID
-    if (imageLoad(depth_keys, px).r == key) imageAtomicMax(visibility, px, tri.id);
+    if (key_matches(key, imageLoad(depth_keys, px).r)) imageAtomicMax(visibility, px, tri.id);
 #else
     if (imageLoad(depth_keys, px).r < key) imageAtomicMax(depth_keys, px, key);
 #endif

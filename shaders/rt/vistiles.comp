@@ -43,7 +43,7 @@ void main() {
             uint key;
             if (!cover(tri, px, key)) continue;
 #ifdef MODE_ID
-            if (imageLoad(depth_keys, px).r == key) imageAtomicMax(visibility, px, tri.id);
+            if (key_matches(key, imageLoad(depth_keys, px).r)) imageAtomicMax(visibility, px, tri.id);
 #else
             if (imageLoad(depth_keys, px).r < key) imageAtomicMax(depth_keys, px, key);
 #endif

@@ -174,4 +174,14 @@ bool rect_may_cover(Tri tri, ivec2 lo, ivec2 hi) {
 const uint KEY_ULPS = 2u;
 bool key_matches(uint key, uint stored) { return key + KEY_ULPS >= stored && key <= stored + KEY_ULPS; }
 
+// A big triangle's setup, stored once by the depth pass for its tile jobs (binding 10): both tile
+// passes read the same record, so they rasterize with identical values and skip the setup.
+struct TriRecord { vec4 c0, c1, c2, n; ivec4 box; };  // c*.w: eps, n.w: the id's bits
+TriRecord pack_tri(Tri t) {
+    return TriRecord(vec4(t.c0, t.eps.x), vec4(t.c1, t.eps.y), vec4(t.c2, t.eps.z), vec4(t.n, uintBitsToFloat(t.id)), t.box);
+}
+Tri unpack_tri(TriRecord r) {
+    return Tri(r.c0.xyz, r.c1.xyz, r.c2.xyz, r.n.xyz, vec3(r.c0.w, r.c1.w, r.c2.w), r.box, floatBitsToUint(r.n.w));
+}
+
 uint pixels_of(Tri tri) { return uint(tri.box.z - tri.box.x + 1) * uint(tri.box.w - tri.box.y + 1); }

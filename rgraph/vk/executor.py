@@ -65,7 +65,7 @@ class Executor:
     def __init__(self, plan: dict, *, validate: bool, device_index: int | None, verbose: bool = True,
                  inputs: dict[str, Any] | None = None, one_call_per_queue: bool = True,
                  workarounds: Iterable[str] = LAYER_WORKAROUNDS, instance: Instance | None = None,
-                 device: Device | None = None) -> None:
+                 device: Device | None = None, external: dict[str, list[Any]] | None = None) -> None:
         if plan.get("format") != "rgraph-plan/1":
             raise ExecutionError("not an rgraph plan (format != rgraph-plan/1)")
         self.source_plan = plan
@@ -73,6 +73,7 @@ class Executor:
         self.verbose = verbose
         self.one_call_per_queue = one_call_per_queue
         self.inputs = dict(inputs or {})
+        self.external = dict(external or {})  # resource -> caller's VkBuffer per set (rgraph.vk.resources)
         self.owns_device = device is None
         self.scene_gpu: Any = None
         self.samplers: dict[str, Any] = {}

@@ -22,7 +22,7 @@ def create(ex: Any) -> None:
         if p.get("device", 0) != 0:
             raise ExecutionError(f"pass {p['name']!r}: multi-device plans are not supported")
     ex.log.context = "creating resources"
-    ex.resources = ResourceSet(dev, ex.plan, FRAMES_IN_FLIGHT)
+    ex.resources = ResourceSet(dev, ex.plan, FRAMES_IN_FLIGHT, external=ex.external)
     ex.log.context = "initialising persistent resources"
     one_time.init_shared(ex)
     if any(r["kind"] == "accel" for r in ex.plan["resources"]):

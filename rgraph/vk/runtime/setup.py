@@ -62,6 +62,21 @@ def scene(ex: Any) -> Any:
     return ex.scene_gpu
 
 
+def attach_logic(ex: Any, hz: float) -> None:
+    """A logic thread at ``hz`` for the scene (``rgraph.vk.runtime.logic``; without a scene it
+    ticks with nothing to compute); ``run_frames`` starts and stops it."""
+    from rgraph.vk.runtime.logic import LogicThread
+
+    try:
+        scene = ex.scene_gpu
+        lock = scene.deform.lock if scene is not None and scene.deform is not None else None
+        ex.logic = LogicThread(scene.logic_step if scene is not None else (lambda _s: None), hz, lock=lock)
+    except ValueError as exc:
+        raise ExecutionError(str(exc)) from None
+    if ex.scene_gpu is not None:
+        ex.scene_gpu.attach_logic(ex.logic)
+
+
 def pool(ex: Any, family: int, set_index: int) -> Any:
     """The command pool of ``family`` for frame-in-flight set ``set_index`` (FRAMES_IN_FLIGHT:
     one-time work), created on first use."""

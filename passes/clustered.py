@@ -31,6 +31,7 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, PassSetup, pack
 
+from .gpu_draw import draw_args
 from .scene_passes import SCENE_FRONT_FACE
 
 MODES = ("clustered", "all_lights")
@@ -158,7 +159,7 @@ class ForwardClustered(PassImpl):
     def record(self, rec, frame_set: int) -> None:
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
         rec.push(self.pipeline, self.push)
-        self.scene.draw(rec, frame_set)
+        self.scene.draw(rec, frame_set, args=draw_args(self.setup, frame_set))
 
 
 @register("cluster_heatmap")

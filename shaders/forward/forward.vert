@@ -11,7 +11,7 @@ layout(location = 2) flat out uint out_material;
 void main() {
     uint d = uint(gl_InstanceIndex);
     out_world = scene_world_position(in_position, d).xyz;
-    out_normal = mat3(draws[d].normal_matrix) * in_normal;
-    out_material = draws[d].info.x;
+    out_normal = scene_normal3(d) * in_normal;
+    out_material = scene_info(d).x;
     gl_Position = scene_clip_position(in_position, d);
 }

@@ -32,6 +32,7 @@ class DepthPrepass(PassImpl):
 
     clear_values = {"depth": 0.0}
     attachment_load = {"depth": "clear"}
+    multiview = True
 
     def __init__(self, setup):
         super().__init__(setup)

@@ -135,3 +135,16 @@ def test_stereo_layers_equal_mono_images_from_each_eye(tmp_path):
         _plan, mono = render(mono_path, size=SIZE)
         diff = np.abs(stereo[eye] - srgb_codes(mono))
         assert diff.max() <= 1, f"eye {eye}: max diff {diff.max()} codes at {np.argwhere(diff > 1)[:5].tolist()}"
+
+
+@pytest.mark.vulkan
+@pytest.mark.slow
+def test_vr_benchmark_smoke(capsys):
+    """benchmarks/vr_tests.py end to end at a tiny size: a row per view count and mode, figures > 0."""
+    from benchmarks.vr_tests import main
+
+    assert main(["--size", "32x18", "--frames", "2", "--warmup", "0.3", "--tests", "lighting", "--views", "1,2"]) == 0
+    out = capsys.readouterr().out
+    for line in ("lighting views=1 gpu", "lighting views=1 naive", "lighting views=2 gpu", "lighting views=2 naive"):
+        assert line in out
+    assert "| lighting | 2 | 969 |" in out

@@ -2,13 +2,16 @@
 
 Built once per run from ``plan["scene_source"]`` by the executor (``Executor._scene``):
 
-- rigid geometry (every mesh's vertices; all indices), the materials and the authored lights
+- rigid geometry (every mesh's vertices; all indices, placed by the TLSF allocator in one
+  buffer each), the materials, the authored lights, the mesh table (binding 6) and, with
+  ``draw.mode=gpu`` (``rgraph.vk.scene_modes``), the persistent per-instance data (binding 1)
   live in device-local buffers, filled once through a host staging buffer and
   ``vkCmdCopyBuffer`` followed by a buffer barrier COPY/TRANSFER_WRITE -> ALL_COMMANDS/MEMORY_READ
   in the same command buffer (a fence wait alone does not make device writes visible);
 - per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
-  uniform, the Draws and Decals storage buffers (camera-relative, float64 on the CPU), and the
-  deformable meshes' vertices (deformed on the CPU every frame).
+  uniform, the Views uniform (binding 5, ``views=2``), the Draws (draw modes cpu and naive) and
+  Decals storage buffers (camera-relative, float64 on the CPU), naive mode's per-object draw
+  commands, and the deformable meshes' vertices (deformed on the CPU every frame).
 
 Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(frame_set)``,
 ``vertex_input`` and ``draw(rec, frame_set)``.
@@ -19,6 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from rgraph.memory.tlsf import Tlsf
+from rgraph.scene import instances as scene_instances
 from rgraph.scene import packing
 from rgraph.scene.build import SceneData, load_scene_data
 from rgraph.vk import names
@@ -26,12 +31,11 @@ from rgraph.vk.device import Device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
-from rgraph.memory.tlsf import Tlsf
-from rgraph.scene import instances as scene_instances
 from rgraph.vk.resources import HostBuffer, memory_type
 from rgraph.vk.scene_modes import draw_mode, view_count
 
-BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS, BINDING_VIEWS, BINDING_MESHES = range(7)
+(BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS, BINDING_VIEWS,
+ BINDING_MESHES) = range(7)
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,9 @@ from typing import Any
 
 from rgraph.vk.lower import LAYER_WORKAROUNDS, QueueLayout, Recording
 
+#: Seconds of untimed frames before timed ones on a GPU (``Gpu.default_warmup_s``).
+WARMUP_S = 0.3
+
 
 @dataclass
 class RunSummary:
@@ -89,6 +92,13 @@ class Gpu:
     def messages(self) -> list[Any]:
         """Every validation message logged on this instance so far."""
         return list(self.instance.log.messages)
+
+    @property
+    def default_warmup_s(self) -> float:
+        """Warm-up before timed frames: ``WARMUP_S`` on a GPU (the H200 idles at low clocks:
+        its first frames ran about 3x slower), none on a CPU device (lavapipe has no clocks
+        to raise, and CI time matters)."""
+        return 0.0 if self.choice["type"] == "cpu" else WARMUP_S
 
     def memory_requirements(self) -> Any:
         """The live device's memory-requirements provider (``rgraph.vk.memreq``)."""
@@ -180,6 +190,22 @@ class Executable:
         timings = self.executor.run_frames(frames, marks)
         return RunSummary(timings, log[first:], self.executor.frames_done)
 
+    def warm_up(self, seconds: float) -> int:
+        """Run untimed frames for about ``seconds`` of wall time (at least one frame when
+        ``seconds`` > 0) so that a GPU that idles at low clocks is at its working clocks when
+        timing starts; the frames count (the data check knows them). Returns the frames run."""
+        if seconds <= 0:
+            return 0
+        import time
+
+        done, start, batch = 0, time.perf_counter(), 1
+        while True:
+            self.executor.run_frames(batch)
+            done += batch
+            if time.perf_counter() - start >= seconds:
+                return done
+            batch = min(2 * batch, 64)
+
     def read_back(self) -> dict[tuple, bytes]:
         """Raw bytes per (resource, mip, layer) of outputs, persistent and imported resources."""
         return self.executor.read_back()
@@ -191,10 +217,11 @@ class Executable:
         return decode_outputs(self.plan, self.read_back())
 
     def run_and_check(self, frames: int, *, check_data: bool, out_png: Path | None = None,
-                      read_outputs: bool = False) -> Any:
-        """Run, read back when needed, check the probe's data (``rgraph.probe.check``), write
-        the PNG and close this executable (the device stays open): an
-        ``rgraph.vk.executor.RunResult`` with the messages logged from load to close."""
+                      read_outputs: bool = False, warmup_s: float | None = None) -> Any:
+        """Warm up (``warmup_s`` seconds; None: ``default_warmup_s`` of the device), run, read
+        back when needed, check the probe's data (``rgraph.probe.check``), write the PNG and
+        close this executable (the device stays open): an ``rgraph.vk.executor.RunResult``
+        with the messages logged from load to close."""
         from rgraph.png import first_output_image, write_output_png
         from rgraph.probe.check import check_outputs
         from rgraph.vk.errors import ExecutionError
@@ -204,6 +231,7 @@ class Executable:
         try:
             if out_png is not None and first_output_image(self.plan) is None:
                 raise ExecutionError("--out: the plan has no output image")
+            self.warm_up(self.gpu.default_warmup_s if warmup_s is None else warmup_s)
             summary = self.run(frames)
             result = RunResult([], summary.timings, None, self.gpu.name)
             if check_data or read_outputs or out_png is not None:

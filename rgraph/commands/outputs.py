@@ -21,6 +21,17 @@ COMMAND_LINE = "<command line>"
 MAX_FRAMES = 1_000_000
 
 
+def warmup_seconds(text: str) -> float:
+    """argparse type for ``--warmup``: seconds in 0..600 (NaN and inf refused)."""
+    try:
+        value = float(text) if len(text) <= 12 else None
+    except ValueError:
+        value = None
+    if value is None or not 0.0 <= value <= 600.0:
+        raise argparse.ArgumentTypeError(f"expected seconds in 0..600, got {quote(text)}")
+    return value
+
+
 def frame_count(text: str) -> int:
     """argparse type for ``--frames``: an integer in 1..MAX_FRAMES (``1e20`` is refused)."""
     try:

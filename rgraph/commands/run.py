@@ -27,6 +27,7 @@ from rgraph.commands.outputs import (
     check_pass_params,
     frame_count,
     output_path,
+    warmup_seconds,
     write_output,
 )
 from rgraph.errors import RGraphError
@@ -45,6 +46,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     add_sync_argument(parser)
     parser.add_argument("--frames", type=frame_count, default=1, help="frames to run (default 1)")
+    parser.add_argument("--warmup", type=warmup_seconds, default=None, metavar="SECONDS",
+                        help="untimed frames before the timed ones (default: 0.3 s on a GPU, none on a CPU device)")
     parser.add_argument("--validate", action="store_true",
                         help="Khronos validation + synchronization validation; exit 1 on any message")
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
@@ -238,7 +241,7 @@ def run(args: argparse.Namespace) -> int:
                                                       "(see graphs/clustered.yaml)")
             exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else ())
             result = exe.run_and_check(args.frames, check_data=args.validate if args.check_data is None
-                                       else args.check_data, out_png=args.out,
+                                       else args.check_data, out_png=args.out, warmup_s=args.warmup,
                                        read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
             result.messages = gpu.close()  # the device's teardown included
     except (VulkanUnavailable, ExecutionError) as exc:

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
+from rgraph.commands.outputs import warmup_seconds
 from rgraph.errors import RGraphError
 
 PLOT_METRICS = ("flip", "ssim", "psnr", "hdr_flip", "hdr_rel_mse", "hdr_log_psnr")
@@ -26,6 +27,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="param of the reference setting (repeatable; default: the graph's defaults)")
     parser.add_argument("--grid", action="store_true", help="every combination of the knobs' values")
     parser.add_argument("--frames", type=int, default=8, help="frames per setting; times are medians (default 8)")
+    parser.add_argument("--warmup", type=warmup_seconds, default=None, metavar="SECONDS",
+                        help="untimed frames before each setting's timed ones (default: 0.3 s on a GPU, none on a CPU device)")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     parser.add_argument("--hdr", metavar="RESOURCE",
@@ -59,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     request = SweepRequest(
         graph=args.graph, knobs=[parse_knob(k) for k in args.knob], scene=args.scene,
         base=parse_params(args.param), reference=parse_assignments(args.reference, "--reference"),
-        grid=args.grid, size=parse_size(args.size), frames=args.frames, device=args.device,
+        grid=args.grid, size=parse_size(args.size), frames=args.frames, warmup_s=args.warmup, device=args.device,
         policy=args.policy, hdr=args.hdr, validate=args.validate)
     if args.workers is not None and args.workers < 1:
         raise RGraphError.in_file("<command line>", f"--workers must be at least 1, got {args.workers}")

@@ -37,6 +37,7 @@ class SweepRequest:
     policy: str | None = None
     hdr: str | None = None  # an intermediate image read back for HDR metrics
     validate: bool = False
+    warmup_s: float | None = None  # None: the device's default (api.Gpu.default_warmup_s)
 
 
 @dataclass
@@ -177,7 +178,8 @@ def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> di
 
 
 def _render(request: SweepRequest, plan: dict, gpu: Any) -> _Rendering:
-    result = gpu.load(plan).run_and_check(request.frames, check_data=False, read_outputs=True)
+    result = gpu.load(plan).run_and_check(request.frames, check_data=False, read_outputs=True,
+                                          warmup_s=request.warmup_s)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None

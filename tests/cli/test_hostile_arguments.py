@@ -52,6 +52,16 @@ def test_frames_are_bounded(graph: Path, capsys, frames: str) -> None:
     assert "error: argument --frames: expected an integer in 1..1,000,000" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("command", ["run", "sweep"])
+@pytest.mark.parametrize("seconds", ["-1", "nan", "inf", "1e9", "soon"])
+def test_warmup_is_bounded(graph: Path, capsys, command: str, seconds: str) -> None:
+    extra = ["--knob", "a=1", "-o", str(graph.parent / "o")] if command == "sweep" else []
+    with pytest.raises(SystemExit) as info:
+        main([command, str(graph), "--warmup", seconds, *extra])
+    assert info.value.code == 2
+    assert "error: argument --warmup: expected seconds in 0..600" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("param,message", [
     ("hbao.directions=0", "param 'hbao.directions' (read by pass 'hbao_downsample', impl 'hbao_downsample') must "
                           "be in 1..64, got 0"),

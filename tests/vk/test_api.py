@@ -84,3 +84,31 @@ def test_bundled_graphs_run_without_layer_workarounds(graph, capsys):
     assert rc in (0, 1), err
     assert "recorded without the validation-layer workarounds" in err
     assert re.search(r"rgraph: \d+ validation message\(s\)", err)
+
+
+PROBE_GRAPH = """\
+rgraph: 1
+resources:
+  mid:   {kind: image, format: r32_sfloat, size: [16, 16]}
+  color: {kind: image, format: r32_sfloat, size: [16, 16], lifetime: output}
+passes:
+  make: {kind: compute, writes: {mid: storage_write}}
+  use:  {kind: compute, reads: {mid: sampled}, writes: {color: storage_write}}
+outputs: [color]
+"""
+
+
+def test_warm_up_runs_untimed_frames_that_count(tmp_path):
+    """``warm_up`` runs frames for the given wall time (at least one), nothing on a CPU device
+    by default; the timed run after it reports only its own frames, and the probe's data
+    check (which knows every frame run) still passes."""
+    with rgraph.open_device(validate=True, verbose=False) as gpu:
+        assert gpu.choice["type"] == "cpu" and gpu.default_warmup_s == 0.0
+        (tmp_path / "g.yaml").write_text(PROBE_GRAPH)
+        exe = gpu.load(rgraph.compile(tmp_path / "g.yaml", device=gpu))
+        assert exe.warm_up(0) == 0 and exe.executor.frames_done == 0
+        warmed = exe.warm_up(0.05)
+        assert warmed >= 1 and exe.executor.frames_done == warmed
+        result = exe.run_and_check(2, check_data=True, warmup_s=0.02)
+        assert result.timings["frames"] == 2 and result.data_ok
+        assert [str(m) for m in result.messages] == []

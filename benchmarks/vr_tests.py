@@ -57,15 +57,6 @@ def load_kwargs(gpu: Any, logic_hz: float | None) -> dict[str, Any]:
     return {"logic_hz": logic_hz}
 
 
-def warm_up(exe: Any, seconds: float) -> int:
-    """Run frames until ``seconds`` have passed (at least 3 frames); the frames run."""
-    t0, frames = time.perf_counter(), 0
-    while frames < 3 or time.perf_counter() - t0 < seconds:
-        exe.run(3)
-        frames += 3
-    return frames
-
-
 def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, frames: int, warmup: float,
             logic_hz: float | None) -> dict[str, Any]:
     from benchmarks.frame_cpu import frame_parts
@@ -76,7 +67,8 @@ def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, f
                          memory=gpu.memory_requirements())
     marks: list[float] = []
     with gpu.load(plan, **load_kwargs(gpu, logic_hz)) as exe:
-        warmed = warm_up(exe, warmup)
+        exe.warm_up(warmup)
+        warmed = exe.run(3).frames  # frames run before timing (warm-up included)
         t0 = time.perf_counter()
         timings = exe.run(frames, marks=marks).timings
         wall_ms = (time.perf_counter() - t0) * 1000.0 / frames

@@ -78,6 +78,7 @@ class SceneGPU:
         self._pool = None
         self.set_layout = None
         self._sets: list[Any] = []
+        self._submit_once = submit_once
         try:
             self._build(submit_once)
         except BaseException:
@@ -296,6 +297,17 @@ class SceneGPU:
         for mesh, base in self._deform_layout:
             self.deform_buffers[frame_set].write(packing.vertex_bytes(data.deformed(mesh, frame)),
                                                  base * packing.VERTEX_BYTES)
+
+    def refresh_instances(self) -> None:
+        """After instances moved (``SceneMesh.positions`` changed in ``self.data``): drop the
+        per-scene caches and, with draw.mode=gpu, upload the persistent instance table again -
+        only when something changed, never per frame. The upload waits for the device to be
+        idle (frames in flight read the table), so it suits rare changes."""
+        for cache in ("_instance_arrays", "_packed_draw_table", "_frame_cache", "_views_cache"):
+            self.data.__dict__.pop(cache, None)
+        if self.mode == "gpu":
+            vk().vkDeviceWaitIdle(self.device.handle)
+            self._upload(self._submit_once, [(self.instance_buffer, scene_instances.instance_bytes(self.data))])
 
     def draw(self, rec: Any, frame_set: int, share: Any = None, args: Any = None) -> None:
         """Bind vertex and index buffers and record the scene's draws.

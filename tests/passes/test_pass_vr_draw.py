@@ -158,10 +158,10 @@ def test_moved_instances_are_uploaded_once_and_drawn_where_they_are(tmp_path, mo
     """SceneGPU.refresh_instances after moving a mesh's instances: the next frame equals a fresh
     run of the scene with the mesh authored at the new place."""
     from clustered_helpers import GRAPH
+    from rgraph.passes.tonemap_ref import srgb_codes as codes
 
     import rgraph
     from rgraph.compiler.pipeline import compile_graph
-    from rgraph.passes.tonemap_ref import srgb_codes as codes
 
     def plan_of(path):
         return compile_graph(GRAPH, scene_path=path, size=SIZE, params={"draw.mode": mode})

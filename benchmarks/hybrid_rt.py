@@ -4,10 +4,17 @@
     python3 -m benchmarks.hybrid_rt --size small          # 64x36, 2 frames: lavapipe smoke run
     python3 -m benchmarks.hybrid_rt --depth-sweep         # rt.max_depth 1..8 vs a depth-16 reference
 
+Fairness: per scene and camera every plan (stand-alone, hybrid, hardware-raster hybrid) is
+loaded on one device, each runs untimed frames for ``--warmup`` seconds (the GPU clocks ramp up),
+then the timed frames run in alternating chunks (``--chunk`` frames of each in turn, the order
+rotating), so a clock change hits every plan alike; medians over the chunks' medians.
+
 Per scene and camera: stand-alone frame T (graphs/rt_standalone.yaml, the GPU span of the frame);
-the hybrid frame t (its GPU span), split at the end of the raster visibility buffer: t_b = frame
-start -> G-buffer end (the sky pass, tiny and independent of it, included), t_a = G-buffer end ->
-frame end (ray reset/classification, shading with shadow rays, indirect secondary rays); t_a / T,
+the hybrid frame t (graphs/rt_hybrid.yaml: compute visibility buffer; its GPU span), split at
+the end of the visibility buffer: t_b = frame start -> visibility buffer end (the sky pass, tiny
+and independent of it, included), t_a = the rest (ray reset/classification, shading with shadow
+rays, indirect secondary rays); the ``raster`` columns are the same for
+graphs/rt_hybrid_raster.yaml (hardware-raster visibility buffer; ``--no-raster`` skips it); t_a / T,
 t / T; all medians of GPU timestamps over ``--frames`` frames. (Each pass's own timestamp pair
 starts at TOP_OF_PIPE before its barriers, so it overlaps the previous pass still draining:
 summing per-pass times double-counts; the per-pass medians are kept in the JSON as ``passes``.)
@@ -30,11 +37,16 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ("rt_living_room", "rt_conference", "rt_gallery")
 SIZES = {"full": (1280, 720), "small": (64, 36)}
-GBUFFER_PASSES = ("gbuffer",)
+#: the visibility-buffer passes (t_b ends with the last of them): hardware raster or compute
+GBUFFER_PASSES = ("gbuffer", "vis_clear", "vis_depth", "vis_depth_tiles", "vis_id", "vis_id_tiles")
+RASTER_GRAPH = "rt_hybrid_raster"
+WARMUP_S = 0.3  # seconds of frames of every plan before timing (GPU clocks ramp up); rgraph.api.WARMUP_S
+CHUNK = 5       # frames per timed run; the plans alternate run by run
 
 
 def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: int, params: dict[str, str],
          extra: tuple[str, ...] = ()) -> tuple[dict, dict[str, Any]]:
+    """One plan on its own device (the depth sweep: accuracy, not a timing comparison)."""
     from rgraph.api import open_device
     from rgraph.compiler.pipeline import compile_graph
 
@@ -43,6 +55,47 @@ def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: in
                              extra_outputs=list(extra), memory=gpu.memory_requirements())
         result = gpu.load(plan).run_and_check(frames, check_data=False, read_outputs=True)
     return result.timings, result.outputs
+
+
+def _median(values: list[float | None]) -> float | None:
+    kept = [v for v in values if v is not None]
+    return float(np.median(kept)) if kept else None
+
+
+def _merge(chunks: list[dict[str, Any]]) -> dict[str, Any]:
+    """Timings of several runs of one plan: the median of the runs' medians, per quantity."""
+    passes = {name: _median([c["passes"].get(name) for c in chunks]) for name in chunks[0]["passes"]}
+    ends = {name: _median([c["intervals"][name]["end_ms"] for c in chunks if name in c["intervals"]])
+            for name in chunks[0].get("intervals", {})}
+    return {"total_ms": _median([c["total_ms"] for c in chunks]), "passes": passes, "end_ms": ends,
+            "frames": sum(c["frames"] for c in chunks)}
+
+
+def side_by_side(gpu: Any, plans: dict[str, dict], frames: int, warmup_s: float, chunk: int) -> dict[str, Any]:
+    """Load every plan on ``gpu``, run each for at least ``warmup_s`` seconds (alternating, so
+    the clocks ramp up under all of them), then time ``frames`` frames of each in alternating
+    chunks of ``chunk`` frames (a clock change hits every plan alike; the order rotates each
+    round). Returns {name: {"timings": merged, "outputs": arrays}}."""
+    import time
+
+    exes = {name: gpu.load(plan) for name, plan in plans.items()}
+    try:
+        names = list(exes)
+        start = time.perf_counter()
+        while True:
+            for name in names:
+                exes[name].run(min(chunk, 2))
+            if time.perf_counter() - start >= warmup_s:
+                break
+        chunks: dict[str, list] = {name: [] for name in names}
+        sizes = [chunk] * (frames // chunk) + ([frames % chunk] if frames % chunk else [])
+        for r, n in enumerate(sizes):
+            for name in names[r % len(names):] + names[:r % len(names)]:
+                chunks[name].append(exes[name].run(n).timings)
+        return {name: {"timings": _merge(chunks[name]), "outputs": exes[name].read_outputs()} for name in names}
+    finally:
+        for exe in exes.values():
+            exe.close()
 
 
 def _metrics(reference: np.ndarray, test: np.ndarray) -> dict[str, float | None]:
@@ -55,22 +108,45 @@ def _metrics(reference: np.ndarray, test: np.ndarray) -> dict[str, float | None]
     return {"psnr_db": psnr(a, b), "ssim": ssim(gray_a, gray_b), "flip": None if f is None else float(f[1])}
 
 
-def measure(scene: str, camera: int, size: tuple[int, int], frames: int, depth: int) -> dict[str, Any]:
+def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str, Any], alone: dict[str, Any],
+                    prefix: str = "") -> dict[str, Any]:
+    t = timings["total_ms"]
+    t_b = max((v for k, v in timings["end_ms"].items() if k in GBUFFER_PASSES and v is not None), default=0.0)
+    t_a = t - t_b
+    m = _metrics(alone["color"][..., :3].astype(np.float64), outputs["color"][..., :3].astype(np.float64))
+    return {f"{prefix}t_a_ms": t_a, f"{prefix}t_a_over_T": t_a / T, f"{prefix}t_b_ms": t_b, f"{prefix}t_ms": t,
+            f"{prefix}t_over_T": t / T, f"{prefix}passes": timings["passes"],
+            **({f"{prefix}{k}": v for k, v in m.items()})}
+
+
+def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
+            warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True) -> dict[str, Any]:
+    """One table row: stand-alone, the hybrid (compute visibility buffer) and, with ``raster``,
+    the hybrid with the hardware-raster visibility buffer, side by side on ``gpu``."""
+    from rgraph.compiler.pipeline import compile_graph
+
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
     params = {"rt.max_depth": str(depth)}
-    t_alone, alone = _run("rt_standalone", path, camera, size, frames, params)
-    t_hybrid, hybrid = _run("rt_hybrid", path, camera, size, frames, params, extra=("ray_args", "visibility"))
-    T = t_alone["total_ms"]
-    t = t_hybrid["total_ms"]
-    t_b = max(t_hybrid["intervals"][name]["end_ms"] for name in GBUFFER_PASSES)
-    t_a = t - t_b
-    traced = int(np.frombuffer(hybrid["ray_args"].tobytes()[:4], dtype=np.uint32)[0]) if "ray_args" in hybrid else 0
+    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs"))}
+    if raster:
+        graphs["raster"] = (RASTER_GRAPH, ())
+    plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=params,
+                                 extra_outputs=list(extra), memory=gpu.memory_requirements())
+             for name, (graph, extra) in graphs.items()}
+    runs = side_by_side(gpu, plans, frames, warmup_s, chunk)
+    alone, hybrid = runs["alone"], runs["hybrid"]
+    T = alone["timings"]["total_ms"]
+    out = hybrid["outputs"]
+    traced = int(np.frombuffer(out["ray_args"].tobytes()[:4], dtype=np.uint32)[0]) if "ray_args" in out else 0
     row = {"scene": scene, "camera": camera, "size": list(size), "frames": frames, "max_depth": depth,
-           "T_ms": T, "t_a_ms": t_a, "t_a_over_T": t_a / T, "t_b_ms": t_b, "t_ms": t, "t_over_T": t / T,
-           "passes": t_hybrid["passes"],
+           "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
-           "boundary_share": boundary_share(hybrid["visibility"][..., 0], prim_bits_of(path, size, camera)),
-           **_metrics(alone["color"][..., :3].astype(np.float64), hybrid["color"][..., :3].astype(np.float64))}
+           "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
+    if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
+        header = np.frombuffer(out["vis_jobs"].tobytes()[:8], dtype=np.uint32)
+        row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
+    if raster:
+        row.update(_hybrid_columns(runs["raster"]["timings"], T, runs["raster"]["outputs"], alone["outputs"], "raster_"))
     return row
 
 
@@ -115,21 +191,32 @@ def _fmt(x: Any, spec: str) -> str:
 
 
 def table(rows: list[dict[str, Any]]) -> str:
+    raster = any("raster_t_ms" in r for r in rows)
     head = ("| scene | camera | T (ms) | t_a (ms) | t_a/T | t_b (ms) | t (ms) | t/T | PSNR (dB) | SSIM | FLIP "
-            "| traced | primary traced |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+            "| traced | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
+            + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else ""))
     lines = [head]
     for r in rows:
-        lines.append(f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
-                     f"| {r['t_b_ms']:.3f} | {r['t_ms']:.3f} | {r['t_over_T']:.2f} | {_fmt(r['psnr_db'], '.1f')} "
-                     f"| {_fmt(r['ssim'], '.4f')} | {_fmt(r['flip'], '.4f')} | {r['traced_share']:.1%} "
-                     f"| {r['boundary_share']:.1%} |")
+        line = (f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
+                f"| {r['t_b_ms']:.3f} | {r['t_ms']:.3f} | {r['t_over_T']:.2f} | {_fmt(r['psnr_db'], '.1f')} "
+                f"| {_fmt(r['ssim'], '.4f')} | {_fmt(r['flip'], '.4f')} | {r['traced_share']:.1%} "
+                f"| {r['boundary_share']:.1%} |")
+        if raster:
+            line += (f" {r['raster_t_b_ms']:.3f} | {r['raster_t_ms']:.3f} | {r['raster_t_over_T']:.2f} "
+                     f"| {_fmt(r['raster_psnr_db'], '.1f')} |") if "raster_t_ms" in r else " - | - | - | - |"
+        lines.append(line)
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--size", default="full", help="full (1280x720), small (64x36) or WxH")
-    parser.add_argument("--frames", type=int, default=None, help="frames per run (default 50; small: 2)")
+    parser.add_argument("--frames", type=int, default=None, help="timed frames per plan (default 50; small: 2)")
+    parser.add_argument("--warmup", type=float, default=None,
+                        help=f"seconds of untimed frames of every plan first (default: {WARMUP_S} on a GPU, "
+                             "0 on a CPU device: Gpu.default_warmup_s)")
+    parser.add_argument("--chunk", type=int, default=CHUNK, help="frames per timed run (plans alternate)")
+    parser.add_argument("--no-raster", action="store_true", help="skip the hardware-raster hybrid variant")
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--cameras", default="0,1,2,3,4")
     parser.add_argument("--max-depth", type=int, default=4)
@@ -137,16 +224,24 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
     args = parser.parse_args(argv)
     size = SIZES.get(args.size) or tuple(int(v) for v in args.size.lower().split("x"))
-    frames = args.frames or (2 if args.size == "small" else 50)
+    small = args.size == "small"
+    frames = args.frames or (2 if small else 50)
+    raster = not args.no_raster and (ROOT / "graphs" / f"{RASTER_GRAPH}.yaml").exists()
     scenes = [s for s in args.scenes.split(",") if s]
     rows: list[dict[str, Any]] = []
-    for scene in scenes:
-        if args.depth_sweep:
+    if args.depth_sweep:
+        for scene in scenes:
             rows += depth_sweep(scene, int(args.cameras.split(",")[0]), size, frames)
-            continue
-        for camera in (int(c) for c in args.cameras.split(",") if c):
-            rows.append(measure(scene, camera, size, frames, args.max_depth))
-            print(json.dumps(rows[-1]), file=sys.stderr)
+    else:
+        from rgraph.api import open_device
+
+        with open_device(validate=False, verbose=False) as gpu:  # one device for every plan of the run
+            warmup = args.warmup if args.warmup is not None else gpu.default_warmup_s
+            for scene in scenes:
+                for camera in (int(c) for c in args.cameras.split(",") if c):
+                    rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
+                                        chunk=max(1, args.chunk), raster=raster))
+                    print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))
     if args.depth_sweep:

@@ -102,10 +102,8 @@ class RayTracingImpl(PassImpl):
         self.data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
         tables = pack_tables(self.data)
         bindings = []
-        for i, name in enumerate(TABLES):
-            buf = setup.host_buffer(len(tables[name]), "storage")
-            buf.write(tables[name])
-            bindings.append(Binding(i, "storage_buffer", buffers=((buf.handle, buf.size),)))
+        for i, name in enumerate(TABLES):  # device-local: every hit reads them, every frame
+            bindings.append(Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)))
         bindings.append(Binding(6, "sampled", "sky", array=True, sampler="nearest"))
         self.sets = setup.descriptors(bindings + images)
         self.accel = next(a["resource"] for a in setup.plan_pass["accesses"] if a["usage"] == "accel_read")

@@ -199,6 +199,19 @@ class PassSetup:
         self._host_buffers.append(buf)
         return buf
 
+    def device_buffer(self, payload: bytes, usage: str | int = "storage") -> tuple[Any, int]:
+        """(handle, size) of a DEVICE_LOCAL buffer holding ``payload`` (filled once, now), owned
+        by the pass; ``usage`` as ``host_buffer``."""
+        from rgraph.vk.static_buffer import upload_static
+
+        v = vk()
+        flags = usage if isinstance(usage, int) else {
+            "uniform": v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "storage": v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT}[usage]
+        handle, memory, size = upload_static(self.device, payload, flags)
+        self.own("vkFreeMemory", memory)  # destroyed newest first: the buffer, then its memory
+        self.own("vkDestroyBuffer", handle)
+        return handle, size
+
     def sampler(self, kind: str = "linear") -> Any:
         """A shared clamp-to-edge sampler: ``linear`` or ``nearest``."""
         if kind not in self._samplers:

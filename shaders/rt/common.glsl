@@ -2,15 +2,8 @@
 // offsets, the lighting model (passes/rt_model.py and its NumPy reference passes/rt_ref.py).
 #extension GL_EXT_ray_tracing : require
 
-struct Instance {
-    vec4 m0, m1, m2;   // camera-relative object -> world, rows of a 3x4
-    vec4 n0, n1, n2;   // normal matrix rows
-    uvec4 info;        // x: first index of the mesh in idx[], y: material, z: first vertex
-};
-layout(set = 0, binding = 0, std430) readonly buffer Instances { Instance inst[]; };
-layout(set = 0, binding = 1, std430) readonly buffer Positions { float pos[]; };
+#include "rt/tables.glsl"
 layout(set = 0, binding = 2, std430) readonly buffer Normals { float nrm[]; };
-layout(set = 0, binding = 3, std430) readonly buffer Indices { uint idx[]; };
 layout(set = 0, binding = 4, std430) readonly buffer Materials { vec4 mat[]; };  // albedo.rgb ks | kr kt ior n
 layout(set = 0, binding = 5, std430) readonly buffer Lights { vec4 lights[]; };  // xyz type | radiance
 layout(set = 0, binding = 6) uniform sampler2DArray sky_map;
@@ -57,9 +50,7 @@ vec3 sample_sky(vec3 d) {
     return texelFetch(sky_map, ivec3(max(i, 0), max(j, 0), int(face)), 0).rgb;
 }
 
-vec3 vertex_of(uint v) { return vec3(pos[3u * v], pos[3u * v + 1u], pos[3u * v + 2u]); }
 vec3 normal_of(uint v) { return vec3(nrm[3u * v], nrm[3u * v + 1u], nrm[3u * v + 2u]); }
-vec3 to_world(Instance I, vec3 p) { return vec3(dot(I.m0, vec4(p, 1.0)), dot(I.m1, vec4(p, 1.0)), dot(I.m2, vec4(p, 1.0))); }
 vec3 normal_to_world(Instance I, vec3 n) { return vec3(dot(I.n0.xyz, n), dot(I.n1.xyz, n), dot(I.n2.xyz, n)); }
 
 // Geometric and shading normals (world), oriented alike.

@@ -37,6 +37,15 @@ bool hit_triangle(vec3 d, uint instance, uint prim, out Hit h) {
     return u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0;
 }
 
+// Whether the secondary pass shades pixel px (its visible instance's material reflects or
+// refracts: the test of classify.comp, which put px on the compacted list).
+bool classified(uvec2 px) {
+    uint id = texelFetch(visibility, ivec2(px), 0).r;
+    if (id == 0u) return false;
+    vec4 k = mat[2u * inst[vis_instance(id)].info.y + 1u];
+    return k.x > 0.0 || k.y > 0.0;
+}
+
 // false: nothing (the sky).
 bool first_hit(uvec2 px, vec3 d, out Hit h) {
     uint id = texelFetch(visibility, ivec2(px), 0).r;

@@ -20,6 +20,7 @@ SMALL = {
     "allocator_lines": {"alloc.meshes": "200", "alloc.segments": "10"},
     "rt_standalone": {"rt.sky_size": "16"},
     "rt_hybrid": {"rt.sky_size": "16"},
+    "rt_hybrid_raster": {"rt.sky_size": "16"},
     "async_overlap": {"shadow.size": "256", "particles.count": "4096", "particles.substeps": "2"},
 }
 

@@ -42,8 +42,9 @@ def psnr(a, b) -> float:
 
 
 @pytest.mark.vulkan
-def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels():
-    _plan, hybrid = _run("rt_hybrid", 20, extra=("ray_args", "visibility"))
+@pytest.mark.parametrize("graph", ["rt_hybrid", "rt_hybrid_raster"])  # compute / hardware visibility buffer
+def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels(graph):
+    _plan, hybrid = _run(graph, 20, extra=("ray_args", "visibility"))
     _plan, alone = _run("rt_standalone", 20)
     a, b = alone["color"][..., :3].astype(np.float64), hybrid["color"][..., :3].astype(np.float64)
     assert np.isfinite(b).all()
@@ -66,11 +67,14 @@ def test_no_reflective_or_refractive_materials_culls_the_secondary_rays(tmp_path
                      .replace("refractive: 0.9, ", ""))
     plan = compile_graph("rt_hybrid", scene_path=scene, size=(16, 16))
     culled = {c["pass"]: c["reason"] for c in plan["culled"]}
-    assert set(culled) == {"reset_rays", "classify", "secondary"}
+    assert set(culled) == {"classify", "secondary"}
     assert all(reason == "scene has none of reflective_materials, refractive_materials" for reason in culled.values())
-    assert {p["name"] for p in plan["passes"]} == {"build_as", "sky", "gbuffer", "shade"}
+    assert {p["name"] for p in plan["passes"]} == {"build_as", "sky", "vis_clear", "vis_depth", "vis_depth_tiles",
+                                                   "vis_id", "vis_id_tiles", "shade"}
     full = compile_graph("rt_hybrid", scene_path=SCENE, size=(16, 16))
     assert not full["culled"]
+    raster = compile_graph("rt_hybrid_raster", scene_path=scene, size=(16, 16))
+    assert {c["pass"] for c in raster["culled"]} == {"reset_rays", "classify", "secondary"}
 
 
 # A grazing view: the camera and a point light inside a thin box (the old rt_gallery camera 4),
@@ -89,6 +93,18 @@ meshes:
   - {shape: box, params: {size: [0.1, 4.0, 10.0]}, material: wall, position: [0.0, 2.0, 0.0]}
   - {shape: sphere, params: {radius: 0.02, segments: 8, rings: 4}, material: mirror, position: [0.0, 1.0, 0.0]}
 """
+
+
+@pytest.mark.vulkan
+def test_hybrid_agrees_on_the_visibility_buffer_hard_cases():
+    """Camera 1e6 m from the origin, a box through the camera plane, huge, degenerate and
+    sub-pixel triangles (tests/data/rt/vis_hard.yaml)."""
+    from locations import TESTS
+
+    scene = TESTS / "data" / "rt" / "vis_hard.yaml"
+    _plan, hybrid = _run("rt_hybrid", 32, scene=scene)
+    _plan, alone = _run("rt_standalone", 32, scene=scene)
+    assert psnr(alone["color"][..., :3].astype(np.float64), hybrid["color"][..., :3].astype(np.float64)) >= 45
 
 
 @pytest.mark.vulkan

@@ -1,0 +1,157 @@
+"""The hybrid's visibility buffer rasterized in compute shaders (graphs/rt_hybrid.yaml), the
+same r32_uint ids as the hardware raster ``rt_gbuffer`` (graphs/rt_hybrid_raster.yaml), formed
+by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
+
+- ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1), the job list's
+  count and overflow flag (``vis_jobs`` header) 0, and ``ray_args`` = (0, 1, 1) when the pass
+  writes it (one pass fewer than ``rt_reset_rays``);
+- ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen box
+  exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs``
+  (capacity (bytes - 16) / 8, at most 8 x 65535) and raise ``vis_args``' group count; on
+  overflow the thread rasterizes its box itself;
+- ``rt_vis_depth_tiles``: 8 jobs per 16x16 workgroup (indirect dispatch over ``vis_args``);
+- ``rt_vis_id`` / ``rt_vis_id_tiles``: the same, writing the id where the key is the stored one.
+"""
+
+from __future__ import annotations
+
+import struct
+from typing import Any
+
+import numpy as np
+
+from rgraph.impl import PassImpl, register
+from rgraph.vk.passkit import Binding
+
+from .raytrace_hybrid import prim_bits
+from .raytrace_standalone import pack_tables
+from .rt_model import camera_basis
+
+TILE = 32  # pixels per side of a tile job (shaders/rt/visraster.glsl)
+JOBS_PER_GROUP = 8
+MAX_JOBS = 65535 * JOBS_PER_GROUP  # maxComputeWorkGroupCount[0] is at least 65535 on every device
+JOB_HEADER = 16  # vis_jobs: count, overflow flag, padding, then (triangle, tile) pairs
+GROUP = 64        # threads per workgroup of the per-triangle passes
+CLIP_FRACTION = 1e-3  # the bounding boxes' clip plane: this share of the camera's near distance
+
+
+def triangle_starts(data) -> np.ndarray:
+    """Per TLAS instance (mesh-major): the global index of its first triangle."""
+    counts = [mesh.data.triangle_count for mesh in data.meshes for _p in mesh.positions]
+    return np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.uint32) if counts else np.zeros(1, np.uint32)
+
+
+def raster_constants(data, size: tuple[int, int]) -> bytes:
+    """The push block of shaders/rt/visraster.glsl (the camera of shade.glsl: camera_ray)."""
+    _cam, (right, up, fwd), tan_half = camera_basis(data)
+    triangles = sum(mesh.data.triangle_count * len(mesh.positions) for mesh in data.meshes)
+    instances = sum(len(mesh.positions) for mesh in data.meshes)
+    clip = CLIP_FRACTION * float(data.model.camera.near)
+    return struct.pack("<12f4I", *right, tan_half, *up, size[0] / size[1], *fwd, clip, size[0], size[1],
+                       triangles, max(instances, 1))
+
+
+def groups_for(items: int, per_group: int = GROUP) -> tuple[int, int]:
+    """A 2D dispatch covering ``items`` (x at most 32768 groups; the shader linearizes)."""
+    groups = max(1, -(-items // per_group))
+    x = min(groups, 32768)
+    return x, -(-groups // x)
+
+
+class VisPass(PassImpl):
+    """Common setup: geometry tables (device-local), the per-instance triangle starts, the
+    visibility-buffer images and the job list, the push constants."""
+
+    shader = "rt/visraster.comp"
+    mode_id = False
+    uses_args = True   # binding 7 in the shader
+
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup)
+        from rgraph.scene.build import load_scene_data
+
+        if not setup.plan.get("scene_source"):
+            raise ValueError(f"pass {setup.name!r}: the visibility buffer needs a scene (--scene)")
+        self.data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
+        tables = pack_tables(self.data)
+        bindings = [Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),))
+                    for i, name in ((0, "instances"), (1, "positions"), (3, "indices"))]
+        bindings.append(Binding(4, "storage_buffer", buffers=(setup.device_buffer(triangle_starts(self.data).tobytes()),)))
+        bindings.append(Binding(5, "storage_image", "vis_depth"))
+        if self.mode_id:
+            bindings.append(Binding(6, "storage_image", "visibility"))
+        if self.uses_args:
+            bindings.append(Binding(7, "storage_buffer", "vis_args"))
+        bindings.append(Binding(8, "storage_buffer", "vis_jobs"))
+        self.sets = setup.descriptors(bindings)
+        capacity = min(MAX_JOBS, (int(setup.resource_plan("vis_jobs")["bytes"]) - JOB_HEADER) // 8)
+        big = int(setup.param("rt.vis_big_pixels", 256))
+        if capacity < 1 or big < 1:
+            raise ValueError(f"pass {setup.name!r}: vis_jobs must hold a job (16 + 8 bytes) and rt.vis_big_pixels be >= 1")
+        defines: dict[str, object] = {"PRIM_BITS": prim_bits(self.data), "BIG_PIXELS": f"{big}u",
+                                      "JOB_CAPACITY": f"{capacity}u", "TILE": TILE,
+                                      "JOBS_PER_GROUP": f"{JOBS_PER_GROUP}u"}
+        if self.mode_id:
+            defines["MODE_ID"] = 1
+        self.pipeline = setup.compute_pipeline(self.shader, [self.sets.layout], defines=defines, push_constant_bytes=64)
+        self.push = raster_constants(self.data, setup.extent_of("visibility"))
+        self.groups = groups_for(struct.unpack_from("<I", self.push, 56)[0])
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*self.groups)
+
+
+class VisTiles(VisPass):
+    """The big triangles' tile jobs: 8 per workgroup, dispatched indirectly from vis_args."""
+
+    shader = "rt/vistiles.comp"
+    uses_args = False
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.push(self.pipeline, self.push)
+        args, _size = self.setup.buffer("vis_args", frame_set)
+        rec.dispatch_indirect(args, 0)
+
+
+@register("rt_vis_depth")
+class VisDepth(VisPass):
+    pass
+
+
+@register("rt_vis_id")
+class VisId(VisPass):
+    mode_id = True
+    uses_args = False
+
+
+@register("rt_vis_depth_tiles")
+class VisDepthTiles(VisTiles):
+    pass
+
+
+@register("rt_vis_id_tiles")
+class VisIdTiles(VisTiles):
+    mode_id = True
+
+
+@register("rt_vis_clear")
+class VisClear(PassImpl):
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup)
+        bindings = [Binding(5, "storage_image", "vis_depth"), Binding(6, "storage_image", "visibility"),
+                    Binding(7, "storage_buffer", "vis_args"), Binding(8, "storage_buffer", "vis_jobs")]
+        reset = setup.has("ray_args")  # also reset the compacted ray list (instead of rt_reset_rays)
+        if reset:
+            bindings.append(Binding(9, "storage_buffer", "ray_args"))
+        self.sets = setup.descriptors(bindings)
+        self.pipeline = setup.compute_pipeline("rt/visclear.comp", [self.sets.layout],
+                                               defines={"RESET_RAYS": 1} if reset else None)
+        w, h = setup.extent_of("visibility")
+        self.groups = (-(-w // 8), -(-h // 8))
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.dispatch(*self.groups)

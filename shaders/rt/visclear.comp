@@ -1,0 +1,26 @@
+#version 460
+// Compute visibility buffer, first pass: depth keys and ids 0 (nothing), the tile jobs' indirect
+// arguments (0, 1, 1), the job list's count and overflow flag 0; with RESET_RAYS (the pass
+// writes ray_args) also the compacted ray list's arguments (0, 1, 1), saving rt_reset_rays.
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 5, r32ui) uniform writeonly uimage2D depth_keys;
+layout(set = 0, binding = 6, r32ui) uniform writeonly uimage2D visibility;
+layout(set = 0, binding = 7, std430) writeonly buffer Args { uint args[4]; };
+layout(set = 0, binding = 8, std430) writeonly buffer Jobs { uint header[4]; };
+#ifdef RESET_RAYS
+layout(set = 0, binding = 9, std430) writeonly buffer RayArgs { uint ray_args[4]; };
+#endif
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (px == ivec2(0)) {
+        args[0] = 0u; args[1] = 1u; args[2] = 1u; args[3] = 0u;
+        header[0] = 0u; header[1] = 0u;
+#ifdef RESET_RAYS
+        ray_args[0] = 0u; ray_args[1] = 1u; ray_args[2] = 1u; ray_args[3] = 0u;
+#endif
+    }
+    if (any(greaterThanEqual(px, imageSize(depth_keys)))) return;
+    imageStore(depth_keys, px, uvec4(0u));
+    imageStore(visibility, px, uvec4(0u));
+}

@@ -1,7 +1,7 @@
 """Median compile time (parsed spec -> plan) for random graphs of 250 .. 16k passes.
 
     .venv/bin/python benchmarks/compile_scaling.py [--sizes 250,1000,4000,16000] [--policy aliased]
-        [--chain 10000] [--side-effects 5000]
+        [--chain 10000] [--side-effects 5000] [--phases]
 
 Prints one row per size and the growth exponent fitted on log(time) vs log(passes), then
 two structured graphs: a chain (pass i reads buffer b_i and writes b_{i+1}: every buffer
@@ -23,22 +23,61 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rgraph.compiler.pipeline import compile_plan, frontend  # noqa: E402
+from rgraph.plan import Plan  # noqa: E402
 from rgraph.random_graph import random_graph, to_yaml  # noqa: E402
+from rgraph.spec.specialize import Spec  # noqa: E402
 
 
-def measure(passes: int, policy: str, repeats: int) -> tuple[float, int, int]:
+def timed(spec: Spec, policy: str, repeats: int) -> tuple[float, float, Plan]:
+    """Median wall time and minimum CPU time (process time: less disturbed by other jobs on a
+    shared machine) of ``repeats`` compiles of ``spec``, and the plan."""
+    wall, cpu = [], []
+    plan = None
+    for _ in range(repeats):
+        start, start_cpu = time.perf_counter(), time.process_time()
+        plan = compile_plan(spec, policy=policy)
+        wall.append(time.perf_counter() - start)
+        cpu.append(time.process_time() - start_cpu)
+    assert plan is not None
+    return statistics.median(wall), min(cpu), plan
+
+
+def phase_times(spec: Spec, policy: str, repeats: int) -> dict[str, float]:
+    """Minimum CPU seconds of each compiler phase (``rgraph.compiler.phases.PHASES``)."""
+    import gc
+
+    from rgraph.compiler.phases import PHASES, Compilation
+    from rgraph.compiler.pipeline import DEFAULT_PROFILE, _default_provider
+
+    best: dict[str, float] = {}
+    enabled = gc.isenabled()
+    gc.disable()  # as in pipeline.compilation
+    try:
+        for _ in range(repeats):
+            c = Compilation(spec, policy, _default_provider(), DEFAULT_PROFILE)
+            for name, phase in PHASES:
+                start = time.process_time()
+                c = phase(c)
+                best[name] = min(best.get(name, math.inf), time.process_time() - start)
+    finally:
+        if enabled:
+            gc.enable()
+    return best
+
+
+def phases_line(spec: Spec, policy: str, repeats: int) -> str:
+    return "  phases, min cpu ms: " + ", ".join(
+        f"{name} {seconds * 1e3:.1f}" for name, seconds in phase_times(spec, policy, repeats).items())
+
+
+def measure(passes: int, policy: str, repeats: int) -> tuple[float, float, int, int, Spec]:
     graph = random_graph(seed=passes, passes=passes)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "g.yaml"
         path.write_text(to_yaml(graph))
         spec = frontend(path, size=(16, 16)).spec
-    times = []
-    plan = {}
-    for _ in range(repeats):
-        start = time.perf_counter()
-        plan = compile_plan(spec, policy=policy)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), len(plan.passes), plan.stats.barriers
+    median, cpu, plan = timed(spec, policy, repeats)
+    return median, cpu, len(plan.passes), plan.stats.barriers, spec
 
 
 def chain_yaml(count: int) -> str:
@@ -63,19 +102,13 @@ def side_effects_yaml(count: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-def measure_text(text: str, policy: str, repeats: int) -> tuple[float, int]:
+def measure_text(text: str, policy: str, repeats: int) -> tuple[float, float, int, Spec]:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "g.yaml"
         path.write_text(text)
         spec = frontend(path, size=(16, 16)).spec
-    times = []
-    plan = None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        plan = compile_plan(spec, policy=policy)
-        times.append(time.perf_counter() - start)
-    assert plan is not None
-    return statistics.median(times), len(plan.passes)
+    median, cpu, plan = timed(spec, policy, repeats)
+    return median, cpu, len(plan.passes), spec
 
 
 def cache_hit_us(passes: int, repeats: int = 200) -> float:
@@ -101,14 +134,18 @@ def main() -> None:
     parser.add_argument("--policy", default="aliased")
     parser.add_argument("--chain", type=int, default=10000, help="resources of the chain graph (0: skip)")
     parser.add_argument("--side-effects", type=int, default=5000, help="side-effect buffers (0: skip)")
+    parser.add_argument("--phases", action="store_true", help="also the minimum CPU time of each compiler phase")
     args = parser.parse_args()
     sizes = [int(s) for s in args.sizes.split(",")]
     rows = []
-    print(f"{'passes':>8} {'executed':>9} {'barriers':>9} {'median ms':>10} {'us/pass':>8}")
+    print(f"{'passes':>8} {'executed':>9} {'barriers':>9} {'median ms':>10} {'us/pass':>8} {'min cpu ms':>11}")
     for n in sizes:
-        median, executed, barriers = measure(n, args.policy, repeats=max(3, min(15, 16000 // n)))
+        repeats = max(3, min(15, 16000 // n))
+        median, cpu, executed, barriers, spec = measure(n, args.policy, repeats)
         rows.append((n, median))
-        print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f}")
+        print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f} {cpu * 1e3:>11.1f}")
+        if args.phases:
+            print(phases_line(spec, args.policy, repeats))
     xs = [math.log(n) for n, _ in rows]
     ys = [math.log(t) for _, t in rows]
     mx, my = statistics.fmean(xs), statistics.fmean(ys)
@@ -117,8 +154,10 @@ def main() -> None:
     for label, count, text in (("chain", args.chain, chain_yaml), ("side-effect buffers", args.side_effects,
                                                                       side_effects_yaml)):
         if count:
-            median, executed = measure_text(text(count), args.policy, repeats=3)
-            print(f"{label} of {count}: {executed} passes, median {median * 1e3:.1f} ms")
+            median, cpu, executed, spec = measure_text(text(count), args.policy, repeats=3)
+            print(f"{label} of {count}: {executed} passes, median {median * 1e3:.1f} ms (min cpu {cpu * 1e3:.1f} ms)")
+            if args.phases:
+                print(phases_line(spec, args.policy, 3))
     print(f"unchanged 1,000-pass graph through PlanCache: median {cache_hit_us(1000):.1f} us")
 
 

@@ -129,7 +129,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     params = {"rt.max_depth": str(depth)}
     graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs"))}
     if raster:
-        graphs["raster"] = (RASTER_GRAPH, ())
+        graphs["raster"] = (RASTER_GRAPH, ("visibility",))
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=params,
                                  extra_outputs=list(extra), memory=gpu.memory_requirements())
              for name, (graph, extra) in graphs.items()}
@@ -146,7 +146,12 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         header = np.frombuffer(out["vis_jobs"].tobytes()[:8], dtype=np.uint32)
         row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
     if raster:
-        row.update(_hybrid_columns(runs["raster"]["timings"], T, runs["raster"]["outputs"], alone["outputs"], "raster_"))
+        raster_out = runs["raster"]["outputs"]
+        row.update(_hybrid_columns(runs["raster"]["timings"], T, raster_out, alone["outputs"], "raster_"))
+        ids, raster_ids = out["visibility"][..., 0], raster_out["visibility"][..., 0]
+        # diagnosis of the two visibility buffers: ids that differ, and compute holes (0 where the raster has an id)
+        row.update(vis_differs_share=float((ids != raster_ids).mean()),
+                   vis_holes_share=float(((ids == 0) & (raster_ids != 0)).mean()))
     return row
 
 

@@ -7,8 +7,9 @@ by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
   writes it (one pass fewer than ``rt_reset_rays``);
 - ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen box
   exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs``
-  (capacity (bytes - 16) / 8, at most 8 x 65535) and raise ``vis_args``' group count; on
-  overflow the thread rasterizes its box itself;
+  (capacity (bytes - 16) / 8, at most 8 x 65535) after storing its setup in ``vis_tris`` (80
+  bytes each), and raise ``vis_args``' group count; on overflow the thread rasterizes its box
+  itself;
 - ``rt_vis_depth_tiles``: 8 jobs per 16x16 workgroup (indirect dispatch over ``vis_args``);
 - ``rt_vis_id`` / ``rt_vis_id_tiles``: the same, writing the id where the key is the stored one.
 """
@@ -30,7 +31,8 @@ from .rt_model import camera_basis
 TILE = 32  # pixels per side of a tile job (shaders/rt/visraster.glsl)
 JOBS_PER_GROUP = 8
 MAX_JOBS = 65535 * JOBS_PER_GROUP  # maxComputeWorkGroupCount[0] is at least 65535 on every device
-JOB_HEADER = 16  # vis_jobs: count, overflow flag, padding, then (triangle, tile) pairs
+JOB_HEADER = 16  # vis_jobs: job count, overflow flag, record count, padding, then (record, tile) pairs
+RECORD_BYTES = 80  # vis_tris: a big triangle's setup (shaders/rt/visraster.glsl: TriRecord)
 GROUP = 64        # threads per workgroup of the per-triangle passes
 CLIP_FRACTION = 1e-3  # the bounding boxes' clip plane: this share of the camera's near distance
 
@@ -64,7 +66,8 @@ class VisPass(PassImpl):
 
     shader = "rt/visraster.comp"
     mode_id = False
-    uses_args = True   # binding 7 in the shader
+    uses_args = True     # binding 7 in the shader
+    uses_records = True  # binding 10: the big triangles' setup records
 
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
@@ -83,14 +86,18 @@ class VisPass(PassImpl):
         if self.uses_args:
             bindings.append(Binding(7, "storage_buffer", "vis_args"))
         bindings.append(Binding(8, "storage_buffer", "vis_jobs"))
+        if self.uses_records:
+            bindings.append(Binding(10, "storage_buffer", "vis_tris"))
         self.sets = setup.descriptors(bindings)
+        records = int(setup.resource_plan("vis_tris")["bytes"]) // RECORD_BYTES if self.uses_records else 1
         capacity = min(MAX_JOBS, (int(setup.resource_plan("vis_jobs")["bytes"]) - JOB_HEADER) // 8)
         big = int(setup.param("rt.vis_big_pixels", 256))
-        if capacity < 1 or big < 1:
-            raise ValueError(f"pass {setup.name!r}: vis_jobs must hold a job (16 + 8 bytes) and rt.vis_big_pixels be >= 1")
+        if capacity < 1 or records < 1 or big < 1:
+            raise ValueError(f"pass {setup.name!r}: vis_jobs must hold a job (16 + 8 bytes), vis_tris a record "
+                             f"({RECORD_BYTES} bytes) and rt.vis_big_pixels be >= 1")
         defines: dict[str, object] = {"PRIM_BITS": prim_bits(self.data), "BIG_PIXELS": f"{big}u",
                                       "JOB_CAPACITY": f"{capacity}u", "TILE": TILE,
-                                      "JOBS_PER_GROUP": f"{JOBS_PER_GROUP}u"}
+                                      "JOBS_PER_GROUP": f"{JOBS_PER_GROUP}u", "TRI_CAPACITY": f"{records}u"}
         if self.mode_id:
             defines["MODE_ID"] = 1
         self.pipeline = setup.compute_pipeline(self.shader, [self.sets.layout], defines=defines, push_constant_bytes=64)
@@ -125,6 +132,7 @@ class VisDepth(VisPass):
 class VisId(VisPass):
     mode_id = True
     uses_args = False
+    uses_records = False
 
 
 @register("rt_vis_depth_tiles")

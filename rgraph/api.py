@@ -112,10 +112,14 @@ class Gpu:
         return from_device(self.device)
 
     def load(self, compiled: Any, *, inputs: dict[str, Any] | None = None,
-             workarounds: Iterable[str] = LAYER_WORKAROUNDS, one_call_per_queue: bool = True) -> Executable:
-        """Lower and record ``compiled`` (a plan dict or compiled object) once on this device."""
+             workarounds: Iterable[str] = LAYER_WORKAROUNDS, one_call_per_queue: bool = True,
+             external: dict[str, list[Any]] | None = None, logic_hz: float | None = None) -> Executable:
+        """Lower and record ``compiled`` (a plan dict or compiled object) once on this device.
+        ``external``: buffers bound by the caller for those resources (``rgraph.vk.resources``).
+        ``logic_hz``: the scene's logic on its own thread at that rate, frames interpolating
+        between its last two states (``rgraph.vk.runtime.logic``)."""
         exe = Executable(self, plan_of(compiled), inputs=inputs, workarounds=workarounds,
-                         one_call_per_queue=one_call_per_queue)
+                         one_call_per_queue=one_call_per_queue, external=external, logic_hz=logic_hz)
         self._executables.append(exe)
         return exe
 
@@ -153,7 +157,8 @@ class Executable:
     """A plan lowered (``recording``) and recorded once on a ``Gpu``; run it any number of times."""
 
     def __init__(self, gpu: Gpu, plan: dict, *, inputs: dict[str, Any] | None,
-                 workarounds: Iterable[str], one_call_per_queue: bool) -> None:
+                 workarounds: Iterable[str], one_call_per_queue: bool,
+                 external: dict[str, list[Any]] | None = None, logic_hz: float | None = None) -> None:
         from rgraph.vk.executor import Executor
 
         self.gpu = gpu
@@ -161,7 +166,8 @@ class Executable:
         self._first_message = len(gpu.instance.log.messages)
         self.executor = Executor(plan, validate=gpu.validate, device_index=None, inputs=inputs,
                                  one_call_per_queue=one_call_per_queue, workarounds=workarounds,
-                                 instance=gpu.instance, device=gpu.device, verbose=False)
+                                 instance=gpu.instance, device=gpu.device, verbose=False, external=external,
+                                 logic_hz=logic_hz)
         self._closed = False
 
     @property

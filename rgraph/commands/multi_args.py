@@ -19,6 +19,12 @@ def add_split_arguments(parser: argparse.ArgumentParser, *, indices: bool = Fals
                              "depth composited")
     parser.add_argument("--balance", choices=("static", "dynamic"), default="static",
                         help="static: equal shares; dynamic: shares from measured per-device times (run)")
+    if indices:
+        parser.add_argument("--transfer", choices=("auto", "shared", "staged"), default="auto",
+                            help="tiles between devices: shared (one host allocation imported by both, "
+                                 "VK_EXT_external_memory_host), staged (readback + upload); auto: shared where offered")
+        parser.add_argument("--pipelined", action="store_true",
+                            help="start the senders' next frame while device 0 finishes this one (one frame of latency)")
 
 
 def device_list(args: argparse.Namespace) -> list[int] | None:

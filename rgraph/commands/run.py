@@ -60,6 +60,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--trace", type=output_path, metavar="OUT.json",
                         help="write the frame in the Chrome trace event format (Perfetto, chrome://tracing): "
                              "a track per queue, passes as slices, barriers, semaphore waits as flows")
+    parser.add_argument("--logic-hz", dest="logic_hz", type=logic_rate, default=None, metavar="HZ",
+                        help="run the scene's logic (deformation, animation) on its own thread at HZ; frames "
+                             "are submitted as fast as they complete, interpolating between the last two logic "
+                             "states (reports the render thread's CPU per frame)")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.add_argument("--naive-cpu", dest="naive_cpu", action="store_true",
                         help="draw the scene the engines' way for comparison: per-object CPU frustum culling and "
@@ -75,6 +79,31 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     add_split_arguments(parser, indices=True)
     parser.set_defaults(func=run)
+
+
+def logic_rate(text: str) -> float:
+    """``--logic-hz``: a positive, finite number of ticks per second."""
+    try:
+        hz = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (0 < hz <= 10_000):
+        raise argparse.ArgumentTypeError(f"must be in (0, 10000] Hz, not {text}")
+    return hz
+
+
+def render_thread_line(timings: dict) -> str:
+    """One stderr line: the render thread's CPU per frame, and the logic thread's ticks."""
+    r = timings.get("render_thread") or {}
+    line = (f"rgraph: render thread {r.get('cpu_us_per_frame', 0.0):.1f} us CPU per frame "
+            f"(host updates {r.get('update_us', 0.0):.1f} us median)")
+    logic = timings.get("logic")
+    if logic:
+        measured = logic.get("measured_hz")
+        line += (f"; logic {logic['ticks']} ticks at {logic['hz']:g} Hz"
+                 + (f" (measured {measured:.1f} Hz" if measured else " (")
+                 + f", {logic['late_ticks']} late)")
+    return line
 
 
 def is_plan_file(target: str) -> bool:
@@ -239,7 +268,8 @@ def run(args: argparse.Namespace) -> int:
             if args.heatmap and "light_heat" not in outputs:
                 raise RGraphError.in_file(args.graph, "--heatmap needs an output image 'light_heat' "
                                                       "(see graphs/clustered.yaml)")
-            exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else ())
+            exe = gpu.load(plan, workarounds=LAYER_WORKAROUNDS if args.layer_workarounds else (),
+                           logic_hz=args.logic_hz)
             result = exe.run_and_check(args.frames, check_data=args.validate if args.check_data is None
                                        else args.check_data, out_png=args.out, warmup_s=args.warmup,
                                        read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
@@ -279,6 +309,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"rgraph: {len(result.messages)} validation message(s)", file=sys.stderr)
         if result.messages:
             status = 1
+    print(render_thread_line(result.timings), file=sys.stderr)
     if result.data_ok is not None:
         for mismatch in result.mismatches:
             print(f"rgraph: data mismatch: {mismatch}", file=sys.stderr)

@@ -15,6 +15,10 @@ from typing import Any
 from rgraph.commands.common import parse_params, parse_size
 
 
+def _runtime_options(args: argparse.Namespace) -> dict[str, Any]:
+    return {"transfer": getattr(args, "transfer", "auto") or "auto", "pipelined": bool(getattr(args, "pipelined", False))}
+
+
 def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -> int:
     from rgraph.api import open_device
     from rgraph.commands.multi_args import split_from_args
@@ -44,19 +48,22 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
 
             multi, summary, history = run_balanced(
                 gpus, lambda w: compile_graph_plan(args.graph, split=replace(split, weights=w), **options),
-                args.frames)
+                args.frames, **_runtime_options(args))
             plan = multi.plan
-            print("rgraph: shares per frame: " + " -> ".join("/".join(f"{x:.2f}" for x in w) for w in history),
-                  file=sys.stderr)
+            print("rgraph: shares per frame: " + " -> ".join("/".join(f"{x:.2f}" for x in w) for w in history)
+                  + f"; {multi.loads} plan load(s) for {args.frames} frame(s)", file=sys.stderr)
         else:
-            multi = MultiExecutable(gpus, plan)
+            multi = MultiExecutable(gpus, plan, **_runtime_options(args))
+            warm = getattr(args, "warmup", None)
+            multi.warm_up(gpus[0].default_warmup_s if warm is None else warm)
             summary = multi.run(args.frames)
+        frames = getattr(multi, "frames_done", args.frames)  # warm-up frames included (the data check counts them)
         data = multi.read_back()
         check = args.validate if args.check_data is None else args.check_data
         verdict = None
         if check and reference is not None:  # device 0's own resources (not the received buffers)
             known = {r["name"] for r in reference["resources"]}
-            verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, args.frames)
+            verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, frames)
         if args.out:
             from rgraph.png import write_output_png
 
@@ -71,12 +78,13 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
     info = plan.multi_device or {}
     print(f"rgraph: {info.get('split')} over {len(devices)} logical devices {devices}: frame {summary.frame_ms:.2f} ms "
           f"(host), device GPU ms {[round(x, 3) for x in summary.device_ms]}, readback {summary.readback_ms:.2f} ms, "
-          f"device 0 receive+frame {summary.device0_ms:.2f} ms; VK_EXT_external_memory_host offered: "
-          f"{summary.host_memory_import} (staged copy used)", file=sys.stderr)
+          f"device 0 frame {summary.device0_ms:.2f} ms; VK_EXT_external_memory_host offered: "
+          f"{summary.host_memory_import} ({summary.transfer} transfer)", file=sys.stderr)
     if args.timings:
         args.timings.write_text(json.dumps({"devices": devices, "frame_ms": summary.frame_ms,
                                             "device_ms": summary.device_ms, "readback_ms": summary.readback_ms,
-                                            "device0_ms": summary.device0_ms, **summary.timings}, indent=1,
+                                            "device0_ms": summary.device0_ms, "transfer": summary.transfer,
+                                            **summary.timings}, indent=1,
                                            sort_keys=True) + "\n")
     status = 0
     for message in messages:

@@ -22,9 +22,15 @@ if TYPE_CHECKING:
 SIGNAL_STAGES = ("ALL_COMMANDS",)
 
 
+@lru_cache(maxsize=4096)
+def _names(values: frozenset[str]) -> tuple[str, ...]:
+    """A set of stage or access names as the plan's sorted tuple (frozensets cache their hash)."""
+    return tuple(sorted(values))
+
+
 @lru_cache(maxsize=65536)
 def plan_state(st: csync.State) -> pm.State:
-    return pm.State(tuple(sorted(st.stages)), tuple(sorted(st.access)), st.layout, st.queue)
+    return pm.State(_names(st.stages), _names(st.access), st.layout, st.queue)
 
 
 @lru_cache(maxsize=65536)
@@ -47,6 +53,8 @@ def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.En
     frame), a per-cell list for the others (docs/plan.md)."""
     if not states:
         return None
+    if len(states) == 1:
+        return plan_state(next(iter(states.values())))
     distinct = set(states.values())
     if len(distinct) == 1:
         return plan_state(next(iter(distinct)))
@@ -57,7 +65,7 @@ def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.En
 
 
 def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
-    return MappingProxyType(dict(sorted(mapping.items())))
+    return MappingProxyType(dict(sorted(mapping.items()))) if mapping else pm.EMPTY
 
 
 def _frozen_json(value: Any) -> Any:
@@ -76,17 +84,18 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
     out = []
     for i, p in enumerate(passes):
         ps = sync.passes[i]
-        accesses = tuple(
+        accesses = tuple([
             pm.Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
-                      tuple(sorted(s.stages)), tuple(sorted(s.access)), s.layout, a.write)
+                      _names(s.stages), _names(s.access), s.layout, a.write)
             for a, s in zip(p.accesses, sync.access_sync[i], strict=True)
-        )
+        ])
         out.append(pm.PlanPass(
             name=p.name, index=i, device=0, queue=p.queue, kind=p.kind, impl=p.impl, params=_frozen(p.params),
             accesses=accesses,
-            barriers=tuple(_barrier(b, resources) for b in ps.barriers),
-            releases=tuple(_barrier(b, resources) for b in ps.releases),
-            waits=tuple(pm.Wait(w.queue, signal_values[w.signal_pass], tuple(sorted(w.stages))) for w in ps.waits),
+            barriers=tuple([_barrier(b, resources) for b in ps.barriers]) if ps.barriers else (),
+            releases=tuple([_barrier(b, resources) for b in ps.releases]) if ps.releases else (),
+            waits=tuple([pm.Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits])
+            if ps.waits else (),
             signals=(pm.Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
         ))
     return tuple(out)
@@ -96,10 +105,11 @@ def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
     spec, sync, placement = c.spec, c.sync, c.placement
     assert sync is not None and placement is not None
     out = []
+    outputs = set(c.spec.outputs)
     for name in sorted(c.memory):
         res, mem = spec.resources[name], c.memory[name]
         heap, offset = placement.offsets[name]
-        lifetime = "output" if (name in c.spec.outputs and res.lifetime == "transient") else res.lifetime
+        lifetime = "output" if (name in outputs and res.lifetime == "transient") else res.lifetime
         image = res.is_image
         out.append(pm.PlanResource(
             name=name, kind=res.kind, format=res.format.vk_name if res.format else None, bytes=mem.bytes,
@@ -120,13 +130,14 @@ def emit(c: Compilation) -> pm.Plan:
     assert placement is not None and culling is not None
     passes = _passes(c)
     by_name = {p.name: p for p in spec.passes}
+    used = c.memory
     st = placement.stats
     return pm.Plan(
         graph=spec.name, source=spec.source, scene=spec.scene_name, scene_source=c.spec.scene_source,
         size=tuple(spec.size), params=_frozen(spec.params), features=_frozen(spec.features),
         device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if any(p.queue == q for p in passes)),
         passes=passes,
-        culled=tuple(_culled(x.pass_name, x.reason, by_name[x.pass_name], c) for x in culling.culled),
+        culled=tuple(_culled(x.pass_name, x.reason, by_name[x.pass_name], c, used) for x in culling.culled),
         dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
         resources=_resources(c),
         heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
@@ -140,9 +151,9 @@ def emit(c: Compilation) -> pm.Plan:
     )
 
 
-def _culled(name: str, reason: str, p: PassSpec, c: Compilation) -> pm.Culled:
-    """A culled pass with the resources only culled passes used, and their bytes."""
-    only = tuple(sorted({a.resource for a in p.accesses} - set(c.memory)))
+def _culled(name: str, reason: str, p: PassSpec, c: Compilation, used: Mapping[str, Any]) -> pm.Culled:
+    """A culled pass with the resources only culled passes used (not in ``used``), and their bytes."""
+    only = tuple(sorted({a.resource for a in p.accesses if a.resource not in used}))
     return pm.Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
 
 

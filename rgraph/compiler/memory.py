@@ -85,9 +85,10 @@ def requirements(
 ) -> dict[str, Requirement]:
     """The requirement of each used resource, in name order."""
     out = {}
+    kept = set(outputs)  # a list: 5,000 side-effect outputs made this quadratic
     for name in sorted(used):
         res = resources[name]
-        usages = sorted(used[name] | ({"transfer_src"} if name in outputs or res.lifetime == "output" else set()))
+        usages = sorted(used[name] | ({"transfer_src"} if name in kept or res.lifetime == "output" else set()))
         try:
             if res.is_image:
                 assert res.format is not None
@@ -138,9 +139,8 @@ def place_resources(
 ) -> Placement:
     """Place transients with ``policy``; give every other resource its own heap.
     ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
-    aliasable = [
-        n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in outputs
-    ]
+    kept = set(outputs)
+    aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
     blocks = [
         Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
     ]

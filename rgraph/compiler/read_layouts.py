@@ -37,8 +37,10 @@ def unify_read_layouts(
     for i, p in enumerate(passes):
         for j, a in enumerate(p.accesses):
             res = resources[a.resource]
+            if not res.is_image:
+                continue  # buffers have no layout
             fmt = res.format
-            if (not res.is_image or res.lifetime != "transient" or fmt is None or fmt.has_depth
+            if (res.lifetime != "transient" or fmt is None or fmt.has_depth
                     or fmt.has_stencil or not _whole(a, res)):
                 excluded.add(a.resource)
             uses.setdefault(a.resource, []).append((i, j))

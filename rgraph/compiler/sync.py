@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
@@ -30,9 +31,9 @@ PERSISTENT = ("persistent", "imported")
 PREVIOUS_FRAME = -1
 
 
-@dataclass(frozen=True)
-class State:
-    """Where a cell stands: stages/access of the last accesses that later ones must wait for."""
+class State(NamedTuple):
+    """Where a cell stands: stages/access of the last accesses that later ones must wait for.
+    (A named tuple: hashed and compared in C, as barrier group keys are many.)"""
 
     stages: frozenset[str]
     access: frozenset[str]  # writes only
@@ -40,29 +41,29 @@ class State:
     queue: str | None
 
 
-@dataclass(frozen=True)
-class BarrierKey:
+class BarrierKey(NamedTuple):
     src: State
     dst: State
     aliases: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True)
-class Barrier:
+EMPTY: frozenset[str] = frozenset()
+
+
+class Barrier(NamedTuple):
     resource: str
     mips: tuple[int, int] | None
     layers: tuple[int, int] | None
     key: BarrierKey
 
 
-@dataclass(frozen=True)
-class Wait:
+class Wait(NamedTuple):
     queue: str
     signal_pass: int  # executed index of the pass whose signal is waited for
     stages: frozenset[str]
 
 
-@dataclass
+@dataclass(slots=True)
 class PassSync:
     barriers: list[Barrier] = field(default_factory=list)
     releases: list[Barrier] = field(default_factory=list)
@@ -78,7 +79,7 @@ class SyncResult:
     initial: dict[str, dict[Cell, State]]
 
 
-@dataclass
+@dataclass(slots=True)
 class _Cell:
     layout: str | None
     queue: str | None
@@ -94,14 +95,19 @@ class _Cell:
 
     def state(self) -> State:
         if self.reads:
-            return State(frozenset().union(*(s for _, s in self.reads)), frozenset(), self.layout, self.queue)
+            return State(self.read_stages(), EMPTY, self.layout, self.queue)
         if self.write:
             return State(self.write[1], self.write[2], self.layout, self.queue)
-        return State(frozenset(), frozenset(), self.layout, self.queue)
+        return State(EMPTY, EMPTY, self.layout, self.queue)
+
+    def read_stages(self) -> frozenset[str]:
+        reads = self.reads
+        if len(reads) == 1:
+            return reads[0][1]
+        return EMPTY.union(*(s for _, s in reads))
 
 
-@dataclass(frozen=True)
-class _Use:
+class _Use(NamedTuple):
     pass_pos: int
     sync: Sync
     write: bool
@@ -172,8 +178,9 @@ def synchronize(
     needed |= {p for preds in alias_sources.values() for p in preds}
     first = _Simulation(passes, per_pass_cells, timeline, resources)
     if needed:
-        first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
-        first.run({c: fresh(c) for c in timeline if c[0] in needed})
+        if not all(c[0] in needed for c in timeline):
+            first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
+        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})
     start: dict[Cell, _Cell] = {}
     for c in timeline:
         res = resources[c[0]]
@@ -290,52 +297,71 @@ class _Simulation:
         self.resources = resources
         self.out = [PassSync() for _ in passes]
         self.cells: dict[Cell, _Cell] = {}
+        self.image = {name: res.is_image for name, res in resources.items()}
+
+    def run_states(self, start: dict[Cell, _Cell]) -> None:
+        """``run`` for the cells' end states only: the barriers it would derive are not kept."""
+        self.cells = cells_now = start
+        step = self._step
+        for i, p in enumerate(self.passes):
+            queue = p.queue
+            for c, (s, w) in self.per_pass_cells[i].items():
+                step(c, cells_now[c], i, queue, s, w)
 
     def run(self, start: dict[Cell, _Cell]) -> None:
-        self.cells = start
+        self.cells = cells_now = start
+        step, out = self._step, self.out
         for i, p in enumerate(self.passes):
             # acquires grouped by their release pass too, so that each acquire's rectangles equal
             # its release's (the layer pairs ownership transfers by exact subresource range)
-            groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = defaultdict(list)
-            release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] = defaultdict(list)
+            groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = {}
+            release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] = {}
             waits: dict[str, tuple[int, set[str]]] = {}
+            queue = p.queue
             for c, (s, w) in self.per_pass_cells[i].items():
-                cell = self.cells[c]
-                key, release_at, wait_on = self._step(c, cell, i, p.queue, s, w)
-                wait_stages = set(s.stages)
-                if key is not None and wait_on and key.src.queue == p.queue:
-                    # A semaphore wait orders only its own stages, and a barrier chains after it only
-                    # through its source stages: they must meet (the swapchain-acquire pattern).
-                    if not key.src.stages:
-                        key = replace(key, src=replace(key.src, stages=frozenset(s.stages)))
-                    wait_stages |= key.src.stages
+                key, release_at, wait_on = step(c, cells_now[c], i, queue, s, w)
                 if key is not None:
-                    groups[(c[0], key, release_at)].append(c)
+                    if wait_on:
+                        wait_stages = set(s.stages)
+                        if key.src.queue == queue:
+                            # A semaphore wait orders only its own stages, and a barrier chains after it
+                            # only through its source stages: they must meet (the swapchain-acquire pattern).
+                            if not key.src.stages:
+                                key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
+                            wait_stages |= key.src.stages
+                    group = (c[0], key, release_at)
+                    if group in groups:
+                        groups[group].append(c)
+                    else:
+                        groups[group] = [c]
                     if release_at is not None:
-                        release_groups[(release_at, c[0], key)].append(c)
+                        release_groups.setdefault((release_at, c[0], key), []).append(c)
+                elif wait_on:
+                    wait_stages = set(s.stages)
                 for q, j in wait_on:
                     prev = waits.get(q)
                     waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
-            self.out[i].barriers = _rectangles(groups)
-            for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
-                self.out[j].releases.extend(_rectangles({(res, key): cs}))
-            for q, (j, stages) in sorted(waits.items()):
-                self.out[i].waits.append(Wait(q, j, frozenset(stages)))
-                self.out[j].signal = True
+            out[i].barriers = _rectangles(groups) if groups else []
+            if release_groups:
+                for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
+                    out[j].releases.extend(_rectangles({(res, key): cs}))
+            if waits:
+                for q, (j, stages) in sorted(waits.items()):
+                    out[i].waits.append(Wait(q, j, frozenset(stages)))
+                    out[j].signal = True
 
     def _step(self, c: Cell, cell: _Cell, i: int, queue: str, s: Sync, write: bool):
         """Update one cell for pass ``i``; return (barrier key, release pass, (queue, wait pass))."""
-        uses = self.timeline[c]
         k = cell.cursor
         cell.cursor += 1
-        prev = cell.state()
-        if self._is_image(c):
+        if self.image[c[0]]:
             has_content = cell.layout not in (None, "UNDEFINED")
         else:
             has_content = not cell.aliases and (cell.write is not None or bool(cell.reads))
         cross = cell.queue is not None and cell.queue != queue
         release_at = None
-        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue]  # aliased memory used on another queue
+        # aliased memory used on another queue
+        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue] if cell.alias_waits else []
         if cross and cell.last_pass is not None and not cell.last_in_previous_frame:
             wait_on.append((cell.queue, cell.last_pass))  # earlier frames: the runtime's frame-boundary waits
         transfer = cross and has_content
@@ -346,26 +372,25 @@ class _Simulation:
         key: BarrierKey | None = None
         if write or layout_change:
             if cell.reads:
-                src = State(prev.stages, frozenset(), cell.layout, src_queue)
+                src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
             elif cell.write:
                 src = State(cell.write[1], cell.write[2], cell.layout, src_queue)
             else:
-                src = State(frozenset(), frozenset(), cell.layout, src_queue)
+                src = State(EMPTY, EMPTY, cell.layout, src_queue)
             if src.stages or src.access or layout_change or transfer:
                 dst_stages, dst_access = s.stages, s.access
                 if not write:  # a transition for a read group: cover the whole group
-                    dst_stages, dst_access = self._group(uses, k, s.layout, queue)
-                    cell.covered_until = self._group_end(uses, k, s.layout, queue)
+                    dst_stages, dst_access, cell.covered_until = self._group(self.timeline[c], k, s.layout, queue)
                     cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             if write:
                 cell.write = (i, s.stages, s.writes)
                 cell.reads = []
                 cell.covered_until = k
-                cell.visible = (frozenset(), frozenset())
+                cell.visible = (EMPTY, EMPTY)
             else:
                 if layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
-                    cell.write = (i, s.stages, frozenset()) if cell.layout != "UNDEFINED" else None
+                    cell.write = (i, s.stages, EMPTY) if cell.layout != "UNDEFINED" else None
                 if layout_change:
                     cell.reads = []
                 cell.reads.append((i, s.stages))
@@ -373,11 +398,10 @@ class _Simulation:
             seen = s.stages <= cell.visible[0] and s.access <= cell.visible[1]  # e.g. last frame's barrier
             if transfer or (cell.write and k > cell.covered_until and not seen):
                 if cell.reads:  # the write is already available: chain through the reads
-                    src = State(prev.stages, frozenset(), cell.layout, src_queue)
+                    src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
                 else:
-                    src = State(cell.write[1] if cell.write else frozenset(), cell.write[2] if cell.write else frozenset(), cell.layout, src_queue)
-                dst_stages, dst_access = self._group(uses, k, s.layout, queue)
-                cell.covered_until = self._group_end(uses, k, s.layout, queue)
+                    src = State(cell.write[1] if cell.write else EMPTY, cell.write[2] if cell.write else EMPTY, cell.layout, src_queue)
+                dst_stages, dst_access, cell.covered_until = self._group(self.timeline[c], k, s.layout, queue)
                 cell.visible = (dst_stages, dst_access)
                 key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
             cell.reads.append((i, s.stages))
@@ -393,9 +417,6 @@ class _Simulation:
         cell.last_in_previous_frame = False
         return key, release_at, wait_on
 
-    def _is_image(self, c: Cell) -> bool:
-        return self.resources[c[0]].is_image
-
     @staticmethod
     def _group_end(uses: list[_Use], k: int, layout: str | None, queue: str) -> int:
         j = k
@@ -406,14 +427,18 @@ class _Simulation:
             j += 1
         return j
 
-    def _group(self, uses: list[_Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str]]:
+    def _group(self, uses: list[_Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
+        """Stages and accesses of the read group starting at use ``k``, and its last use."""
         end = self._group_end(uses, k, layout, queue)
+        if end == k:
+            only = uses[k].sync
+            return only.stages, only.access, end
         stages: set[str] = set()
         access: set[str] = set()
         for u in uses[k : end + 1]:
             stages |= u.sync.stages
             access |= u.sync.access
-        return frozenset(stages), frozenset(access)
+        return frozenset(stages), frozenset(access), end
 
     def final_states(self) -> dict[Cell, State]:
         return {c: cell.state() for c, cell in self.cells.items()}
@@ -422,10 +447,17 @@ class _Simulation:
 def _rectangles(groups: Mapping[tuple, list[Cell]]) -> list[Barrier]:
     """Merge cells with one barrier into mip x layer rectangles (deterministic order); a group
     key is (resource, BarrierKey, ...)."""
-    out = [Barrier(res, mips, layers, key)
-           for (res, key, *_), cs in groups.items()
-           for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
-    return sorted(out, key=_barrier_sort_key)
+    out = []
+    for (res, key, *_), cs in groups.items():
+        if len(cs) == 1:  # one cell (every buffer): its own rectangle
+            _, mip, layer = cs[0]
+            out.append(Barrier(res, (mip, mip + 1), (layer, layer + 1), key))
+        else:
+            out += [Barrier(res, mips, layers, key)
+                    for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
+    if len(out) > 1:
+        out.sort(key=_barrier_sort_key)
+    return out
 
 
 def mip_layer_rectangles(cells: Iterable[tuple[int, int]]) -> list[tuple[tuple[int, int], tuple[int, int]]]:

@@ -7,7 +7,7 @@ without prefixes and ``_BIT`` (FORMAT.md section 3).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 
 # Shader stages of a pass kind, used by sampled/storage/uniform/accel_read usages.
 KIND_SHADER_STAGES: dict[str, tuple[str, ...]] = {
@@ -91,7 +91,7 @@ class Sync:
     access: frozenset[str]
     layout: str | None
 
-    @property
+    @cached_property
     def writes(self) -> frozenset[str]:
         return self.access & WRITE_ACCESS
 

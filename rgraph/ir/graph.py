@@ -7,7 +7,7 @@ subresource cell (resource, mip, layer), like SSA renaming of each cell.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 
 import networkx as nx
 
@@ -18,14 +18,15 @@ READ_WRITE_USAGES = frozenset({"color_attachment_blend", "depth_attachment", "st
 Cell = tuple[str, int, int]
 
 
-def cells(access: AccessSpec) -> Iterator[Cell]:
-    """The (resource, mip, layer) cells an access touches; buffers have the one cell (0, 0)."""
-    if access.mips is None or access.layers is None:
-        yield (access.resource, 0, 0)
-        return
-    for mip in range(*access.mips):
-        for layer in range(*access.layers):
-            yield (access.resource, mip, layer)
+def cells(access: AccessSpec) -> tuple[Cell, ...]:
+    """The (resource, mip, layer) cells an access touches, mip-major; buffers have the one
+    cell (0, 0)."""
+    mips, layers, name = access.mips, access.layers, access.resource
+    if mips is None or layers is None:
+        return ((name, 0, 0),)
+    if mips[1] - mips[0] == 1 and layers[1] - layers[0] == 1:
+        return ((name, mips[0], layers[0]),)
+    return tuple((name, mip, layer) for mip in range(*mips) for layer in range(*layers))
 
 
 def reads(access: AccessSpec) -> bool:

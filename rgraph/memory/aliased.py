@@ -47,13 +47,12 @@ def overlapping_pairs(blocks: Sequence[Block]) -> int:
     """Ordered pairs (i, j), i != j, of blocks whose lifetimes overlap: n log n, no pair lists."""
     if not blocks:
         return 0
-    starts = np.sort(np.fromiter((b.start for b in blocks), dtype=np.int64, count=len(blocks)))
-    ends = np.sort(np.fromiter((b.end for b in blocks), dtype=np.int64, count=len(blocks)))
-    # j overlaps i iff start_j <= end_i and end_j >= start_i
-    total = 0
-    for b in blocks:
-        total += int(np.searchsorted(starts, b.end, side="right")) - int(np.searchsorted(ends, b.start, side="left"))
-    return total - len(blocks)
+    starts = np.fromiter((b.start for b in blocks), dtype=np.int64, count=len(blocks))
+    ends = np.fromiter((b.end for b in blocks), dtype=np.int64, count=len(blocks))
+    # j overlaps i iff start_j <= end_i and end_j >= start_i (no j ends before it starts)
+    began = np.searchsorted(np.sort(starts), ends, side="right")
+    ended = np.searchsorted(np.sort(ends), starts, side="left")
+    return int(began.sum() - ended.sum()) - len(blocks)
 
 
 def too_dense(blocks: Sequence[Block], time_budget_s: float) -> bool:
@@ -77,11 +76,13 @@ class ClassResult:
 def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
     lb = inst.lower_bound()
     best: ClassResult | None = None
-    for name, order in orderings(inst).items():
+    for name, order in orderings(inst):
         offsets = best_fit(inst, order)
         peak = inst.peak(offsets)
         if best is None or peak < best.peak:
             best = ClassResult(offsets, peak, lb, f"greedy:{name}")
+        if best.peak <= lb:
+            break  # proven optimal: no later ordering can be strictly better
     assert best is not None
     if best.peak <= lb or inst.n == 0 or not inst.separable:
         # Conflicts beyond time overlaps (cross-queue pairs) leave the time bound out of

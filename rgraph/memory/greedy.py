@@ -6,7 +6,7 @@ it in time and can hold it (aligned); when no gap fits it goes on top of them.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Iterator, Sequence
 
 from rgraph.memory.instance import Instance
 
@@ -14,11 +14,12 @@ from rgraph.memory.instance import Instance
 def best_fit(inst: Instance, order: Sequence[int]) -> list[int]:
     """Offsets for every block, placing blocks in ``order``."""
     offsets = [-1] * inst.n
-    tops = [0] * inst.n
+    placed: list[tuple[int, int] | None] = [None] * inst.n  # (offset, top) once placed
     size, align, neighbors = inst.size, inst.align, inst.neighbors
+    get = placed.__getitem__
     for i in order:
         need, a = size[i], align[i]
-        taken = sorted((offsets[j], tops[j]) for j in neighbors[i] if offsets[j] >= 0)
+        taken = sorted(filter(None, map(get, neighbors[i])))  # placed neighbours by (offset, top)
         best_off, best_gap = -1, -1
         cursor = 0
         for lo, hi in taken:
@@ -33,22 +34,20 @@ def best_fit(inst: Instance, order: Sequence[int]) -> list[int]:
         if best_off < 0:
             best_off = cursor if cursor % a == 0 else cursor + a - cursor % a
         offsets[i] = best_off
-        tops[i] = best_off + need
+        placed[i] = (best_off, best_off + need)
     return offsets
 
 
-def orderings(inst: Instance) -> dict[str, list[int]]:
-    """The static orderings tried by the heuristic (all deterministic, ties by index)."""
+def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:
+    """The static orderings tried by the heuristic, in turn (all deterministic, ties by
+    index); each is sorted only when asked for, so a caller that stops early pays less."""
     n = range(inst.n)
     s, e, z = inst.start, inst.end, inst.size
+    yield "size", sorted(n, key=lambda i: (-z[i], s[i], i))
+    yield "area", sorted(n, key=lambda i: (-z[i] * (e[i] - s[i] + 1), i))
+    yield "length", sorted(n, key=lambda i: (-(e[i] - s[i]), -z[i], i))
+    yield "start", sorted(n, key=lambda i: (s[i], -z[i], i))
     totals = inst.section_totals()
     contention = [max(totals[inst.sec_lo[i] : inst.sec_hi[i]], default=0) for i in n]
-    keys: dict[str, Callable[[int], tuple]] = {
-        "size": lambda i: (-z[i], s[i], i),
-        "area": lambda i: (-z[i] * (e[i] - s[i] + 1), i),
-        "length": lambda i: (-(e[i] - s[i]), -z[i], i),
-        "start": lambda i: (s[i], -z[i], i),
-        "contention": lambda i: (-contention[i], -z[i] * (e[i] - s[i] + 1), i),
-        "contention_size": lambda i: (-contention[i], -z[i], i),
-    }
-    return {name: sorted(n, key=key) for name, key in keys.items()}
+    yield "contention", sorted(n, key=lambda i: (-contention[i], -z[i] * (e[i] - s[i] + 1), i))
+    yield "contention_size", sorted(n, key=lambda i: (-contention[i], -z[i], i))

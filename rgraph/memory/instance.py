@@ -6,10 +6,46 @@ from bisect import bisect_left
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from heapq import heappop, heappush
 
 import numpy as np
 
 from rgraph.memory.model import Block
+
+#: From this many blocks, neighbours come from a sweep over start times (cost in the pairs
+#: found) instead of one numpy row per block (cost n**2, cheap per element).
+SWEEP_FROM = 1500
+
+
+def time_neighbors(start: Sequence[int], end: Sequence[int]) -> list[list[int]]:
+    """For each block, the other blocks whose closed lifetime ``[start, end]`` overlaps
+    its own, ascending by index."""
+    n = len(start)
+    if n < SWEEP_FROM:
+        starts = np.asarray(start, dtype=np.int64)
+        ends = np.asarray(end, dtype=np.int64)
+        rows = []
+        for i in range(n):
+            row = (starts <= end[i]) & (ends >= start[i])
+            row[i] = False
+            rows.append(np.flatnonzero(row).tolist())
+        return rows
+    neighbors: list[list[int]] = [[] for _ in range(n)]
+    active: list[tuple[int, int]] = []  # heap of (end, block) of blocks begun so far
+    live: set[int] = set()
+    for i in sorted(range(n), key=start.__getitem__):
+        s = start[i]
+        while active and active[0][0] < s:
+            live.discard(heappop(active)[1])
+        row = neighbors[i]
+        for j in live:
+            row.append(j)
+            neighbors[j].append(i)
+        live.add(i)
+        heappush(active, (end[i], i))
+    for row in neighbors:
+        row.sort()
+    return neighbors
 
 
 @dataclass
@@ -42,13 +78,7 @@ class Instance:
         blocks = list(blocks)
         start = [b.start for b in blocks]
         end = [b.end for b in blocks]
-        starts = np.asarray(start, dtype=np.int64)
-        ends = np.asarray(end, dtype=np.int64)
-        neighbors: list[list[int]] = []
-        for i in range(len(blocks)):
-            row = (starts <= end[i]) & (ends >= start[i])
-            row[i] = False
-            neighbors.append(np.flatnonzero(row).tolist())
+        neighbors = time_neighbors(start, end)
         separable = True
         if conflicts:
             index = {b.name: k for k, b in enumerate(blocks)}

@@ -2,9 +2,10 @@
 
 Object space, float64. Breathing scales the mesh radially around its +Y axis; a Gaussian
 dent (an instrument pressing on the skin) deepens and relaxes at the front (+Z) of the mesh
-below the middle. Normals are recomputed from the deformed faces every frame (area
-weighted, zero-area faces ignored, degenerate vertices fall back to their rest normal): they
-are always unit length and never NaN.
+below the middle. Normals and tangents follow the deformed faces (``rgraph.scene.smoothing``:
+area weighted, smoothing groups across UV seams, zero-area faces ignored, degenerate vertices
+fall back to their rest normal; always unit length, never NaN): on the GPU every frame
+(``rgraph.vk.scene_deform``), here in float64 as the reference (``at``).
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rgraph.scene.shapes import MeshData, vertex_normals
+from rgraph.scene.shapes import MeshData
+from rgraph.scene.smoothing import SmoothingTopology, build_topology, normals_tangents
 
 FRAME_SECONDS = 1.0 / 60.0
 
@@ -28,6 +30,11 @@ class Deformer:
     press_width: float = 0.25  # fraction of the mesh radius
     _radius: float = field(init=False, default=1.0)
     _centre: np.ndarray = field(init=False)
+    # positions = basis^T (1, breath - 1, -depth): rest, its radial (x, z) part, the dent
+    # direction (Gaussian falloff * rest normal); (3, 3n) float64 and float32
+    _basis: np.ndarray = field(init=False, repr=False)
+    _basis32: np.ndarray = field(init=False, repr=False)
+    topology: SmoothingTopology = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         p = self.rest.positions
@@ -37,27 +44,47 @@ class Deformer:
         target = np.array([0.0, lo[1] + 0.35 * (hi[1] - lo[1]), self._radius])
         # the press centre: the surface vertex nearest the front point below the middle
         self._centre = p[int(np.argmin(((p - target) ** 2).sum(axis=1)))].copy() if len(p) else target
+        d2 = ((p - self._centre) ** 2).sum(axis=1)
+        sigma = self.press_width * self._radius
+        dent = np.exp(-d2 / (2.0 * sigma * sigma))[:, None] * self.rest.normals
+        self._basis = np.stack([p.reshape(-1), (p * (1.0, 0.0, 1.0)).reshape(-1), dent.reshape(-1)])
+        self._basis32 = self._basis.astype(np.float32)
+        self.topology = build_topology(len(p), self.rest.indices, self.rest.smooth_group, p)
 
     @property
     def max_displacement(self) -> float:
         """An upper bound of how far any vertex moves (for bounds)."""
         return self._radius * (self.breath_amplitude + 0.1 * self.press_depth)
 
-    def positions(self, seconds: float) -> np.ndarray:
-        p = self.rest.positions.copy()
+    def _coefficients(self, seconds: float) -> np.ndarray:
         breath = 1.0 + self.breath_amplitude * np.sin(2.0 * np.pi * seconds / self.breath_period)
-        p[:, 0] *= breath
-        p[:, 2] *= breath
         press = 0.5 - 0.5 * np.cos(2.0 * np.pi * seconds / self.press_period)
-        d2 = ((self.rest.positions - self._centre) ** 2).sum(axis=1)
-        sigma = self.press_width * self._radius
-        dent = 0.1 * self.press_depth * self._radius * press * np.exp(-d2 / (2.0 * sigma * sigma))
-        return p - dent[:, None] * self.rest.normals
+        return np.array([1.0, breath - 1.0, -0.1 * self.press_depth * self._radius * press])
+
+    def positions(self, seconds: float) -> np.ndarray:
+        """Deformed positions at ``seconds`` (n, 3) float64: the rest positions scaled radially
+        by the breath, minus the dent along the rest normals."""
+        return (self._coefficients(seconds) @ self._basis).reshape(-1, 3)
+
+    def write_positions(self, seconds: float, out: np.ndarray) -> None:
+        """``positions(seconds)`` in float32 into ``out`` ((n, 3) float32, C-contiguous: e.g.
+        mapped memory), one matrix-vector product without allocating (the per-frame path;
+        within about one float32 ulp of ``positions``)."""
+        if not out.flags.c_contiguous or out.dtype != np.float32 or out.size != self._basis32.shape[1]:
+            raise ValueError("write_positions: out must be a C-contiguous (n, 3) float32 array")
+        np.dot(self._coefficients(seconds).astype(np.float32), self._basis32, out=out.reshape(-1))
 
     def at(self, seconds: float) -> MeshData:
+        """The deformed mesh with its reference normals (float64; ``tangents_at`` for tangents)."""
         pos = self.positions(seconds)
-        idx = self.rest.indices.astype(np.int64)
-        return MeshData(pos, vertex_normals(pos, idx, fallback=self.rest.normals), self.rest.indices)
+        normals, _tangents = normals_tangents(pos, self.rest.indices, self.topology, self.rest.normals,
+                                              self.rest.uvs)
+        return MeshData(pos, normals, self.rest.indices, self.rest.uvs, self.rest.smooth_group)
+
+    def tangents_at(self, seconds: float) -> np.ndarray:
+        """Reference tangents (n, 4) at ``seconds``: xyz unit, w the bitangent's handedness."""
+        return normals_tangents(self.positions(seconds), self.rest.indices, self.topology, self.rest.normals,
+                                self.rest.uvs)[1]
 
     def at_frame(self, frame: int) -> MeshData:
         return self.at(frame * FRAME_SECONDS)

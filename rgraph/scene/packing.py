@@ -40,9 +40,10 @@ def split_hi_lo(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return hi, lo
 
 
-def frame_bytes(scene: SceneData, frame: int) -> bytes:
-    """The Frame uniform for ``frame``. Everything but the time fields depends on the camera
-    alone and is cached per camera state (the per-frame cost is the camera and a copy)."""
+def frame_bytes(scene: SceneData, frame: int, seconds: float | None = None) -> bytes:
+    """The Frame uniform for ``frame`` (at scene time ``seconds``: default the frame's). Everything
+    but the time fields depends on the camera alone and is cached per camera state (the
+    per-frame cost is the camera and a copy)."""
     cam = scene.camera(frame)
     key = (np.asarray(cam.position, dtype=np.float64).tobytes(), np.asarray(cam.view_proj).tobytes())
     cached = getattr(scene, "_frame_cache", None)
@@ -51,7 +52,8 @@ def frame_bytes(scene: SceneData, frame: int) -> bytes:
         scene._frame_cache = cached  # type: ignore[attr-defined]
     f = cached[1].copy()
     o = FRAME_OFFSETS["time"] // 4
-    f[o:o + 4] = (scene.seconds(frame), float(frame), cam.near, np.radians(cam.fov_y_deg))
+    f[o:o + 4] = (scene.seconds(frame) if seconds is None else seconds, float(frame), cam.near,
+                  np.radians(cam.fov_y_deg))
     return f.tobytes()
 
 

@@ -19,11 +19,15 @@ EPS = 1e-12
 
 @dataclass(frozen=True)
 class MeshData:
-    """positions (n, 3) float64, normals (n, 3) float64 unit, indices (m, 3) uint32."""
+    """positions (n, 3) float64, normals (n, 3) float64 unit, indices (m, 3) uint32; optional
+    uvs (n, 2) float64 and smooth_group (n,): per vertex the representative vertex of its
+    smoothing group (vertices split at a UV seam share one normal: ``rgraph.scene.smoothing``)."""
 
     positions: np.ndarray
     normals: np.ndarray
     indices: np.ndarray
+    uvs: np.ndarray | None = None
+    smooth_group: np.ndarray | None = None
 
     @property
     def vertex_count(self) -> int:
@@ -68,13 +72,20 @@ def _mesh(positions, normals, indices) -> MeshData:
 
 
 def merge(meshes: list[MeshData]) -> MeshData:
-    positions, normals, indices, base = [], [], [], 0
+    """One mesh of ``meshes`` (uvs kept when every part has them; smoothing groups offset)."""
+    positions, normals, indices, groups, base = [], [], [], [], 0
     for m in meshes:
         positions.append(m.positions)
         normals.append(m.normals)
         indices.append(m.indices.astype(np.int64) + base)
+        own = np.arange(m.vertex_count) if m.smooth_group is None else m.smooth_group.astype(np.int64)
+        groups.append(own + base)
         base += m.vertex_count
-    return _mesh(np.concatenate(positions), np.concatenate(normals), np.concatenate(indices))
+    merged = _mesh(np.concatenate(positions), np.concatenate(normals), np.concatenate(indices))
+    uvs = np.concatenate([m.uvs for m in meshes]) if all(m.uvs is not None for m in meshes) else None
+    group = np.concatenate(groups).astype(np.uint32)
+    seamless = bool(np.array_equal(group, np.arange(base)))
+    return MeshData(merged.positions, merged.normals, merged.indices, uvs, None if seamless else group)
 
 
 def revolve(radius: np.ndarray, height: np.ndarray, n_radial: np.ndarray, n_up: np.ndarray, segments: int,
@@ -237,7 +248,8 @@ def neck(radius=0.06, height=0.2, prominence=0.012, segments=64, stacks=48) -> M
             a, b, c, d = i * segments + j, i * segments + j2, (i + 1) * segments + j2, (i + 1) * segments + j
             tris += [(a, b, c), (a, c, d)]
     tris_arr = np.asarray(tris)
-    side = MeshData(side_pos, vertex_normals(side_pos, tris_arr), tris_arr.astype(np.uint32))
+    side_normals = vertex_normals(side_pos, tris_arr)  # on the welded side: no seam yet
+    side = _split_seam(side_pos, side_normals, tris_arr, segments, stacks)
     caps = []
     for row, up in ((stacks, True), (0, False)):
         ring = side_pos[row * segments:(row + 1) * segments]
@@ -245,8 +257,33 @@ def neck(radius=0.06, height=0.2, prominence=0.012, segments=64, stacks=48) -> M
         pos = np.concatenate([centre[None], ring])
         ctris = [(0, 1 + j, 1 + (j + 1) % segments) if up else (0, 1 + (j + 1) % segments, 1 + j)
                  for j in range(segments)]
-        caps.append(_mesh(pos, np.tile((0.0, 1.0 if up else -1.0, 0.0), (segments + 1, 1)), ctris))
+        cap = _mesh(pos, np.tile((0.0, 1.0 if up else -1.0, 0.0), (segments + 1, 1)), ctris)
+        planar = 0.5 + 0.5 * (pos[:, [0, 2]] - centre[[0, 2]]) / max(float(np.abs(pos[:, [0, 2]]).max()), EPS)
+        caps.append(MeshData(cap.positions, cap.normals, cap.indices, planar))
     return merge([side, *caps])
+
+
+def _split_seam(pos: np.ndarray, normals: np.ndarray, tris: np.ndarray, segments: int, stacks: int) -> MeshData:
+    """The side grid (rows of ``segments`` vertices) with UVs (u around, v up): the u = 1 seam
+    gets its own column of vertices (copies of column 0, appended), in column 0's smoothing
+    groups, and the last column's triangles use it."""
+    rows = stacks + 1
+    seam = pos[0::segments][:rows] if segments else pos[:0]
+    seam_ids = len(pos) + np.arange(rows)
+    tris = tris.copy()
+    last = np.zeros(len(tris), dtype=bool)  # the two triangles of column segments - 1 in every row
+    last[(np.arange(stacks)[:, None] * segments + segments - 1) * 2 + np.arange(2)] = True
+    column0 = tris % segments == 0
+    remap = last[:, None] & column0
+    tris[remap] = seam_ids[tris[remap] // segments]
+    j = np.tile(np.arange(segments), rows)
+    i = np.repeat(np.arange(rows), segments)
+    uv = np.concatenate([np.stack([j / segments, i / stacks], axis=1),
+                         np.stack([np.ones(rows), np.arange(rows) / stacks], axis=1)])
+    group = np.concatenate([np.arange(len(pos)), np.arange(rows) * segments])
+    return MeshData(np.ascontiguousarray(np.concatenate([pos, seam]), dtype=np.float64),
+                    np.concatenate([normals, normals[0::segments][:rows]]),
+                    tris.astype(np.uint32), uv, group.astype(np.uint32))
 
 
 def blob(radius=0.5, bumpiness=0.25, lobes=6, seed=0, segments=32, rings=16) -> MeshData:

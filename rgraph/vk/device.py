@@ -163,6 +163,17 @@ def _query_features(handle: Any) -> tuple[Any, Any, Any, Any]:
     return f2, f12, (f11, f13), f2.features
 
 
+#: enabled whenever offered: the shared host allocation between devices (rgraph.vk.multi.host_memory)
+OPTIONAL_EXTENSIONS = ("VK_EXT_external_memory_host",)
+
+
+def offered_extensions(physical: Any) -> set[str]:
+    """The device extensions a physical device offers."""
+    v = vk()
+    return {p.extensionName if isinstance(p.extensionName, str) else v.ffi.string(p.extensionName).decode()
+            for p in v.vkEnumerateDeviceExtensionProperties(physical, None)}
+
+
 def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True,
                   ray_tracing: bool = False, rt_pipelines: bool = False) -> Device:
     """Choose a physical device, check required features, create the queues. ``ray_tracing``
@@ -203,6 +214,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         from rgraph.vk import rt_device
 
         head, extensions = rt_device.chain(physical.handle, physical.name, e12, bind2=rt_pipelines)
+    extensions = extensions + [e for e in OPTIONAL_EXTENSIONS if e in offered_extensions(physical.handle)]
     enabled = v.VkPhysicalDeviceFeatures2(pNext=head, features=core_features)
     info = v.VkDeviceCreateInfo(
         pNext=enabled, queueCreateInfoCount=len(queue_infos), pQueueCreateInfos=queue_infos,

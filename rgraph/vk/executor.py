@@ -60,12 +60,14 @@ class Executor:
     With ``device`` given (an open ``Device`` of ``instance``) the executor borrows them and
     ``close`` leaves them open; otherwise it opens an instance (``validate``) and a device
     (``device_index``) and closes them. ``workarounds``: the validation-layer rewrites the
-    lowering applies (``rgraph.vk.lower.workarounds``)."""
+    lowering applies (``rgraph.vk.lower.workarounds``). ``logic_hz``: scene logic on its own
+    thread at that rate (``rgraph.vk.runtime.logic``), the frame loop interpolating."""
 
     def __init__(self, plan: dict, *, validate: bool, device_index: int | None, verbose: bool = True,
                  inputs: dict[str, Any] | None = None, one_call_per_queue: bool = True,
                  workarounds: Iterable[str] = LAYER_WORKAROUNDS, instance: Instance | None = None,
-                 device: Device | None = None) -> None:
+                 device: Device | None = None, external: dict[str, list[Any]] | None = None,
+                 logic_hz: float | None = None) -> None:
         if plan.get("format") != "rgraph-plan/1":
             raise ExecutionError("not an rgraph plan (format != rgraph-plan/1)")
         self.source_plan = plan
@@ -73,6 +75,7 @@ class Executor:
         self.verbose = verbose
         self.one_call_per_queue = one_call_per_queue
         self.inputs = dict(inputs or {})
+        self.external = dict(external or {})  # resource -> caller's VkBuffer per set (rgraph.vk.resources)
         self.owns_device = device is None
         self.scene_gpu: Any = None
         self.samplers: dict[str, Any] = {}
@@ -95,6 +98,7 @@ class Executor:
         self.host_buffers: list[HostBuffer] = []
         self.barrier_batches: list[BarrierBatch] = []
         self.frames_done = 0
+        self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread with logic_hz (run_frames starts it)
         try:
             if self.instance.validate:
                 refuse_layer_for_ray_tracing(plan)
@@ -112,6 +116,8 @@ class Executor:
                 raise ExecutionError(str(exc)) from None
             self.plan = self.recording.plan
             _setup.create(self)
+            if logic_hz is not None:
+                _setup.attach_logic(self, logic_hz)
         except BaseException:
             self.close()
             raise

@@ -128,6 +128,7 @@ class PassSetup:
         self.params = PassParams({**plan.get("params", {}), **plan_pass.get("params", {})})
         self.features: dict[str, Any] = dict(plan.get("features", {}))
         self._scene = scene
+        self.uses_scene = False  # set by the first ``scene`` lookup (rgraph.vk.runtime.commands)
         self.accels = accels  # rgraph.vk.accel.AccelSet of the plan's accels (None: none)
         self._samplers = samplers if samplers is not None else {}
         self._objects: list[tuple[str, Any]] = []
@@ -139,6 +140,7 @@ class PassSetup:
     @property
     def scene(self) -> Any:
         """The run's ``rgraph.vk.scene_gpu.SceneGPU`` (built on first use, shared by all passes)."""
+        self.uses_scene = True
         if callable(self._scene):
             self._scene = self._scene()
         if self._scene is None:

@@ -7,13 +7,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from rgraph.vk import names
 from rgraph.vk.device import Device
 from rgraph.vk.loader import vk
 from rgraph.vk.rt_record import RayTracingCommands
 
 
 class RecordContext(RayTracingCommands):
-    """Commands a pass implementation may record. Deliberately no barriers."""
+    """Commands a pass implementation may record. Deliberately no barriers (but ``make_available_to_host``)."""
 
     def __init__(self, device: Device, command_buffer: Any) -> None:
         self._device = device
@@ -114,3 +115,17 @@ class RecordContext(RayTracingCommands):
 
     def copy_image_to_buffer(self, src: Any, src_layout: int, dst: Any, regions: list[Any]) -> None:
         vk().vkCmdCopyImageToBuffer(self._cb, src, src_layout, dst, len(regions), regions)
+
+    def make_available_to_host(self, buffer: Any) -> None:
+        """The one barrier a pass may record: its copy's writes to ``buffer`` made available to
+        the host (COPY -> HOST), for a buffer another device reads through host memory after
+        the host waited for this frame (rgraph.vk.multi.host_memory). The plan's barriers are
+        device-side only; this one orders nothing on the device."""
+        v = vk()
+        b = v.VkBufferMemoryBarrier2(srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT,
+                                     srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                     dstStageMask=v.VK_PIPELINE_STAGE_2_HOST_BIT, dstAccessMask=v.VK_ACCESS_2_HOST_READ_BIT,
+                                     srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
+                                     dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, buffer=buffer, offset=0,
+                                     size=names.WHOLE_SIZE)
+        v.vkCmdPipelineBarrier2(self._cb, v.VkDependencyInfo(bufferMemoryBarrierCount=1, pBufferMemoryBarriers=[b]))

@@ -93,12 +93,16 @@ class HostBuffer:
 class ResourceSet:
     """Every plan resource for every frame-in-flight set, bound into per-heap memory."""
 
-    def __init__(self, device: Device, plan: dict, sets: int) -> None:
+    def __init__(self, device: Device, plan: dict, sets: int, external: dict[str, list[Any]] | None = None) -> None:
+        """``external``: buffers the caller created and bound (one VkBuffer per set, the
+        caller destroys them), used instead of creating those plan resources: the shared host
+        allocation of ``rgraph.vk.multi.host_memory``. Even a shared lifetime gets one per set."""
         self.device = device
         self.plan = plan
         self.sets = sets
         self.by_set: list[dict[str, Resource]] = [{} for _ in range(sets)]
         self.memories: list[Any] = []
+        self.external = dict(external or {})
         self._create()
 
     def get(self, name: str, set_index: int) -> Resource:
@@ -128,6 +132,13 @@ class ResourceSet:
                 raise ExecutionError(f"resource {res['name']!r} has no heap in the plan")
             if res["heap"] not in heaps:
                 raise ExecutionError(f"resource {res['name']!r} names heap {res['heap']} that the plan lacks")
+            if res["name"] in self.external:
+                handles = self.external[res["name"]]
+                if res["kind"] != "buffer" or len(handles) != self.sets:
+                    raise ExecutionError(f"resource {res['name']!r}: an external buffer needs one handle per set")
+                for t in range(self.sets):
+                    self.by_set[t][res["name"]] = Resource(res, handles[t], t)
+                continue
             members[res["heap"]].append(res)
         for heap_id, heap in sorted(heaps.items()):
             residents = members[heap_id]
@@ -220,6 +231,8 @@ class ResourceSet:
                 if id(r) in seen:
                     continue
                 seen.add(id(r))
+                if r.name in self.external:
+                    continue
                 for view in r.views.values():
                     v.vkDestroyImageView(dev, view, None)
                 if r.is_image:

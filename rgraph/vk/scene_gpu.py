@@ -10,8 +10,11 @@ Built once per run from ``plan["scene_source"]`` by the executor (``Executor._sc
   in the same command buffer (a fence wait alone does not make device writes visible);
 - per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
   uniform, the Views uniform (binding 5, ``views=2``), the Draws (draw modes cpu and naive) and
-  Decals storage buffers (camera-relative, float64 on the CPU), naive mode's per-object draw
-  commands, and the deformable meshes' vertices (deformed on the CPU every frame);
+  Decals storage buffers (camera-relative, float64 on the CPU; cpu mode rewrites them only when
+  the camera moves, naive every frame), naive mode's per-object draw commands, and the
+  deformable meshes' positions (deformed on the CPU every frame); their normals and tangents
+  are computed on the GPU (``rgraph.vk.scene_deform``: ``record_deform`` at the start of the
+  frame's first scene batch on the graphics queue), into the vertex buffers the draws bind.
 - skinning (bindings 7-9, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights (lined up with
   the TLSF-placed rigid vertex buffer), the ring of packed logic states and each set's
   interpolation factor.
@@ -29,12 +32,13 @@ from rgraph.memory.tlsf import Tlsf
 from rgraph.scene import instances as scene_instances
 from rgraph.scene import packing
 from rgraph.scene.build import SceneData, load_scene_data
-from rgraph.vk import names
 from rgraph.vk.device import Device
+from rgraph.vk.device_local import DeviceBuffer, DeviceLocal
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
-from rgraph.vk.resources import HostBuffer, memory_type
+from rgraph.vk.resources import HostBuffer
+from rgraph.vk.runtime.logic import interpolation_alpha
 from rgraph.vk.scene_modes import draw_mode, view_count
 from rgraph.vk.skin_gpu import BINDING_BONES, BINDING_SKIN_FRAME, BINDING_SKIN_VERTICES, SkinGPU
 
@@ -50,13 +54,6 @@ class DrawCall:
     vertex_offset: int
     instances: int
     first_instance: int
-
-
-@dataclass
-class _DeviceBuffer:
-    handle: Any
-    memory: Any
-    size: int
 
 
 class SceneGPU:
@@ -78,13 +75,18 @@ class SceneGPU:
             self.data: SceneData = load_scene_data(source, self.extent, int(plan.get("camera", 0)))
         except (OSError, ValueError) as exc:
             raise ExecutionError(f"scene {source}: {exc}") from None
-        self._device_buffers: list[_DeviceBuffer] = []
+        self._device_local = DeviceLocal(device)
         self._host: list[HostBuffer] = []
         self._pool = None
         self.skin = None
         self.set_layout = None
         self._sets: list[Any] = []
         self._submit_once = submit_once
+        self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
+        self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread (attach_logic)
+        self.ticks_taken: list[tuple[int, int] | None] = [None] * sets  # per set: the logic ticks its frame mixes
+        self.alpha_range = [1.0, 0.0]
+        self.deform: Any = None  # rgraph.vk.scene_deform.DeformGPU when the scene has deformable meshes
         try:
             self._build(submit_once)
         except BaseException:
@@ -130,18 +132,8 @@ class SceneGPU:
         return self._sets[frame_set]
 
     # ----------------------------------------------------------------- creation
-    def _device_buffer(self, size: int, usage: int) -> _DeviceBuffer:
-        v = vk()
-        dev = self.device.handle
-        handle = v.vkCreateBuffer(dev, v.VkBufferCreateInfo(size=max(size, 16), usage=usage | v.VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                            sharingMode=v.VK_SHARING_MODE_EXCLUSIVE), None)
-        req = v.vkGetBufferMemoryRequirements(dev, handle)
-        index = memory_type(self.device, req.memoryTypeBits, v.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)
-        memory = v.vkAllocateMemory(dev, v.VkMemoryAllocateInfo(allocationSize=req.size, memoryTypeIndex=index), None)
-        v.vkBindBufferMemory(dev, handle, memory, 0)
-        buf = _DeviceBuffer(handle, memory, max(size, 16))
-        self._device_buffers.append(buf)
-        return buf
+    def _device_buffer(self, size: int, usage: int) -> DeviceBuffer:
+        return self._device_local.buffer(size, usage)
 
     def _host_buffer(self, size: int, usage: int) -> HostBuffer:
         buf = HostBuffer.create(self.device, size, usage)
@@ -219,43 +211,20 @@ class SceneGPU:
                                for _ in range(self.sets)] if self.mode == "naive" else [])
         decals_size = max(len(data.decals), 1) * packing.DECAL_BYTES
         self.decal_buffers = [self._host_buffer(decals_size, storage) for _ in range(self.sets)]
-        self.deform_buffers = ([self._host_buffer(deform_base * packing.VERTEX_BYTES, v.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT)
-                                for _ in range(self.sets)] if deform_base else [])
+        if deform_base:
+            from rgraph.vk.scene_deform import DeformGPU, DeformPart
+
+            parts = [DeformPart(mesh.data, mesh.deformer.topology, base, mesh.deformer)
+                     for mesh, base in self._deform_layout]
+            self.deform = DeformGPU(self.device, self.sets, parts, device_buffer=self._device_buffer,
+                                    host_buffer=self._host_buffer, upload=lambda ups: self._upload(submit_once, ups))
         self._make_descriptors(materials_size=len(materials), lights_size=len(scene_lights), draws_size=draws_size,
                                decals_size=decals_size, views_size=views_size, meshes_size=len(meshes))
         for s in range(self.sets):
             self.update(0, s)
 
-    def _upload(self, submit_once: Any, uploads: list[tuple[_DeviceBuffer, bytes]]) -> None:
-        v = vk()
-        offsets, total = [], 0
-        for _buf, payload in uploads:
-            offsets.append(total)
-            total += (len(payload) + 15) // 16 * 16
-        staging = HostBuffer.create(self.device, max(total, 16), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
-        try:
-            for (_buf, payload), off in zip(uploads, offsets, strict=True):
-                staging.write(payload, off)
-
-            def record(cb: Any) -> None:
-                keep: list[Any] = []
-                for (buf, payload), off in zip(uploads, offsets, strict=True):
-                    region = v.VkBufferCopy(srcOffset=off, dstOffset=0, size=len(payload))
-                    keep.append(region)
-                    v.vkCmdCopyBuffer(cb, staging.handle, buf.handle, 1, [region])
-                barriers = [v.VkBufferMemoryBarrier2(
-                    srcStageMask=v.VK_PIPELINE_STAGE_2_COPY_BIT, srcAccessMask=v.VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                    dstStageMask=v.VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, dstAccessMask=v.VK_ACCESS_2_MEMORY_READ_BIT,
-                    srcQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=v.VK_QUEUE_FAMILY_IGNORED,
-                    buffer=buf.handle, offset=0, size=names.WHOLE_SIZE) for buf, _payload in uploads]
-                dep = v.VkDependencyInfo(bufferMemoryBarrierCount=len(barriers), pBufferMemoryBarriers=barriers)
-                keep.append((barriers, dep))
-                v.vkCmdPipelineBarrier2(cb, dep)
-
-            if uploads:
-                submit_once("graphics", record)
-        finally:
-            staging.destroy()
+    def _upload(self, submit_once: Any, uploads: list[tuple[DeviceBuffer, bytes]]) -> None:
+        self._device_local.upload(submit_once, uploads)
 
     def _make_descriptors(self, *, materials_size: int, lights_size: int, draws_size: int, decals_size: int,
                           views_size: int, meshes_size: int) -> None:
@@ -298,20 +267,65 @@ class SceneGPU:
         ``draw.mode=gpu`` writes no per-object data (the instances are persistent);
         ``naive`` culls every object on the CPU and writes one draw command per object."""
         data = self.data
-        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame))
-        if self.mode != "gpu":
-            self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
+        logic = self.logic
+        if logic is None:
+            seconds = data.seconds(frame)
+        else:  # between the logic thread's last two states
+            prev, cur = logic.latest() if self.deform is None else self.deform.take(frame_set, logic.latest)
+            alpha = interpolation_alpha(logic.clock(), cur.wall, logic.hz)
+            seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
+            self.alpha_range[0] = min(self.alpha_range[0], alpha)
+            self.alpha_range[1] = max(self.alpha_range[1], alpha)
+        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame, seconds))
+        camera = data.camera(frame).position.tobytes()
+        # camera-relative tables change with the camera only; naive mode (the engines' way) writes
+        # every object's matrix every frame
+        if self._camera_written[frame_set] != camera or self.mode == "naive":
+            if self.mode != "gpu":
+                self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
+            if data.decals:
+                self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
+            self._camera_written[frame_set] = camera
         if self.views > 1:
             self.view_buffers[frame_set].write(scene_instances.cached_views_bytes(data, frame, self.views, self.ipd))
         if self.mode == "naive":
             self.naive_buffers[frame_set].write(scene_instances.naive_commands(data, frame, self.calls, self.views,
                                                                                self.ipd))
-        if data.decals:
-            self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
-        for mesh, base in self._deform_layout:
-            self.deform_buffers[frame_set].write(packing.vertex_bytes(data.deformed(mesh, frame)),
-                                                 base * packing.VERTEX_BYTES)
-        self.skin.update(data.seconds(frame), frame_set)
+        if logic is None:
+            if self.skin is not None:
+                self.skin.update(seconds, frame_set)
+            if self.deform is not None:
+                self.deform.write(seconds, frame_set)
+            return
+        if self.skin is not None:  # the logic thread packed these states (logic_step)
+            self.skin.show(frame_set, prev.tick, cur.tick, alpha)
+        if self.deform is not None:
+            self.deform.set_header(frame_set, alpha, prev.value, cur.value)  # the logic wrote the slots
+        self.ticks_taken[frame_set] = (prev.tick, cur.tick)
+
+    def attach_logic(self, logic: Any) -> None:
+        """Take scene time and deformable positions from ``logic`` (a started-on-demand
+        ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step`` and whose lock is
+        ``deform.lock``)."""
+        self.logic = logic
+        if self.skin is not None:
+            self.skin.logic_hz = float(logic.hz)  # skinning's logic ticks are this thread's
+        self.ticks_taken = [None] * self.sets
+        self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
+
+    def logic_step(self, seconds: float) -> Any:
+        """One logic tick at scene time ``seconds`` (the logic thread): the deformable positions
+        written into a free ring slot; the slot (None: no deformable meshes)."""
+        if self.skin is not None and self.skin.active:  # packed here, copied by the render thread
+            self.skin.state(round(seconds * self.logic.hz))
+        if self.deform is None:
+            return None
+        return self.deform.write_slot(seconds, self.logic.published)
+
+    def record_deform(self, cb: Any, frame_set: int) -> None:
+        """The deformable vertices' compute pass and its barriers (nothing without deformable meshes)."""
+        if self.deform is not None:
+            self.deform.record(cb, frame_set)
 
     def refresh_instances(self) -> None:
         """After instances moved (``SceneMesh.positions`` changed in ``self.data``): drop the
@@ -320,6 +334,7 @@ class SceneGPU:
         idle (frames in flight read the table), so it suits rare changes."""
         for cache in ("_instance_arrays", "_packed_draw_table", "_frame_cache", "_views_cache"):
             self.data.__dict__.pop(cache, None)
+        self._camera_written = [None] * self.sets  # the Draws are written again at the next update
         if self.mode == "gpu":
             vk().vkDeviceWaitIdle(self.device.handle)
             self._upload(self._submit_once, [(self.instance_buffer, scene_instances.instance_bytes(self.data))])
@@ -344,13 +359,16 @@ class SceneGPU:
             return
         rec.bind_index_buffer(self.index_buffer.handle)
         bound = None
+        if any(call.deformable for call in calls) and not self.deform.recorded[frame_set]:
+            raise ExecutionError("deformable meshes drawn before their compute pass was recorded (the draw is not "
+                                 "on the graphics queue after the frame's first scene batch)")
         if args is not None and self.mode == "gpu" and share is None:
             rec.bind_vertex_buffers([self.vertex_buffer.handle])
             bound = self.vertex_buffer.handle
             rec.draw_indexed_indirect_count(args, 16, args, 0, self.draw_count)
             calls = [c for c in calls if c.deformable]
         for call in calls:
-            want = self.deform_buffers[frame_set].handle if call.deformable else self.vertex_buffer.handle
+            want = self.deform.vertex_buffers[frame_set].handle if call.deformable else self.vertex_buffer.handle
             if want is not bound:
                 rec.bind_vertex_buffers([want])
                 bound = want
@@ -365,6 +383,9 @@ class SceneGPU:
     def destroy(self) -> None:
         v = vk()
         dev = self.device.handle
+        if self.deform is not None:
+            self.deform.destroy()
+            self.deform = None
         if self._pool is not None:
             v.vkDestroyDescriptorPool(dev, self._pool, None)
             self._pool = None
@@ -375,10 +396,7 @@ class SceneGPU:
         for buf in reversed(self._host):
             buf.destroy()
         self._host = []
+        self._device_local.destroy()
         if self.skin is not None:
             self.skin.destroy()
             self.skin = None
-        for buf in reversed(self._device_buffers):
-            v.vkDestroyBuffer(dev, buf.handle, None)
-            v.vkFreeMemory(dev, buf.memory, None)
-        self._device_buffers = []

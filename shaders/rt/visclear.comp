@@ -15,7 +15,7 @@ void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (px == ivec2(0)) {
         args[0] = 0u; args[1] = 1u; args[2] = 1u; args[3] = 0u;
-        header[0] = 0u; header[1] = 0u;
+        header[0] = 0u; header[1] = 0u; header[2] = 0u;
 #ifdef RESET_RAYS
         ray_args[0] = 0u; ray_args[1] = 1u; ray_args[2] = 1u; ray_args[3] = 0u;
 #endif

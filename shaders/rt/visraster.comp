@@ -2,12 +2,13 @@
 #extension GL_GOOGLE_include_directive : require
 // Compute visibility buffer, one thread per triangle (rt/visraster.glsl). MODE_ID undefined: the
 // depth pass (atomicMax of the key). A triangle whose box exceeds BIG_PIXELS reserves (one atomic)
-// a job per TILE x TILE tile of its box (tiles from the box's corner, so a medium triangle is one
-// job) for rt/vistiles.comp, where a workgroup does JOBS_PER_GROUP jobs: walls and floors do not
+// a record of its setup and a job per TILE x TILE tile of its box (tiles from the box's corner, so
+// a medium triangle is one job) for rt/vistiles.comp, where a workgroup does JOBS_PER_GROUP jobs: walls and floors do not
 // serialize on one thread; the indirect group count becomes ceil(jobs / JOBS_PER_GROUP)
 // (atomicMax). When the list is full (JOB_CAPACITY) the reservation is undone (a reservation made
 // while an undone one is pending fails too, so the list stays contiguous and ends within the
-// capacity), the overflow flag is set and the thread rasterizes its box itself. MODE_ID: the id
+// capacity; likewise a record past TRI_CAPACITY), the overflow flag is set and the thread
+// rasterizes its box itself. MODE_ID: the id
 // pass (atomicMax of the id where the key equals the stored one); big triangles are left to the
 // tile jobs unless the depth pass overflowed: then every big triangle is also done here (the
 // jobs that did run write the same ids again: atomicMax is idempotent).
@@ -16,18 +17,19 @@ layout(local_size_x = 64) in;
 #ifdef MODE_ID
 layout(set = 0, binding = 5, r32ui) uniform readonly uimage2D depth_keys;
 layout(set = 0, binding = 6, r32ui) uniform uimage2D visibility;
-layout(set = 0, binding = 8, std430) readonly buffer Jobs { uint job_count; uint overflow; uvec2 pad; uvec2 jobs[]; };
+layout(set = 0, binding = 8, std430) readonly buffer Jobs { uint job_count; uint overflow; uint tri_count; uint pad; uvec2 jobs[]; };
 #else
 layout(set = 0, binding = 5, r32ui) uniform uimage2D depth_keys;
 layout(set = 0, binding = 7, std430) buffer Args { uint groups; uint y; uint z; uint w; } args;
-layout(set = 0, binding = 8, std430) buffer Jobs { uint job_count; uint overflow; uvec2 pad; uvec2 jobs[]; };
+layout(set = 0, binding = 8, std430) buffer Jobs { uint job_count; uint overflow; uint tri_count; uint pad; uvec2 jobs[]; };
+layout(set = 0, binding = 10, std430) writeonly buffer Records { TriRecord records[]; };
 #endif
 
 void visit(Tri tri, ivec2 px) {
     uint key;
     if (!cover(tri, px, key)) return;
 #ifdef MODE_ID
-    if (imageLoad(depth_keys, px).r == key) imageAtomicMax(visibility, px, tri.id);
+    if (key_matches(key, imageLoad(depth_keys, px).r)) imageAtomicMax(visibility, px, tri.id);
 #else
     if (imageLoad(depth_keys, px).r < key) imageAtomicMax(depth_keys, px, key);
 #endif
@@ -44,15 +46,19 @@ void main() {
 #else
         ivec2 tiles = (tri.box.zw - tri.box.xy + TILE) / TILE;
         uint n = uint(tiles.x * tiles.y);
-        uint first = atomicAdd(job_count, n);
-        if (first + n <= JOB_CAPACITY) {
-            uint k = first;
-            for (int ty = 0; ty < tiles.y; ++ty)
-                for (int tx = 0; tx < tiles.x; ++tx) jobs[k++] = uvec2(t, (uint(ty) << 16) | uint(tx));
-            atomicMax(args.groups, (first + n + JOBS_PER_GROUP - 1u) / JOBS_PER_GROUP);
-            return;
+        uint rec = atomicAdd(tri_count, 1u);  // a record slot past the capacity is never written
+        if (rec < TRI_CAPACITY) {
+            uint first = atomicAdd(job_count, n);
+            if (first + n <= JOB_CAPACITY) {
+                records[rec] = pack_tri(tri);
+                uint k = first;
+                for (int ty = 0; ty < tiles.y; ++ty)
+                    for (int tx = 0; tx < tiles.x; ++tx) jobs[k++] = uvec2(rec, (uint(ty) << 16) | uint(tx));
+                atomicMax(args.groups, (first + n + JOBS_PER_GROUP - 1u) / JOBS_PER_GROUP);
+                return;
+            }
+            atomicAdd(job_count, 0u - n);
         }
-        atomicAdd(job_count, 0u - n);
         atomicOr(overflow, 1u);
 #endif
     }

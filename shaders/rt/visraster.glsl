@@ -21,8 +21,8 @@
 // (shaders/rt/hybrid.glsl: first_hit), so such a pixel gets the stand-alone's answer.
 //
 // Two passes, 32-bit image atomics only: depth (atomicMax of the key) then id (where the key
-// equals the stored one, atomicMax of the id: ties between triangles resolve to the larger id,
-// deterministic). Both evaluate the key with the same `precise` code, so they agree bit for bit.
+// equals the stored one within KEY_ULPS, atomicMax of the id: ties between triangles resolve to
+// the larger id, deterministic). Both evaluate the key with the same `precise` code.
 // The screen bounding box only bounds the pixels tested (screen_box: the triangle clipped to the
 // view frustum, near plane z >= forward.w, tiny: the coverage test decides).
 #include "rt/tables.glsl"
@@ -61,8 +61,9 @@ uint instance_of(uint t) {  // the largest i with tri_start[i] <= t
 }
 
 float plane_side(int k, vec3 q, vec2 slope) {  // >= 0: inside plane k of the widened view frustum
-    return k == 0 ? q.z - frame.forward.w : k == 1 ? slope.x * q.z - q.x : k == 2 ? slope.x * q.z + q.x
-         : k == 3 ? slope.y * q.z - q.y : slope.y * q.z + q.y;
+    precise float f = k == 0 ? q.z - frame.forward.w : k == 1 ? slope.x * q.z - q.x : k == 2 ? slope.x * q.z + q.x
+                    : k == 3 ? slope.y * q.z - q.y : slope.y * q.z + q.y;
+    return f;
 }
 
 // The pixels whose centres the triangle may cover: the box of its part inside the view frustum
@@ -108,15 +109,23 @@ bool screen_box(vec3 p0, vec3 p1, vec3 p2, out ivec4 box) {
     return box.x <= box.z && box.y <= box.w;
 }
 
+// to_world of tables.glsl with `precise` (no contraction) inside: every pass and path must get
+// bit-identical vertices, as the depth keys are compared for equality across compilations.
+vec3 world_vertex(Instance I, uint v) {
+    vec4 p = vec4(vertex_of(v), 1.0);
+    precise vec3 w = vec3(dot(I.m0, p), dot(I.m1, p), dot(I.m2, p));
+    return w;
+}
+
 // Setup of global triangle t; false when it covers no pixel (degenerate, behind, off screen).
 bool setup_triangle(uint t, out Tri tri) {
     uint instance = instance_of(t);
     uint prim = t - tri_start[instance];
     Instance I = inst[instance];
     uint base = I.info.x + 3u * prim;
-    precise vec3 p0 = to_world(I, vertex_of(I.info.z + idx[base]));
-    precise vec3 p1 = to_world(I, vertex_of(I.info.z + idx[base + 1u]));
-    precise vec3 p2 = to_world(I, vertex_of(I.info.z + idx[base + 2u]));
+    precise vec3 p0 = world_vertex(I, I.info.z + idx[base]);
+    precise vec3 p1 = world_vertex(I, I.info.z + idx[base + 1u]);
+    precise vec3 p2 = world_vertex(I, I.info.z + idx[base + 2u]);
     tri.id = vis_encode(instance, prim);
     tri.box = ivec4(0, 0, -1, -1);
     precise vec3 n = cross(p1 - p0, p2 - p0);
@@ -155,6 +164,24 @@ bool rect_may_cover(Tri tri, ivec2 lo, ivec2 hi) {
         m = max(m, vec3(dot(d, tri.c0), dot(d, tri.c1), dot(d, tri.c2)));
     }
     return all(greaterThanEqual(m, -2.0 * tri.eps - 1e-6 * abs(m)));
+}
+
+// The id pass's test against the stored (largest) key: equal within KEY_ULPS float ulps, so the
+// nearest triangle keeps its pixel even if two compilations (depth / id pass, thread / tile path)
+// round its key differently; a triangle that close in depth (a neighbour across a shared edge,
+// coplanar z-fighting) may take the pixel instead (the larger id wins), which the shading passes'
+// check of the pixel centre against the claimed triangle covers.
+const uint KEY_ULPS = 2u;
+bool key_matches(uint key, uint stored) { return key + KEY_ULPS >= stored && key <= stored + KEY_ULPS; }
+
+// A big triangle's setup, stored once by the depth pass for its tile jobs (binding 10): both tile
+// passes read the same record, so they rasterize with identical values and skip the setup.
+struct TriRecord { vec4 c0, c1, c2, n; ivec4 box; };  // c*.w: eps, n.w: the id's bits
+TriRecord pack_tri(Tri t) {
+    return TriRecord(vec4(t.c0, t.eps.x), vec4(t.c1, t.eps.y), vec4(t.c2, t.eps.z), vec4(t.n, uintBitsToFloat(t.id)), t.box);
+}
+Tri unpack_tri(TriRecord r) {
+    return Tri(r.c0.xyz, r.c1.xyz, r.c2.xyz, r.n.xyz, vec3(r.c0.w, r.c1.w, r.c2.w), r.box, floatBitsToUint(r.n.w));
 }
 
 uint pixels_of(Tri tri) { return uint(tri.box.z - tri.box.x + 1) * uint(tri.box.w - tri.box.y + 1); }

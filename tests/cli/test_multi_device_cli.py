@@ -47,3 +47,16 @@ def test_run_on_two_logical_devices_validated(capsys, tmp_path):
     err = capsys.readouterr().err
     assert "0 validation message(s)" in err and "data check ok against the one-device plan" in err
     assert len(json.loads(timings.read_text())["device_ms"]) == 2
+
+
+def test_run_staged_pipelined_and_dynamic(capsys, tmp_path):
+    timings = tmp_path / "t.json"
+    assert main(["run", PROBE_GRAPH, "--size", "64x64", "--devices", "0,0", "--split", "sort-first", "--validate",
+                 "--transfer", "staged", "--pipelined", "--frames", "3", "--timings", str(timings)]) == 0
+    err = capsys.readouterr().err
+    assert "(staged transfer)" in err and "0 validation message(s)" in err and "data check ok" in err
+    assert json.loads(timings.read_text())["transfer"] == "staged"
+    assert main(["run", PROBE_GRAPH, "--size", "64x64", "--devices", "0,0", "--split", "sort-first", "--validate",
+                 "--balance", "dynamic", "--frames", "4"]) == 0
+    err = capsys.readouterr().err
+    assert "plan load(s) for 4 frame(s)" in err and "(shared transfer)" in err and "data check ok" in err

@@ -4,7 +4,8 @@ tracing ones, which the 1.3.239 layer cannot validate), data-checked against the
 reference of the camera rays (passes/rt_vis_ref.py): equal ids on >= 99% of the pixels, every
 mismatch on a triangle or silhouette edge. Hard cases: tests/data/rt/vis_hard.yaml (1e6 m from
 the origin, triangles crossing the camera plane or behind it, degenerate, sub-pixel and
-screen-sized ones), the tile-job list overflowing, and every triangle sent to the tile jobs."""
+screen-sized ones), the tile-job list or the setup records overflowing, and every triangle sent
+to the tile jobs."""
 
 from __future__ import annotations
 
@@ -74,7 +75,9 @@ def test_hard_cases_and_the_tile_job_paths_give_the_same_ids():
     assert full_args[1] == 1 and full_args[0] <= 8
     every, every_args = _visibility(HARD, size, {"rt.vis_big_pixels": "1"})  # nearly all triangles as tiles
     assert every_args[0] > args[0] and every_args[1] == 0
-    assert np.array_equal(full, ids) and np.array_equal(every, ids)
+    few, few_args = _visibility(HARD, size, {"rt.vis_tri_bytes": "160"})  # 2 setup records: overflow
+    assert few_args[1] == 1
+    assert np.array_equal(full, ids) and np.array_equal(every, ids) and np.array_equal(few, ids)
 
 
 def test_triangle_starts_and_dispatch_shape():

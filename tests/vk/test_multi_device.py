@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from locations import ROOT
+from multi_helpers import assert_data_ok, validated_pair
 
 from rgraph.api import open_device
 from rgraph.compiler.multi_device import Split
@@ -22,10 +23,7 @@ SIZE = (64, 64)
 
 @pytest.fixture(scope="module")
 def gpus():
-    pair = [open_device(validate=True, device=0, verbose=False) for _ in range(2)]
-    yield pair
-    for g in pair:
-        assert g.close() == [], "validation messages"
+    yield from validated_pair()
 
 
 def _one_device(gpu, graph):
@@ -57,9 +55,7 @@ def test_probe_graph_split_equals_one_device_and_passes_data_check(gpus, mode):
     plan, data, out, summary = _split(gpus, PROBE_GRAPH, mode)
     assert {p.device for p in plan.passes} == {0, 1}
     assert summary.device_ms[1] > 0
-    known = {r["name"] for r in reference["resources"]}
-    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 1)
-    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert_data_ok(reference, data, 1)
     assert np.array_equal(ref["color"], out["color"])
     assert _messages(gpus) == []
 
@@ -103,9 +99,7 @@ def test_later_frames_refill_the_received_tiles(gpus, mode):
         data = multi.read_back()
     finally:
         multi.close()
-    known = {r["name"] for r in reference["resources"]}
-    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 4)
-    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert_data_ok(reference, data, 4)
     assert _messages(gpus) == []
 
 
@@ -125,7 +119,5 @@ def test_three_logical_devices_with_uneven_bands(gpus, mode):
     finally:
         multi.close()
     assert third.close() == []
-    known = {r["name"] for r in reference["resources"]}
-    verdict = check_outputs(reference, {k: v for k, v in data.items() if k[0] in known}, 2)
-    assert verdict.ok is True, [str(m) for m in verdict.mismatches]
+    assert_data_ok(reference, data, 2)
     assert _messages(gpus) == []

@@ -60,6 +60,7 @@ class Download(_BandCopy):
         img = self.setup.resource(self.image, frame_set)
         buf, _size = self.setup.buffer(self.buffer, frame_set)
         rec.copy_image_to_buffer(img.handle, self.layout, buf, self.regions)
+        rec.make_available_to_host(buf)  # the shared host allocation: the receiver reads it after the fence
 
 
 @register(UPLOAD_IMPL)

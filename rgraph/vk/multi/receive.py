@@ -26,7 +26,6 @@ def refill(executable: Any, received: dict[str, bytes]) -> None:
             raise ExecutionError(f"device 0's plan has no receiving buffer {name!r}")
         staging = HostBuffer.create(ex.device, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
         staging.write(data)
-        ex.host_buffers.append(staging)
         work.append((r, staging, len(data)))
 
     def record(cb: Any) -> None:
@@ -36,4 +35,8 @@ def refill(executable: Any, received: dict[str, bytes]) -> None:
             v.vkCmdCopyBuffer(cb, staging.handle, r.handle, 1, [v.VkBufferCopy(srcOffset=0, dstOffset=0, size=size)])
             buffer_barrier(cb, r, copy_write(), _any_access())
 
-    submit_once(ex, "graphics", record)
+    try:
+        submit_once(ex, "graphics", record)
+    finally:  # waited for: this frame's staging buffers go now (not at close: one set per frame)
+        for _r, staging, _size in work:
+            staging.destroy()

@@ -1,6 +1,7 @@
 """Command buffers: one per batch of the lowered recording and frame-in-flight set, recorded once.
 
-Per pass: a debug label, a start timestamp, the pass's lowered barrier calls, its commands
+Per pass: a debug label, a start timestamp, (the first scene pass on the graphics queue: the
+scene's deformable vertices, ``SceneGPU.record_deform``), the pass's lowered barrier calls, its commands
 (``ImplPass.record``), its lowered releases, an end timestamp. Nothing here decides a
 barrier (``rgraph.vk.lower``); ``rgraph.vk.record`` builds the structs.
 """
@@ -22,6 +23,7 @@ def record(ex: Any) -> None:
     recording = ex.recording
     plan_passes = ex.plan["passes"]
     ex.command_buffers = []
+    deform_batch = scene_batch(ex)
     for s in range(FRAMES_IN_FLIGHT):
         per_batch = []
         for bi, batch in enumerate(recording.batches):
@@ -41,6 +43,8 @@ def record(ex: Any) -> None:
                 label_begin(dev, cb, f"pass {lowered.name}")
                 if timestamps:
                     v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, ex.query_pools[s], 2 * i)
+                if bi == deform_batch and i == batch.passes[0]:  # counted in this pass's GPU time
+                    ex.scene_gpu.record_deform(cb, s)
                 for barriers in barrier_batches(ex.resources, s, lowered.before):
                     ex.barrier_batches.append(barriers)
                     v.vkCmdPipelineBarrier2(cb, barriers.dependency)
@@ -53,6 +57,18 @@ def record(ex: Any) -> None:
                 label_begin(dev, cb, None)
             v.vkEndCommandBuffer(cb)
         ex.command_buffers.append(per_batch)
+
+
+def scene_batch(ex: Any) -> int | None:
+    """The first batch (submit order) on the graphics VkQueue with a pass that uses the scene:
+    the scene's per-frame compute work (``SceneGPU.record_deform``) goes at its start."""
+    if ex.scene_gpu is None:
+        return None
+    graphics = ex.device.queues["graphics"]
+    for bi, batch in enumerate(ex.recording.batches):
+        if ex.device.queues[batch.queue] == graphics and any(ex.passes[i].setup.uses_scene for i in batch.passes):
+            return bi
+    return None
 
 
 def label_begin(device: Any, cb: Any, text: str | None) -> None:

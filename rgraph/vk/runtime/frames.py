@@ -33,6 +33,10 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
     wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
     timeline values, and one vkQueueSubmit2 per call of ``submit_calls``.
+
+    With a logic thread (``ex.logic``: ``rgraph run --logic-hz``) it runs while the frames do
+    (started here, stopped when they end or fail); an error there stops the loop. The timings
+    report the render thread's CPU time per frame (``render_thread``) and the logic's ticks.
     """
     import numpy as np
 
@@ -62,57 +66,77 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     timed = marks is not None
     mark = marks.append if marks is not None else None
     base = ex.frames_done
-    for local in range(frames):
-        frame = base + local
-        s = frame % FRAMES_IN_FLIGHT
-        t0 = perf()
-        if timed:
-            mark(t0)
-        log.context = f"frame {frame}"  # also a hook: tests/vk/test_soak.py samples RSS on it
-        fenced = fence_counts[s] > 0
-        if timed:
-            mark(perf())
-        if fenced:
-            check_result(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
-        if timed:
-            mark(perf())
-            mark(perf())
-        if fenced and submitted[s] and timestamps:
-            read = get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0
+    logic = ex.logic
+    update_s = np.zeros(frames)
+    thread_t0 = time.thread_time()
+    wall_t0 = perf()
+    try:
+        if logic is not None:
+            try:
+                logic.start()  # tick 0 runs here
+            except Exception as exc:  # noqa: BLE001 -- the step's own error, reported as such
+                raise ExecutionError(f"frame {base}: the logic thread failed: {exc!r}") from exc
+        for local in range(frames):
+            frame = base + local
+            s = frame % FRAMES_IN_FLIGHT
+            t0 = perf()
+            if timed:
+                mark(t0)
+            log.context = f"frame {frame}"  # also a hook: tests/vk/test_soak.py samples RSS on it
+            fenced = fence_counts[s] > 0
             if timed:
                 mark(perf())
-            if read:
-                rows[collected] = query_view
-                collected += 1
-        elif timed:
-            mark(perf())
-        if timed:
-            mark(perf())
-        if fenced:
-            check_result(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
-        if timed:
-            mark(perf())
-            mark(perf())
-        if fenced and timestamps:
-            reset_queries(handle, pools[s], 0, 2 * n)
-        if timed:
-            mark(perf())
-        if scene is not None:
-            scene.update(frame, s)
-        for p in updaters:
-            p.update(frame, s)
-        for slot, offset in ex.value_slots[s]:
-            slot.value = frame + offset
-        for call in ex.submit_calls[s]:
-            if validate:
-                log.context = f"frame {frame} {call.context}"
+            if fenced:
+                check_result(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
             if timed:
                 mark(perf())
-            check_result(submit2(call.queue, call.count, call.infos, call.fence), "vkQueueSubmit2")
+                mark(perf())
+            if fenced and submitted[s] and timestamps:
+                read = get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0
+                if timed:
+                    mark(perf())
+                if read:
+                    rows[collected] = query_view
+                    collected += 1
+            elif timed:
+                mark(perf())
             if timed:
                 mark(perf())
-        submitted[s] = True
-        cpu_s[local] = perf() - t0
+            if fenced:
+                check_result(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
+            if timed:
+                mark(perf())
+                mark(perf())
+            if fenced and timestamps:
+                reset_queries(handle, pools[s], 0, 2 * n)
+            if timed:
+                mark(perf())
+            if logic is not None and logic.error is not None:
+                raise ExecutionError(f"frame {frame}: the logic thread failed: {logic.error!r}")
+            u0 = perf()
+            if scene is not None:
+                scene.update(frame, s)
+            for p in updaters:
+                p.update(frame, s)
+            update_s[local] = perf() - u0
+            for slot, offset in ex.value_slots[s]:
+                slot.value = frame + offset
+            for call in ex.submit_calls[s]:
+                if validate:
+                    log.context = f"frame {frame} {call.context}"
+                if timed:
+                    mark(perf())
+                check_result(submit2(call.queue, call.count, call.infos, call.fence), "vkQueueSubmit2")
+                if timed:
+                    mark(perf())
+            submitted[s] = True
+            cpu_s[local] = perf() - t0
+    finally:
+        if logic is not None:
+            logic.stop()
+    render = {"cpu_us_per_frame": (time.thread_time() - thread_t0) * 1e6 / frames if frames else None,
+              "wall_us_per_frame": (perf() - wall_t0) * 1e6 / frames if frames else None,
+              "update_us": float(np.median(update_s)) * 1e6 if frames else None}
     ex.frames_done = base + frames
     log.context = "finishing"
     for s in range(FRAMES_IN_FLIGHT):
@@ -121,7 +145,11 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if timestamps and get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
                 rows[collected] = query_view
                 collected += 1
-    return timings(ex, rows[:collected], frames, cpu_s)
+    out = timings(ex, rows[:collected], frames, cpu_s)
+    out["render_thread"] = render
+    if logic is not None:
+        out["logic"] = {**logic.stats(), "alpha_range": list(scene.alpha_range) if scene is not None else None}
+    return out
 
 
 def timings(ex: Any, rows: Any, frames: int, cpu_s: Any) -> dict[str, Any]:

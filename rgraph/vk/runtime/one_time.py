@@ -18,21 +18,10 @@ from rgraph.vk.runtime.staging import fill_bytes, image_copy_regions, input_byte
 
 def submit_once(ex: Any, queue: str, record) -> None:
     """Record (``record(cb)``), submit and wait for a one-time command buffer on plan queue ``queue``."""
-    v = vk()
+    from rgraph.vk.device_local import submit_and_wait
+
     dev = ex.device
-    cmd_pool = pool(ex, dev.families[queue], FRAMES_IN_FLIGHT)  # a separate pool for one-time work
-    cb = v.vkAllocateCommandBuffers(dev.handle, v.VkCommandBufferAllocateInfo(
-        commandPool=cmd_pool, level=v.VK_COMMAND_BUFFER_LEVEL_PRIMARY, commandBufferCount=1))[0]
-    v.vkBeginCommandBuffer(cb, v.VkCommandBufferBeginInfo(flags=v.VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT))
-    record(cb)
-    v.vkEndCommandBuffer(cb)
-    fence = v.vkCreateFence(dev.handle, v.VkFenceCreateInfo(), None)
-    cb_info = v.VkCommandBufferSubmitInfo(commandBuffer=cb)
-    submit = v.VkSubmitInfo2(commandBufferInfoCount=1, pCommandBufferInfos=[cb_info])
-    v.vkQueueSubmit2(dev.queues[queue], 1, [submit], fence)
-    v.vkWaitForFences(dev.handle, 1, [fence], v.VK_TRUE, 10**11)
-    v.vkDestroyFence(dev.handle, fence, None)
-    v.vkFreeCommandBuffers(dev.handle, cmd_pool, 1, [cb])
+    submit_and_wait(dev, pool(ex, dev.families[queue], FRAMES_IN_FLIGHT), queue, record)  # a separate pool
 
 
 def init_shared(ex: Any) -> None:

@@ -22,7 +22,7 @@ def create(ex: Any) -> None:
         if p.get("device", 0) != 0:
             raise ExecutionError(f"pass {p['name']!r}: multi-device plans are not supported")
     ex.log.context = "creating resources"
-    ex.resources = ResourceSet(dev, ex.plan, FRAMES_IN_FLIGHT)
+    ex.resources = ResourceSet(dev, ex.plan, FRAMES_IN_FLIGHT, external=ex.external)
     ex.log.context = "initialising persistent resources"
     one_time.init_shared(ex)
     if any(r["kind"] == "accel" for r in ex.plan["resources"]):
@@ -60,6 +60,21 @@ def scene(ex: Any) -> Any:
                                 lambda queue, record: submit_once(ex, queue, record))
         ex.log.context = context
     return ex.scene_gpu
+
+
+def attach_logic(ex: Any, hz: float) -> None:
+    """A logic thread at ``hz`` for the scene (``rgraph.vk.runtime.logic``; without a scene it
+    ticks with nothing to compute); ``run_frames`` starts and stops it."""
+    from rgraph.vk.runtime.logic import LogicThread
+
+    try:
+        scene = ex.scene_gpu
+        lock = scene.deform.lock if scene is not None and scene.deform is not None else None
+        ex.logic = LogicThread(scene.logic_step if scene is not None else (lambda _s: None), hz, lock=lock)
+    except ValueError as exc:
+        raise ExecutionError(str(exc)) from None
+    if ex.scene_gpu is not None:
+        ex.scene_gpu.attach_logic(ex.logic)
 
 
 def pool(ex: Any, family: int, set_index: int) -> Any:

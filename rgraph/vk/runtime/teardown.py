@@ -11,6 +11,8 @@ from rgraph.vk.loader import vk
 
 def close(ex: Any) -> list[ValidationMessage]:
     v = vk()
+    if getattr(ex, "logic", None) is not None:  # before the scene's memory goes away
+        ex.logic.stop()
     dev = ex.device
     if dev is not None and dev.handle is not None:
         ex.log.context = "teardown"

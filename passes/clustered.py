@@ -31,6 +31,7 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, PassSetup, pack
 
+from .gpu_draw import draw_args
 from .scene_passes import SCENE_FRONT_FACE
 
 MODES = ("clustered", "all_lights")
@@ -141,6 +142,7 @@ class ForwardClustered(PassImpl):
 
     clear_values = {"hdr": (0.0, 0.0, 0.0, 1.0)}
     attachment_load = {"hdr": "clear"}
+    multiview = True
 
     def __init__(self, setup: PassSetup) -> None:
         super().__init__(setup)
@@ -158,7 +160,7 @@ class ForwardClustered(PassImpl):
     def record(self, rec, frame_set: int) -> None:
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
         rec.push(self.pipeline, self.push)
-        self.scene.draw(rec, frame_set)
+        self.scene.draw(rec, frame_set, args=draw_args(self.setup, frame_set))
 
 
 @register("cluster_heatmap")
@@ -170,7 +172,8 @@ class ClusterHeatmap(PassImpl):
         self.scene = setup.scene
         self.push = light_push(setup)
         self.w, self.h = setup.extent_of("light_heat")
-        self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest"),
+        left_eye = (0, 1) if int(setup.param("views", 1)) > 1 else None  # views=2: the heatmap of layer 0
+        self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest", layers=left_eye),
                                        Binding(1, "storage_image", "light_grid", array=True),
                                        Binding(2, "storage_image", "light_heat")])
         self.pipeline = setup.compute_pipeline("clustered/heatmap.comp", [self.scene.set_layout, self.sets.layout],

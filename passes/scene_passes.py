@@ -12,6 +12,8 @@ from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
+from .gpu_draw import draw_args
+
 #: Scene geometry is counter-clockwise seen from outside; with the Y-flipped projection and
 #: Vulkan's framebuffer orientation it stays counter-clockwise.
 SCENE_FRONT_FACE = "COUNTER_CLOCKWISE"
@@ -24,11 +26,13 @@ SHADOW_BIAS = (-2.0, -1.5)
 class DepthPrepass(PassImpl):
     """Writes ``depth`` (d32_sfloat): reversed-Z (clear 0, GREATER_OR_EQUAL), infinite far plane,
     invariant positions from ``scene_clip_position`` (forward matches them bit for bit).
+    Reads ``draw_args`` as ``indirect`` when the graph culls on the GPU (``passes.gpu_draw``).
     Param ``depth_prepass.cull`` (``back`` default, or ``none``)."""
     param_schema = {"depth_prepass.cull": Param(str, choices=("back", "front", "none"))}
 
     clear_values = {"depth": 0.0}
     attachment_load = {"depth": "clear"}
+    multiview = True
 
     def __init__(self, setup):
         super().__init__(setup)
@@ -41,7 +45,7 @@ class DepthPrepass(PassImpl):
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set)])
-        self.scene.draw(rec, frame_set, self.setup.param("rgraph.draws"))
+        self.scene.draw(rec, frame_set, self.setup.param("rgraph.draws"), args=draw_args(self.setup, frame_set))
 
 
 @register("shadow_map")

@@ -97,12 +97,16 @@ class PassImpl:
     - ``clear_values``: resource -> RGBA floats (colour) or a depth float (default 0: reversed-Z far);
     - ``owns_render_pass``: True when the implementation creates its render passes itself
       (``setup.own``) and begins and ends them in ``record`` (the probe: one per layer);
-      otherwise the runtime makes one from the pass's attachments and wraps ``record`` in it.
+      otherwise the runtime makes one from the pass's attachments and wraps ``record`` in it;
+    - ``multiview``: True when the shaders handle ``gl_ViewIndex`` (``RGRAPH_VIEWS``): with the
+      graph param ``views`` > 1 and attachments of that many layers, the runtime's render pass
+      renders every view in one pass (VK_KHR_multiview view mask, one framebuffer layer).
     """
 
     attachment_load: ClassVar[dict[str, str]] = {}
     clear_values: ClassVar[dict[str, Any]] = {}
     owns_render_pass: ClassVar[bool] = False
+    multiview: ClassVar[bool] = False
     param_schema: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, setup: Any) -> None:

@@ -65,6 +65,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                              "are submitted as fast as they complete, interpolating between the last two logic "
                              "states (reports the render thread's CPU per frame)")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
+    parser.add_argument("--naive-cpu", dest="naive_cpu", action="store_true",
+                        help="draw the scene the engines' way for comparison: per-object CPU frustum culling and "
+                             "one draw call per object (-p draw.mode=naive; the graph must have that param)")
     parser.add_argument("--json", action="store_true",
                         help="print the result (timings, validation messages, data check) as JSON (docs/cli-json.md)")
     parser.add_argument("--unchecked", action="store_true",
@@ -233,6 +236,8 @@ def run(args: argparse.Namespace) -> int:
     if args.frames < 1:
         print("rgraph: error: --frames must be at least 1", file=sys.stderr)
         return 2
+    if getattr(args, "naive_cpu", False):
+        args.param = [*(args.param or []), "draw.mode=naive"]
     for flag, target in (("--out", args.out), ("--timings", args.timings), ("--trace", args.trace),
                          ("--heatmap", args.heatmap)):
         if target is not None:

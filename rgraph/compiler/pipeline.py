@@ -41,6 +41,14 @@ class Frontend:
     spec: Spec
 
 
+def scene_quantities(model: Any) -> dict[str, int]:
+    """``scene.*`` expression names that are not features: ``draws`` (instances of every mesh;
+    1 without a scene, like ALL_PRESENT)."""
+    if model is None:
+        return {"draws": 1}
+    return {"draws": max(1, sum(m.instances.total if m.instances else 1 for m in model.meshes))}
+
+
 def load_scene_for(source: GraphSource, scene_path: str | Path | None) -> Scene | None:
     if scene_path is not None:
         return load_scene(resolve_scene(scene_path))
@@ -62,7 +70,8 @@ def frontend(
     scene = load_scene_for(source, scene_path)
     features = scene.features if scene else ALL_PRESENT
     resolved = resolve_params(source, params or {})
-    spec = specialize(source, features=features, params=resolved, size=size, scene_name=scene.name if scene else None)
+    spec = specialize(source, features=features, params=resolved, size=size, scene_name=scene.name if scene else None,
+                      quantities=scene_quantities(scene.model if scene else None))
     if scene is not None and scene.path is not None:
         spec = replace(spec, scene_source=str(scene.path))
     return Frontend(source, scene, spec)

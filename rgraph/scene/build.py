@@ -14,8 +14,8 @@ import numpy as np
 
 from rgraph.scene.animation import Animator
 from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
-from rgraph.scene.deform import FRAME_SECONDS, Deformer
 from rgraph.scene.character import build_rig
+from rgraph.scene.deform import FRAME_SECONDS, Deformer
 from rgraph.scene.generate import expand_lights
 from rgraph.scene.shapes import MeshData, make_shape
 from rgraph.spec.scene import Material, SceneFile, load_scene
@@ -48,22 +48,44 @@ class SceneMesh:
     def instances(self) -> int:
         return len(self.positions)
 
-    def world_corners(self) -> np.ndarray:
-        """Corners of every instance's world bounding box (instances * 8, 3), deformation included."""
+    def local_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) object-space box holding every frame: deformation padded; a skinned mesh in
+        any pose stays within the rest mesh's reach around the root joint (the root bobs 2 cm
+        and breathes 1%: rgraph.scene.animation)."""
         lo, hi = self.data.bounds()
         if self.deformer is not None:
             pad = self.deformer.max_displacement
             lo, hi = lo - pad, hi + pad
-        if self.animator is not None:  # any pose: within the rest mesh's reach around the root joint
-            root = self.animator.rig.skeleton.heads[0]
-            reach = 1.02 * float(np.linalg.norm(self.data.positions - root, axis=1).max()) + 0.05
+        if self.animator is not None:
+            root, reach = self._skin_reach()
             lo, hi = root - reach, root + reach
+        return lo, hi
+
+    def _skin_reach(self) -> tuple[np.ndarray, float]:
+        root = self.animator.rig.skeleton.heads[0].astype(np.float64)
+        return root, 1.02 * float(np.linalg.norm(self.data.positions - root, axis=1).max()) + 0.05
+
+    def world_corners(self) -> np.ndarray:
+        """Corners of every instance's world bounding box (instances * 8, 3), any pose or deformation."""
+        lo, hi = self.local_bounds()
         corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-        out = []
-        for p in self.positions:
-            m = model_matrix(p, self.rotation, self.scale)
-            out.append(corners @ m[:3, :3].T + m[:3, 3])
-        return np.concatenate(out)
+        m = model_matrix(np.zeros(3), self.rotation, self.scale)
+        local = corners @ m[:3, :3].T
+        return (self.positions[:, None, :] + local[None, :, :]).reshape(-1, 3)
+
+    def bounding_sphere(self) -> tuple[np.ndarray, float]:
+        """(centre offset from an instance's translation in world axes, radius): the sphere
+        around the rotated, scaled local bounding box (deformation included); for a skinned mesh
+        the sphere of its reach around the root joint (every pose)."""
+        m = model_matrix(np.zeros(3), self.rotation, self.scale)[:3, :3]
+        if self.animator is not None:
+            root, reach = self._skin_reach()
+            return m @ root, reach * float(np.abs(self.scale).max())
+        lo, hi = self.local_bounds()
+        centre = m @ ((lo + hi) / 2.0)
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        radius = float(np.linalg.norm(corners @ m.T - centre, axis=1).max())
+        return centre, radius
 
 
 @dataclass
@@ -150,9 +172,12 @@ class SceneData:
         out = []
         for k, mesh in enumerate(self.meshes):
             flags = 1 if mesh.deformer is not None else 0
-            for p in mesh.positions:
-                m = model_matrix(p - cam, mesh.rotation, mesh.scale)
-                out.append((m, normal_matrix(m), mesh.material, k, flags))
+            base = model_matrix(np.zeros(3), mesh.rotation, mesh.scale)
+            normal = normal_matrix(base)
+            for p in mesh.positions - cam:
+                m = base.copy()
+                m[:3, 3] = p
+                out.append((m, normal, mesh.material, k, flags))
         return out
 
     def bounds_rel(self, camera_position: np.ndarray) -> np.ndarray:
@@ -179,13 +204,35 @@ def _vec(v) -> np.ndarray:
 
 def _instance_positions(mesh) -> np.ndarray:
     base = _vec(mesh.position)
-    if mesh.instances is None:
+    inst = mesh.instances
+    if inst is None:
         return base[None]
-    g = mesh.instances.grid
-    offs = [((i - (g[0] - 1) / 2) * mesh.instances.spacing, (j - (g[1] - 1) / 2) * mesh.instances.spacing,
-             (k - (g[2] - 1) / 2) * mesh.instances.spacing)
-            for i in range(g[0]) for j in range(g[1]) for k in range(g[2])]
-    return base + np.asarray(offs, dtype=np.float64).reshape(-1, 3)
+    if inst.count is not None:
+        lo, hi = np.asarray(inst.bounds, dtype=np.float64)
+        return base + np.random.default_rng(inst.seed).uniform(lo, hi, (inst.count, 3))
+    g = inst.grid
+    axes = [(np.arange(n) - (n - 1) / 2) * inst.spacing for n in g]
+    offs = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    return base + offs
+
+
+#: Unique instances (``unique: true``): each instance's geometry is the shape scaled per axis by
+#: a seeded factor in this range (its own vertex and index data).
+UNIQUE_SCALE = (0.6, 1.4)
+
+
+def _unique_meshes(name: str, data: MeshData, material: int, rotation, scale, positions: np.ndarray,
+                   seed: int, first_draw: int) -> list[SceneMesh]:
+    """One single-instance mesh per instance, its vertices scaled by seeded per-axis factors
+    (``numpy.random.default_rng(seed)``, (instances, 3) factors in ``UNIQUE_SCALE``)."""
+    factors = np.random.default_rng(seed).uniform(*UNIQUE_SCALE, (len(positions), 3))
+    out = []
+    for i, (p, f) in enumerate(zip(positions, factors, strict=True)):
+        normals = data.normals / f
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        own = MeshData(data.positions * f, normals, data.indices.copy())
+        out.append(SceneMesh(f"{name}#{i}", own, material, rotation, scale, p[None], None, first_draw + i))
+    return out
 
 
 def pick_camera(model: SceneFile, camera: int) -> SceneFile:
@@ -221,6 +268,14 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
         except (ValueError, TypeError) as exc:
             raise ValueError(f"mesh {i} ({m.shape}): {exc}") from None
         scale = np.broadcast_to(np.asarray(m.scale, dtype=np.float64), (3,)).copy()
+        if m.unique:
+            if m.deformable or animator is not None:
+                raise ValueError(f"mesh {i} ({m.shape}): unique meshes cannot be deformable or skinned")
+            group = _unique_meshes(f"{i}:{m.shape}", data, material_names.index(m.material), tuple(m.rotation),
+                                   scale, positions, m.seed, draw)
+            draw += len(group)
+            meshes.extend(group)
+            continue
         mesh = SceneMesh(f"{i}:{m.shape}", data, material_names.index(m.material), tuple(m.rotation), scale,
                          positions, Deformer(data) if m.deformable else None, draw, animator, bones)
         draw += mesh.instances

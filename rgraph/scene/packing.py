@@ -98,6 +98,22 @@ def _frame_for_camera(scene: SceneData, cam) -> np.ndarray:
     return f
 
 
+def draw_infos(scene: SceneData) -> np.ndarray:
+    """(draws, 4) uint32 ``info`` of every draw (scene.glsl Draw.info and Instance.info alike):
+    material, mesh index, flags (1 deformable; 2 skinned, bits 8..31 its mesh's bone stride),
+    a skinned draw's first bone entry in a logic state."""
+    out = np.zeros((scene.draw_count, 4), dtype=np.uint32)
+    for index, mesh in enumerate(scene.meshes):
+        d = slice(mesh.first_draw, mesh.first_draw + mesh.instances)
+        out[d, 0], out[d, 1] = mesh.material, index
+        if mesh.deformer is not None:
+            out[d, 2] = 1
+        if mesh.animator is not None:
+            out[d, 2] = DRAW_SKINNED | (mesh.instances << 8)
+            out[d, 3] = mesh.bone_base + np.arange(mesh.instances)
+    return out
+
+
 def _draw_table(scene: SceneData) -> tuple[np.ndarray, np.ndarray]:
     """Per scene, once: (N, 4, 4) float64 world model matrices and the packed (N, DRAW_BYTES/4)
     float32 rows with everything but the camera-relative model (normal matrix, ids)."""
@@ -107,13 +123,9 @@ def _draw_table(scene: SceneData) -> tuple[np.ndarray, np.ndarray]:
         world = np.stack([m for m, *_ in draws]) if draws else np.zeros((0, 4, 4))
         rows = np.zeros((max(len(draws), 1), DRAW_BYTES // 4), dtype=np.float32)
         ints = rows.view(np.uint32)
-        for k, (_model, normal, material, mesh, flags) in enumerate(draws):
+        for k, (_model, normal, *_ids) in enumerate(draws):
             rows[k, 16:32] = mat(normal)
-            ints[k, 32:36] = (material, mesh, flags, 0)
-        for mesh in scene.skinned:  # scene.glsl Draw.info: skinned flag, bone stride, first bone entry
-            d = slice(mesh.first_draw, mesh.first_draw + mesh.instances)
-            ints[d, 34] |= DRAW_SKINNED | (mesh.instances << 8)
-            ints[d, 35] = mesh.bone_base + np.arange(mesh.instances)
+        ints[:len(draws), 32:36] = draw_infos(scene)
         table = (world, rows)
         scene._packed_draw_table = table  # type: ignore[attr-defined]
     return table

@@ -115,15 +115,33 @@ class Material(_Strict):
 
 
 class Instances(_Strict):
-    grid: list[Annotated[int, Field(ge=1, le=MAX_INSTANCES)]] = Field(min_length=3, max_length=3)
+    """FORMAT.md 7: ``{grid: [nx, ny, nz], spacing}`` or ``{count, seed, bounds: [lo, hi]}``
+    (seeded uniform positions, ``numpy.random.default_rng(seed)``)."""
+
+    grid: list[Annotated[int, Field(ge=1, le=MAX_INSTANCES)]] | None = Field(None, min_length=3, max_length=3)
     spacing: float = 1.0
+    count: int | None = Field(None, ge=1, le=MAX_INSTANCES)
+    seed: int = 0
+    bounds: list[Vec3] | None = Field(None, min_length=2, max_length=2)
 
     @model_validator(mode="after")
     def _bounded(self) -> Instances:
-        total = math.prod(self.grid)
+        if (self.grid is None) == (self.count is None):
+            raise ValueError("instances need exactly one of 'grid' or 'count'")
+        if self.count is not None:
+            if self.bounds is None:
+                raise ValueError("instances with 'count' need 'bounds': [[x0, y0, z0], [x1, y1, z1]]")
+            if any(len(b) != 3 for b in self.bounds) or any(self.bounds[0][k] > self.bounds[1][k] for k in range(3)):
+                raise ValueError("bounds must be [[x0, y0, z0], [x1, y1, z1]] with x0 <= x1, y0 <= y1, z0 <= z1")
+            return self
+        total = math.prod(self.grid or ())
         if total > MAX_INSTANCES:
             raise ValueError(f"an instance grid of {total:,} instances is over the limit of {MAX_INSTANCES:,}")
         return self
+
+    @property
+    def total(self) -> int:
+        return self.count if self.count is not None else math.prod(self.grid or ())
 
 
 class Skinned(_Strict):
@@ -145,6 +163,7 @@ class Mesh(_Strict):
     rotation: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
     scale: float | Vec3 = 1.0
     instances: Instances | None = None
+    unique: bool = False  # FORMAT.md 7: every instance its own vertex and index data (seeded sizes)
     seed: int = 0
     skinned: Skinned | None = None
 
@@ -154,6 +173,8 @@ class Mesh(_Strict):
             raise ValueError(f"skinned meshes must be 'shape: character' (the procedural rig), got {self.shape!r}")
         if self.skinned is not None and self.deformable:
             raise ValueError("a mesh is either skinned or deformable, not both")
+        if self.skinned is not None and self.unique:
+            raise ValueError("skinned meshes share one rig: 'unique: true' does not apply to them")
         return self
 
 

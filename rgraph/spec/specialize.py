@@ -201,8 +201,11 @@ def specialize(
     size: tuple[int, int],
     scene_name: str | None = None,
     limits: Limits = Limits(),
+    quantities: Mapping[str, int] | None = None,
 ) -> Spec:
-    env = _Env(params, features)
+    """``quantities``: more ``scene.*`` names for expressions only (e.g. ``scene.draws``), not
+    scene features (``requires`` and the plan's ``features`` do not see them)."""
+    env = _Env(params, {**(quantities or {}), **features})
     resources = {name: _resource(loc, env, size, limits) for name, loc in source.resources.items()}
     outputs = _outputs(source, resources)
     passes: list[PassSpec] = []

@@ -153,12 +153,14 @@ def _family_for(families: list[Any], queue: str) -> int:
 
 
 def _query_features(handle: Any) -> tuple[Any, Any, Any, Any]:
+    """(features2, Vulkan 1.2, (Vulkan 1.1, Vulkan 1.3) features, core features) of a physical device."""
     v = vk()
     f13 = v.VkPhysicalDeviceVulkan13Features()
-    f12 = v.VkPhysicalDeviceVulkan12Features(pNext=f13)
+    f11 = v.VkPhysicalDeviceVulkan11Features(pNext=f13)
+    f12 = v.VkPhysicalDeviceVulkan12Features(pNext=f11)
     f2 = v.VkPhysicalDeviceFeatures2(pNext=f12)
     v.vkGetPhysicalDeviceFeatures2(handle, f2)
-    return f2, f12, f13, f2.features
+    return f2, f12, (f11, f13), f2.features
 
 
 #: enabled whenever offered: the shared host allocation between devices (rgraph.vk.multi.host_memory)
@@ -183,7 +185,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         raise VulkanUnavailable(f"{physical.name} supports Vulkan {physical.api_version}; rgraph needs 1.3")
     if verbose:
         print(f"rgraph: device {physical.index}: {physical.name} ({physical.device_type})", file=sys.stderr)
-    _f2, f12, f13, core = _query_features(physical.handle)
+    _f2, f12, (f11, f13), core = _query_features(physical.handle)
     missing = [n for n in REQUIRED_12 if not getattr(f12, n)] + [n for n in REQUIRED_13 if not getattr(f13, n)]
     if missing:
         raise VulkanUnavailable(f"{physical.name} lacks required Vulkan features: {', '.join(missing)}")
@@ -198,8 +200,10 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
     enabled_core = {n for n in OPTIONAL_CORE if getattr(core, n)}
     core_features = v.VkPhysicalDeviceFeatures(**{n: v.VK_TRUE for n in enabled_core})
     e13 = v.VkPhysicalDeviceVulkan13Features(synchronization2=v.VK_TRUE, maintenance4=v.VK_TRUE)
+    multiview = bool(f11.multiview)  # Vulkan 1.1 (VK_KHR_multiview, core)
+    e11 = v.VkPhysicalDeviceVulkan11Features(pNext=e13, multiview=v.VK_TRUE if multiview else v.VK_FALSE)
     e12 = v.VkPhysicalDeviceVulkan12Features(
-        pNext=e13, timelineSemaphore=v.VK_TRUE, separateDepthStencilLayouts=v.VK_TRUE,
+        pNext=e11, drawIndirectCount=v.VK_TRUE if f12.drawIndirectCount else v.VK_FALSE, timelineSemaphore=v.VK_TRUE, separateDepthStencilLayouts=v.VK_TRUE,
         hostQueryReset=v.VK_TRUE,  # timestamp queries are reset from the host (transfer queues cannot)
         shaderOutputLayer=v.VK_TRUE if f12.shaderOutputLayer else v.VK_FALSE,  # gl_Layer in vertex shaders
         bufferDeviceAddress=v.VK_TRUE if ray_tracing else v.VK_FALSE,
@@ -225,6 +229,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         properties=props, memory_properties=v.vkGetPhysicalDeviceMemoryProperties(physical.handle),
         enabled_features=enabled_core | set(REQUIRED_12) | set(REQUIRED_13)
         | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set())
+        | ({"drawIndirectCount"} if f12.drawIndirectCount else set()) | ({"multiview"} if multiview else set())
         | ({"bufferDeviceAddress", "accelerationStructure", "rayTracingPipeline"} if ray_tracing else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},

@@ -4,7 +4,8 @@ The runtime, not the implementation, owns the VkRenderPass and framebuffers of a
 pass: attachments are the pass's colour accesses in plan order, then its depth access;
 initial and final layouts equal the plan's layouts (no implicit transitions, no subpass
 dependencies), so barriers stay the graph's alone. Layered attachments give one layered
-framebuffer (the implementation selects layers with ``gl_Layer``).
+framebuffer (the implementation selects layers with ``gl_Layer``), or, for a ``multiview``
+implementation with the param ``views`` > 1, a multiview render pass (view mask of all views).
 """
 
 from __future__ import annotations
@@ -115,9 +116,19 @@ class ImplPass:
         subpass = v.VkSubpassDescription(
             pipelineBindPoint=v.VK_PIPELINE_BIND_POINT_GRAPHICS, colorAttachmentCount=len(color_refs),
             pColorAttachments=color_refs or None, pDepthStencilAttachment=depth_ref)
+        views = int(plan.get("params", {}).get("views", 1))
+        chain = {}
+        if impl.multiview and views > 1:
+            if layers != views:
+                raise ExecutionError(f"pass {self.p['name']!r}: views={views} needs attachments of {views} layers, "
+                                     f"they have {layers}")
+            mask = (1 << views) - 1
+            chain["pNext"] = v.VkRenderPassMultiviewCreateInfo(subpassCount=1, pViewMasks=[mask],
+                                                               correlationMaskCount=1, pCorrelationMasks=[mask])
         self.render_pass = v.vkCreateRenderPass(dev, v.VkRenderPassCreateInfo(
             attachmentCount=len(descriptions), pAttachments=descriptions, subpassCount=1, pSubpasses=[subpass],
-            dependencyCount=0), None)
+            dependencyCount=0, **chain), None)
+        framebuffer_layers = 1 if chain else layers  # multiview: the view mask selects the layers
         w, h = self.extent
         for s in range(sets):
             views = []
@@ -128,7 +139,7 @@ class ImplPass:
                 views.append(resources.view(r, tuple(sub["mips"]), tuple(sub["layers"]), aspect, array=layers > 1))
             self.framebuffers.append(v.vkCreateFramebuffer(dev, v.VkFramebufferCreateInfo(
                 renderPass=self.render_pass, attachmentCount=len(views), pAttachments=views,
-                width=w, height=h, layers=layers), None))
+                width=w, height=h, layers=framebuffer_layers), None))
         return layers
 
     def record(self, ctx: RecordContext, frame_set: int) -> None:

@@ -228,8 +228,11 @@ class PassSetup:
 
     # ------------------------------------------------------------- shaders and pipelines
     def shader(self, path: str, defines: dict[str, Any] | None = None) -> Any:
-        """A VkShaderModule from ``shaders/<path>`` compiled by glslc (cached by content)."""
-        compiled = compile_shader(find_shader(path), defines=defines or {})
+        """A VkShaderModule from ``shaders/<path>`` compiled by glslc (cached by content), with the
+        scene's draw-mode and view defines (``rgraph.vk.scene_modes.scene_defines``)."""
+        from rgraph.vk.scene_modes import scene_defines
+
+        compiled = compile_shader(find_shader(path), defines={**scene_defines(self.plan, self.device), **(defines or {})})
         v = vk()
         module = v.vkCreateShaderModule(self.device.handle, v.VkShaderModuleCreateInfo(
             codeSize=len(compiled.spirv), pCode=compiled.spirv), None)

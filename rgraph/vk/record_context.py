@@ -93,6 +93,11 @@ class RecordContext(RayTracingCommands):
     def draw_indexed_indirect(self, buffer: Any, offset: int) -> None:
         vk().vkCmdDrawIndexedIndirect(self._cb, buffer, offset, 1, 20)
 
+    def draw_indexed_indirect_count(self, buffer: Any, offset: int, count_buffer: Any, count_offset: int,
+                                    max_draws: int) -> None:
+        """Vulkan 1.2 ``vkCmdDrawIndexedIndirectCount`` (stride 20: VkDrawIndexedIndirectCommand)."""
+        vk().vkCmdDrawIndexedIndirectCount(self._cb, buffer, offset, count_buffer, count_offset, max_draws, 20)
+
     def dispatch(self, x: int, y: int, z: int = 1) -> None:
         vk().vkCmdDispatch(self._cb, x, y, z)
 

@@ -2,17 +2,22 @@
 
 Built once per run from ``plan["scene_source"]`` by the executor (``Executor._scene``):
 
-- rigid geometry (every mesh's vertices; all indices), the materials and the authored lights
+- rigid geometry (every mesh's vertices; all indices, placed by the TLSF allocator in one
+  buffer each), the materials, the authored lights, the mesh table (binding 6) and, with
+  ``draw.mode=gpu`` (``rgraph.vk.scene_modes``), the persistent per-instance data (binding 1)
   live in device-local buffers, filled once through a host staging buffer and
   ``vkCmdCopyBuffer`` followed by a buffer barrier COPY/TRANSFER_WRITE -> ALL_COMMANDS/MEMORY_READ
   in the same command buffer (a fence wait alone does not make device writes visible);
 - per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
-  uniform, the Draws and Decals storage buffers (camera-relative, float64 on the CPU), and the
+  uniform, the Views uniform (binding 5, ``views=2``), the Draws (draw modes cpu and naive) and
+  Decals storage buffers (camera-relative, float64 on the CPU; cpu mode rewrites them only when
+  the camera moves, naive every frame), naive mode's per-object draw commands, and the
   deformable meshes' positions (deformed on the CPU every frame); their normals and tangents
   are computed on the GPU (``rgraph.vk.scene_deform``: ``record_deform`` at the start of the
   frame's first scene batch on the graphics queue), into the vertex buffers the draws bind.
-- skinning (bindings 5-7, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights, the ring of
-  packed logic states and each set's interpolation factor.
+- skinning (bindings 7-9, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights (lined up with
+  the TLSF-placed rigid vertex buffer), the ring of packed logic states and each set's
+  interpolation factor.
 
 Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(frame_set)``,
 ``vertex_input`` and ``draw(rec, frame_set)``.
@@ -23,6 +28,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from rgraph.memory.tlsf import Tlsf
+from rgraph.scene import instances as scene_instances
 from rgraph.scene import packing
 from rgraph.scene.build import SceneData, load_scene_data
 from rgraph.vk.device import Device
@@ -32,9 +39,11 @@ from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
 from rgraph.vk.resources import HostBuffer
 from rgraph.vk.runtime.logic import interpolation_alpha
+from rgraph.vk.scene_modes import draw_mode, view_count
+from rgraph.vk.skin_gpu import BINDING_BONES, BINDING_SKIN_FRAME, BINDING_SKIN_VERTICES, SkinGPU
 
-BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS = range(5)
-BINDING_SKIN_VERTICES, BINDING_BONES, BINDING_SKIN_FRAME = range(5, 8)  # rgraph.vk.skin_gpu
+(BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS, BINDING_VIEWS,
+ BINDING_MESHES) = range(7)
 
 
 @dataclass(frozen=True)
@@ -57,6 +66,9 @@ class SceneGPU:
             raise ExecutionError("the plan names no scene file (scene_source); scene passes need one")
         self.device = device
         self.sets = sets
+        self.mode = draw_mode(plan)
+        self.views = view_count(plan)
+        self.ipd = float(plan.get("params", {}).get("views.ipd", scene_instances.DEFAULT_IPD))
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
         self.plan_logic_hz = plan.get("logic_hz")  # skinning's logic rate (default 60 Hz)
         try:
@@ -69,6 +81,7 @@ class SceneGPU:
         self.skin = None
         self.set_layout = None
         self._sets: list[Any] = []
+        self._submit_once = submit_once
         self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread (attach_logic)
         self.ticks_taken: list[tuple[int, int] | None] = [None] * sets  # per set: the logic ticks its frame mixes
@@ -132,28 +145,37 @@ class SceneGPU:
 
         v = vk()
         data = self.data
-        # geometry: rigid vertices in one device-local buffer, deformable ones per set in host memory
-        rigid_vertices, indices, calls = [], [], []
-        rigid_base = deform_base = first_index = 0
+        # geometry: every rigid mesh's vertices and every mesh's indices suballocated (TLSF, in
+        # vertex / index units) from one device-local buffer each; deformable vertices per set
+        # in host memory
+        vertex_space, index_space = Tlsf(0, growable=True), Tlsf(0, growable=True)
+        placed_vertices, placed_indices, calls = [], [], []
+        deform_base = 0
         self._deform_layout: list[tuple[Any, int]] = []  # (mesh, vertex offset) in the per-set buffers
         skinned: list[tuple[Any, int]] = []  # (mesh, first vertex in the rigid vertex buffer)
         for mesh in data.meshes:
             count = mesh.data.triangle_count * 3
-            indices.append(mesh.data.indices.reshape(-1))
+            first_index = index_space.allocate(count, 1)
+            placed_indices.append((first_index, mesh.data.indices.reshape(-1)))
             if mesh.deformer is None:
+                base = vertex_space.allocate(mesh.data.vertex_count, 1)
                 if mesh.animator is not None:
-                    skinned.append((mesh, rigid_base))
-                rigid_vertices.append(packing.vertex_bytes(mesh.data))
-                calls.append(DrawCall(False, count, first_index, rigid_base, mesh.instances, mesh.first_draw))
-                rigid_base += mesh.data.vertex_count
+                    skinned.append((mesh, base))
+                placed_vertices.append((base, mesh.data))
+                calls.append(DrawCall(False, count, first_index, base, mesh.instances, mesh.first_draw))
             else:
                 self._deform_layout.append((mesh, deform_base))
                 calls.append(DrawCall(True, count, first_index, deform_base, mesh.instances, mesh.first_draw))
                 deform_base += mesh.data.vertex_count
-            first_index += count
         self.calls = calls
-        index_bytes = np.concatenate(indices).astype(np.uint32).tobytes() if indices else b""
-        vertex_bytes = b"".join(rigid_vertices)
+        index_array = np.zeros(index_space.size, dtype=np.uint32)
+        for first, values in placed_indices:
+            index_array[first:first + len(values)] = values
+        vertex_array = np.zeros((vertex_space.size, packing.VERTEX_BYTES // 4), dtype=np.float32)
+        for base, mesh_data in placed_vertices:
+            vertex_array[base:base + mesh_data.vertex_count, 0:3] = mesh_data.positions
+            vertex_array[base:base + mesh_data.vertex_count, 3:6] = mesh_data.normals
+        index_bytes, vertex_bytes = index_array.tobytes(), vertex_array.tobytes()
         materials = packing.materials_bytes(data)
         scene_lights = packing.scene_lights_bytes(data)
         uploads = []
@@ -166,16 +188,27 @@ class SceneGPU:
         uploads.append((self.materials_buffer, materials))
         self.scene_lights_buffer = self._device_buffer(len(scene_lights), storage)
         uploads.append((self.scene_lights_buffer, scene_lights))
+        gpu = self.mode == "gpu"
+        instances = scene_instances.instance_bytes(data) if gpu else b""
+        meshes = scene_instances.mesh_rows(calls)
+        if gpu:
+            self.instance_buffer = self._device_buffer(len(instances), storage)
+            uploads.append((self.instance_buffer, instances))
+        self.meshes_buffer = self._device_buffer(len(meshes), storage)
+        uploads.append((self.meshes_buffer, meshes))
         self._upload(submit_once, [(b, d) for b, d in uploads if d])
-        from rgraph.vk.skin_gpu import SkinGPU
-
-        self.skin = SkinGPU(self.device, data, self.sets, skinned, rigid_base,
+        self.skin = SkinGPU(self.device, data, self.sets, skinned, vertex_space.size,
                             float(self.plan_logic_hz) if self.plan_logic_hz else 60.0)
 
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]
-        draws_size = len(packing.draws_bytes(data, 0))
-        self.draw_buffers = [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
+        draws_size = len(instances) if gpu else len(packing.draws_bytes(data, 0))
+        self.draw_buffers = [] if gpu else [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
+        views_size = scene_instances.views_size(self.views)
+        self.view_buffers = [self._host_buffer(views_size, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
+                             for _ in range(self.sets)]
+        self.naive_buffers = ([self._host_buffer(data.draw_count * 20, v.VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)
+                               for _ in range(self.sets)] if self.mode == "naive" else [])
         decals_size = max(len(data.decals), 1) * packing.DECAL_BYTES
         self.decal_buffers = [self._host_buffer(decals_size, storage) for _ in range(self.sets)]
         if deform_base:
@@ -186,36 +219,40 @@ class SceneGPU:
             self.deform = DeformGPU(self.device, self.sets, parts, device_buffer=self._device_buffer,
                                     host_buffer=self._host_buffer, upload=lambda ups: self._upload(submit_once, ups))
         self._make_descriptors(materials_size=len(materials), lights_size=len(scene_lights), draws_size=draws_size,
-                               decals_size=decals_size)
+                               decals_size=decals_size, views_size=views_size, meshes_size=len(meshes))
         for s in range(self.sets):
             self.update(0, s)
 
     def _upload(self, submit_once: Any, uploads: list[tuple[DeviceBuffer, bytes]]) -> None:
         self._device_local.upload(submit_once, uploads)
 
-    def _make_descriptors(self, *, materials_size: int, lights_size: int, draws_size: int, decals_size: int) -> None:
+    def _make_descriptors(self, *, materials_size: int, lights_size: int, draws_size: int, decals_size: int,
+                          views_size: int, meshes_size: int) -> None:
         v = vk()
         dev = self.device.handle
         ubo, ssbo = v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
         kinds = [(BINDING_FRAME, ubo), (BINDING_DRAWS, ssbo), (BINDING_MATERIALS, ssbo),
-                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo), (BINDING_SKIN_VERTICES, ssbo),
-                 (BINDING_BONES, ssbo), (BINDING_SKIN_FRAME, ubo)]
+                 (BINDING_SCENE_LIGHTS, ssbo), (BINDING_DECALS, ssbo), (BINDING_VIEWS, ubo), (BINDING_MESHES, ssbo),
+                 (BINDING_SKIN_VERTICES, ssbo), (BINDING_BONES, ssbo), (BINDING_SKIN_FRAME, ubo)]
         bindings = [v.VkDescriptorSetLayoutBinding(binding=b, descriptorType=t, descriptorCount=1,
                                                    stageFlags=v.VK_SHADER_STAGE_ALL) for b, t in kinds]
         self.set_layout = v.vkCreateDescriptorSetLayout(dev, v.VkDescriptorSetLayoutCreateInfo(
             bindingCount=len(bindings), pBindings=bindings), None)
-        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=2 * self.sets),
-                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=6 * self.sets)]
+        sizes = [v.VkDescriptorPoolSize(type=ubo, descriptorCount=3 * self.sets),
+                 v.VkDescriptorPoolSize(type=ssbo, descriptorCount=7 * self.sets)]
         self._pool = v.vkCreateDescriptorPool(dev, v.VkDescriptorPoolCreateInfo(
             maxSets=self.sets, poolSizeCount=len(sizes), pPoolSizes=sizes), None)
         self._sets = list(v.vkAllocateDescriptorSets(dev, v.VkDescriptorSetAllocateInfo(
             descriptorPool=self._pool, descriptorSetCount=self.sets, pSetLayouts=[self.set_layout] * self.sets)))
         for s in range(self.sets):
             sources = [(BINDING_FRAME, ubo, self.frame_buffers[s].handle, packing.FRAME_BYTES),
-                       (BINDING_DRAWS, ssbo, self.draw_buffers[s].handle, draws_size),
+                       (BINDING_DRAWS, ssbo, (self.instance_buffer if self.mode == "gpu" else self.draw_buffers[s]).handle,
+                        draws_size),
                        (BINDING_MATERIALS, ssbo, self.materials_buffer.handle, materials_size),
                        (BINDING_SCENE_LIGHTS, ssbo, self.scene_lights_buffer.handle, lights_size),
-                       (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size)]
+                       (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size),
+                       (BINDING_VIEWS, ubo, self.view_buffers[s].handle, views_size),
+                       (BINDING_MESHES, ssbo, self.meshes_buffer.handle, meshes_size)]
             skin = [*self.skin.descriptors(), self.skin.frame_descriptor(s)]
             sources += [(b, ubo if kind == "uniform" else ssbo, buf.handle, size) for b, kind, buf, size in skin]
             infos = [v.VkDescriptorBufferInfo(buffer=h, offset=0, range=size) for _b, _t, h, size in sources]
@@ -226,7 +263,9 @@ class SceneGPU:
 
     # ----------------------------------------------------------------- per frame
     def update(self, frame: int, frame_set: int) -> None:
-        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished)."""
+        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished).
+        ``draw.mode=gpu`` writes no per-object data (the instances are persistent);
+        ``naive`` culls every object on the CPU and writes one draw command per object."""
         data = self.data
         logic = self.logic
         if logic is None:
@@ -239,11 +278,19 @@ class SceneGPU:
             self.alpha_range[1] = max(self.alpha_range[1], alpha)
         self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame, seconds))
         camera = data.camera(frame).position.tobytes()
-        if self._camera_written[frame_set] != camera:  # camera-relative tables change with the camera only
-            self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
+        # camera-relative tables change with the camera only; naive mode (the engines' way) writes
+        # every object's matrix every frame
+        if self._camera_written[frame_set] != camera or self.mode == "naive":
+            if self.mode != "gpu":
+                self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
             if data.decals:
                 self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
             self._camera_written[frame_set] = camera
+        if self.views > 1:
+            self.view_buffers[frame_set].write(scene_instances.cached_views_bytes(data, frame, self.views, self.ipd))
+        if self.mode == "naive":
+            self.naive_buffers[frame_set].write(scene_instances.naive_commands(data, frame, self.calls, self.views,
+                                                                               self.ipd))
         if logic is None:
             if self.skin is not None:
                 self.skin.update(seconds, frame_set)
@@ -280,9 +327,27 @@ class SceneGPU:
         if self.deform is not None:
             self.deform.record(cb, frame_set)
 
-    def draw(self, rec: Any, frame_set: int, share: Any = None) -> None:
-        """Bind vertex and index buffers and record one drawIndexed per mesh
-        (instances = the mesh's instances, firstInstance = its first draw index).
+    def refresh_instances(self) -> None:
+        """After instances moved (``SceneMesh.positions`` changed in ``self.data``): drop the
+        per-scene caches and, with draw.mode=gpu, upload the persistent instance table again -
+        only when something changed, never per frame. The upload waits for the device to be
+        idle (frames in flight read the table), so it suits rare changes."""
+        for cache in ("_instance_arrays", "_packed_draw_table", "_frame_cache", "_views_cache"):
+            self.data.__dict__.pop(cache, None)
+        self._camera_written = [None] * self.sets  # the Draws are written again at the next update
+        if self.mode == "gpu":
+            vk().vkDeviceWaitIdle(self.device.handle)
+            self._upload(self._submit_once, [(self.instance_buffer, scene_instances.instance_bytes(self.data))])
+
+    def draw(self, rec: Any, frame_set: int, share: Any = None, args: Any = None) -> None:
+        """Bind vertex and index buffers and record the scene's draws.
+
+        - ``args`` (the graph buffer ``draw_args`` of ``draw_cull``, draw.mode=gpu): one
+          ``vkCmdDrawIndexedIndirectCount`` over the culled commands (count at offset 0,
+          commands from offset 16), then the deformable meshes directly;
+        - draw.mode=naive: one ``vkCmdDrawIndexedIndirect`` per object (its CPU-culled command);
+        - otherwise one drawIndexed per mesh (instances = the mesh's instances, firstInstance =
+          its first draw index).
         ``share = [device, devices]`` (sort-last, ``params["rgraph.draws"]``): only this device's
         calls (``rgraph.vk.multi.shares``: balanced by triangle count)."""
         calls = self.calls
@@ -297,11 +362,20 @@ class SceneGPU:
         if any(call.deformable for call in calls) and not self.deform.recorded[frame_set]:
             raise ExecutionError("deformable meshes drawn before their compute pass was recorded (the draw is not "
                                  "on the graphics queue after the frame's first scene batch)")
+        if args is not None and self.mode == "gpu" and share is None:
+            rec.bind_vertex_buffers([self.vertex_buffer.handle])
+            bound = self.vertex_buffer.handle
+            rec.draw_indexed_indirect_count(args, 16, args, 0, self.draw_count)
+            calls = [c for c in calls if c.deformable]
         for call in calls:
             want = self.deform.vertex_buffers[frame_set].handle if call.deformable else self.vertex_buffer.handle
             if want is not bound:
                 rec.bind_vertex_buffers([want])
                 bound = want
+            if self.mode == "naive" and not call.deformable:
+                for d in range(call.first_instance, call.first_instance + call.instances):
+                    rec.draw_indexed_indirect(self.naive_buffers[frame_set].handle, 20 * d)
+                continue
             rec.draw_indexed(call.index_count, call.instances, call.first_index, call.vertex_offset,
                              call.first_instance)
 

@@ -1,15 +1,15 @@
-"""Skinning data on the GPU: set 0 bindings 5-7 of ``shaders/scene/scene.glsl`` (owned by SceneGPU).
+"""Skinning data on the GPU: set 0 bindings 7-9 of ``shaders/scene/skinning.glsl`` (owned by SceneGPU).
 
-- binding 5 ``SkinVertices``: per vertex of the rigid vertex buffer (indexed by
-  ``gl_VertexIndex``), 4 joint indices (uint8) and 4 weights (unorm8) as a ``uvec2``; written
+- binding 7 ``SkinVertices``: per vertex of the rigid vertex buffer (indexed by
+  ``gl_VertexIndex``: the TLSF-placed base of the mesh plus the index, in every draw mode), 4 joint indices (uint8) and 4 weights (unorm8) as a ``uvec2``; written
   once (zeros outside skinned meshes). A 16-byte placeholder when the scene has no skinning.
-- binding 6 ``Bones``: a header, then a ring of logic-state slots. Header: per scene mesh
+- binding 8 ``Bones``: a header, then a ring of logic-state slots. Header: per scene mesh
   (``Draw.info.y``) a ``uvec4`` whose x is the first entry of that mesh's rest joint positions
   (``head``, float32 bits in xyz), then those heads. A slot: the packed joint transforms of
   every skinned instance (rgraph.scene.skinning: 16 bytes per bone, bone-major per mesh). Each
   logic state is packed and written once, into a slot no frame in flight reads; the study's
   "two bone textures" are the two slots a frame set names.
-- binding 7 ``SkinFrame`` (per frame set, std140): ``(alpha, previous slot's first entry,
+- binding 9 ``SkinFrame`` (per frame set, std140): ``(alpha, previous slot's first entry,
   current slot's first entry, 0)``; the vertex shader interpolates previous -> current.
 
 Logic time: frame ``f`` shows ``interpolate(state k - 1, state k, alpha)`` with
@@ -30,6 +30,7 @@ from rgraph.scene.skinning import BONE_BYTES
 from rgraph.vk.device import Device
 from rgraph.vk.resources import HostBuffer
 
+BINDING_SKIN_VERTICES, BINDING_BONES, BINDING_SKIN_FRAME = range(7, 10)  # after scene.glsl's Views (5), Meshes (6)
 SKIN_VERTEX_BYTES = 8
 SKIN_FRAME_BYTES = 16
 
@@ -98,10 +99,11 @@ class SkinGPU:
 
     def descriptors(self) -> list[tuple[int, str, Any, int]]:
         """(binding, kind, buffer, range) for SceneGPU's descriptor writes."""
-        return [(5, "storage", self.vertices, self.vertex_bytes), (6, "storage", self.ring, self.bones_bytes)]
+        return [(BINDING_SKIN_VERTICES, "storage", self.vertices, self.vertex_bytes),
+                (BINDING_BONES, "storage", self.ring, self.bones_bytes)]
 
     def frame_descriptor(self, frame_set: int) -> tuple[int, str, Any, int]:
-        return (7, "uniform", self.frames[frame_set], SKIN_FRAME_BYTES)
+        return (BINDING_SKIN_FRAME, "uniform", self.frames[frame_set], SKIN_FRAME_BYTES)
 
     def state(self, tick: int) -> np.ndarray:
         """Logic state ``tick``: every skinned mesh's packed bones, concatenated (cached: two)."""

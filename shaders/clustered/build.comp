@@ -18,6 +18,13 @@ void main() {
     vec3 lo, hi;
     cluster_bounds(c, lo, hi);
     vec3 pad = vec3(cluster_pad(c.z));
+#if RGRAPH_VIEWS > 1
+    // stereo: one grid for both eyes (same rotation and projection, eyes apart along view x):
+    // grow each froxel by the eyes' view-space offsets so its list serves the same tile of either eye
+    vec3 eyes = vec3(0.0);
+    for (int v = 0; v < RGRAPH_VIEWS; ++v) eyes = max(eyes, abs(mat3(frame.view) * views.eye[v].xyz));
+    pad += eyes;
+#endif
     imageStore(froxel_bounds, ivec3(c.xy, 2 * c.z), vec4(lo - pad, 0.0));
     imageStore(froxel_bounds, ivec3(c.xy, 2 * c.z + 1), vec4(hi + pad, 0.0));
 }

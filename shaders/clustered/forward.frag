@@ -1,5 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#if defined(RGRAPH_VIEWS) && RGRAPH_VIEWS > 1
+#extension GL_EXT_multiview : require
+#define EYE scene_eye(uint(gl_ViewIndex))
+#else
+#define EYE vec3(0.0)
+#endif
 // Clustered forward PBR: GGX (forward/brdf.glsl) over the lights of the fragment's froxel
 // (ALL_LIGHTS = 1: over every light, the reference), plus ambient * diffuse colour and emission.
 // No shadows, no IBL. Writes hdr (linear radiance, clamped to HDR_MAX).
@@ -20,7 +26,7 @@ layout(push_constant) uniform Push { uint capacity; uint light_count; } pc;
 #include "clustered/lights.glsl"
 
 void main() {
-    vec3 to_view = -in_world;
+    vec3 to_view = EYE - in_world;  // views=2: this eye's position (camera-relative)
     vec3 geo = cross(dFdx(in_world), dFdy(in_world));
     geo = dot(geo, to_view) < 0.0 ? -geo : geo;
     vec3 n_in = gl_FrontFacing ? in_normal : -in_normal;
@@ -31,7 +37,7 @@ void main() {
 #if ALL_LIGHTS
     for (uint i = 0u; i < n; ++i) shade_light(i, s, in_world, diffuse, specular);
 #else
-    float view_distance = -dot(vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]), in_world);
+    float view_distance = -dot(vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]), in_world - EYE);
     uvec4 cell = imageLoad(light_grid, cluster_of(gl_FragCoord.xy, view_distance));
     if (cell.y == CLUSTER_OVERFLOW) {
         for (uint i = 0u; i < n; ++i) shade_light(i, s, in_world, diffuse, specular);

@@ -13,7 +13,7 @@ void main() {
     vec3 position = in_position, normal = in_normal;
     scene_vertex_pose(position, normal, d);
     out_world = scene_world_position(position, d).xyz;
-    out_normal = mat3(draws[d].normal_matrix) * normal;
-    out_material = draws[d].info.x;
+    out_normal = scene_normal3(d) * normal;
+    out_material = scene_info(d).x;
     gl_Position = scene_clip_position(position, d);
 }

@@ -5,7 +5,14 @@
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 color;
+#if defined(RGRAPH_VIEWS) && RGRAPH_VIEWS > 1
+layout(set = 0, binding = 0) uniform sampler2DArray hdr;  // views=2: one layer per eye
+layout(location = 1) flat in int in_layer;               // lib/fullscreen.vert FULLSCREEN_LAYERS: the eye
+#define HDR_TEXEL(p) texelFetch(hdr, ivec3(p, in_layer), 0)
+#else
 layout(set = 0, binding = 0) uniform sampler2D hdr;
+#define HDR_TEXEL(p) texelFetch(hdr, p, 0)
+#endif
 layout(push_constant) uniform Push {
     float exposure;
     float inv_white_mapped;  // 1 / hable(white)
@@ -19,7 +26,7 @@ vec3 hable(vec3 x) {
 }
 
 void main() {
-    vec3 raw = texelFetch(hdr, ivec2(gl_FragCoord.xy), 0).rgb;
+    vec3 raw = HDR_TEXEL(ivec2(gl_FragCoord.xy)).rgb;
     bool nan_texel = any_nan(raw);
     vec3 c = sanitize(raw, 3.0e38);  // NaN texel -> 0, negatives/-Inf -> 0, +Inf -> 3e38 (white below)
     vec3 x = min(c * pc.exposure, vec3(X_CAP));

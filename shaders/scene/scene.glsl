@@ -22,6 +22,9 @@
 #define RGRAPH_SCENE_GLSL
 
 #define SCENE_MAX_SHADOW_LIGHTS 4
+#ifndef RGRAPH_VIEWS
+#define RGRAPH_VIEWS 1
+#endif
 
 #define LIGHT_DIRECTIONAL 0
 #define LIGHT_POINT 1
@@ -48,6 +51,7 @@ layout(set = 0, binding = 0, std140) uniform Frame {
     vec4 scene_bounds;    // 784  camera-relative bounding sphere of the scene: centre xyz, radius w
 } frame;                  // 800
 
+#ifndef SCENE_INSTANCES
 // binding 1, std430, 144 bytes each; draws[gl_InstanceIndex] (firstInstance = draw index)
 struct Draw {
     mat4 model;           //   0  object -> camera-relative world
@@ -58,6 +62,28 @@ struct Draw {
                           //      bone entry in a logic state (bone b at w + b * stride)
 };
 layout(set = 0, binding = 1, std430) readonly buffer Draws { Draw draws[]; };
+#else
+// GPU-driven drawing (draw.mode=gpu, rgraph/scene/instances.py): binding 1 holds the
+// persistent per-instance data, written once (and again only when an instance changes);
+// the draw passes get only a 32-bit instance id per draw (firstInstance). 192 bytes each.
+struct Instance {
+#ifdef SCENE_FLOAT64
+    dvec4 translation;    //   0  float64 world translation (shaderFloat64)
+#else
+    uvec4 translation_bits[2];  // 0  the same float64 bits, unread without shaderFloat64
+#endif
+    vec4 columns[3];      //  32  object -> world 3x3 (rotation * scale) columns, w 0
+    vec4 normal_columns[3];  // 80  inverse-transpose of that 3x3, columns
+    uvec4 info;           // 128  as Draw.info (material, mesh, flags: 1 deformable / 2 skinned + bone stride, first bone)
+    vec4 translation_hi;  // 144  xyz: float32(translation)
+    vec4 translation_lo;  // 160  xyz: float32(translation - hi)
+    vec4 sphere;          // 176  bounding sphere: centre offset from the translation (world axes), radius
+};
+layout(set = 0, binding = 1, std430) readonly buffer Instances { Instance instances[]; };
+
+// binding 6, std430, one uvec4 per scene mesh: (index count, first index, vertex offset, 0)
+layout(set = 0, binding = 6, std430) readonly buffer Meshes { uvec4 meshes[]; };
+#endif
 
 // binding 2, std430, 64 bytes each
 struct Material {
@@ -100,18 +126,89 @@ struct Light {
                           //      w: 1 / radius^2 (point/spot), 0 (directional)
 };
 
+#if RGRAPH_VIEWS > 1
+// binding 5, std140 (views=2, VK_KHR_multiview): per eye, camera-relative world -> clip and the
+// eye's camera-relative position; both eyes share the Frame's rotation and projection.
+layout(set = 0, binding = 5, std140) uniform Views {
+    mat4 view_proj[RGRAPH_VIEWS];  //   0
+    vec4 eye[RGRAPH_VIEWS];        // 128  xyz: the eye's position relative to the camera
+} views;
+#endif
+
+// camera-relative world -> clip of view ``view`` (0 without multiview).
+mat4 scene_view_proj(uint view) {
+#if RGRAPH_VIEWS > 1
+    return views.view_proj[view];
+#else
+    return frame.view_proj;
+#endif
+}
+
+// The eye of view ``view``, camera-relative (0 without multiview): shade with eye - world.
+vec3 scene_eye(uint view) {
+#if RGRAPH_VIEWS > 1
+    return views.eye[view].xyz;
+#else
+    return vec3(0.0);
+#endif
+}
+
+// The one vertex-transform include point: every scene vertex shader (and the skinning and
+// deformation hooks) goes through these accessors of draw/instance ``d``.
+#ifdef SCENE_INSTANCES
+// Camera-relative translation of instance d: float64 subtraction with shaderFloat64, else the
+// float32 high/low split (hi - camera_hi) + (lo - camera_lo).
+vec3 scene_translation(uint d) {
+#ifdef SCENE_FLOAT64
+    dvec3 camera = dvec3(frame.camera_hi.xyz) + dvec3(frame.camera_lo.xyz);
+    return vec3(instances[d].translation.xyz - camera);
+#else
+    return (instances[d].translation_hi.xyz - frame.camera_hi.xyz) + (instances[d].translation_lo.xyz - frame.camera_lo.xyz);
+#endif
+}
+
+mat3 scene_model3(uint d) {
+    return mat3(instances[d].columns[0].xyz, instances[d].columns[1].xyz, instances[d].columns[2].xyz);
+}
+
+mat3 scene_normal3(uint d) {
+    return mat3(instances[d].normal_columns[0].xyz, instances[d].normal_columns[1].xyz,
+                instances[d].normal_columns[2].xyz);
+}
+
+uvec4 scene_info(uint d) { return instances[d].info; }
+
+vec4 scene_world_position(vec3 object_position, uint draw_index) {
+    return vec4(scene_model3(draw_index) * object_position + scene_translation(draw_index), 1.0);
+}
+#else
+mat3 scene_normal3(uint d) { return mat3(draws[d].normal_matrix); }
+
+uvec4 scene_info(uint d) { return draws[d].info; }
+
 // One transform for every scene vertex shader, so that depth prepass and forward produce
 // bit-identical positions (declare `invariant gl_Position;`: scene_vertex.glsl does).
 vec4 scene_world_position(vec3 object_position, uint draw_index) {
     return draws[draw_index].model * vec4(object_position, 1.0);
 }
+#endif
 
+vec4 scene_clip_position_of(vec3 object_position, uint draw_index, uint view) {
+    return scene_view_proj(view) * scene_world_position(object_position, draw_index);
+}
+
+#ifdef SCENE_VIEW_INDEX
+vec4 scene_clip_position(vec3 object_position, uint draw_index) {
+    return scene_clip_position_of(object_position, draw_index, SCENE_VIEW_INDEX);
+}
+#else
 vec4 scene_clip_position(vec3 object_position, uint draw_index) {
     return frame.view_proj * scene_world_position(object_position, draw_index);
 }
+#endif
 
 vec3 scene_world_normal(vec3 object_normal, uint draw_index) {
-    vec3 n = mat3(draws[draw_index].normal_matrix) * object_normal;
+    vec3 n = scene_normal3(draw_index) * object_normal;
     float len2 = dot(n, n);
     return len2 > 1e-30 ? n * inversesqrt(len2) : vec3(0.0, 1.0, 0.0);
 }

@@ -17,6 +17,10 @@
 #ifndef RGRAPH_SCENE_VERTEX_GLSL
 #define RGRAPH_SCENE_VERTEX_GLSL
 
+#if defined(RGRAPH_VIEWS) && RGRAPH_VIEWS > 1
+#extension GL_EXT_multiview : require
+#define SCENE_VIEW_INDEX uint(gl_ViewIndex)
+#endif
 #include "scene/scene.glsl"
 
 layout(location = 0) in vec3 in_position;  // object space

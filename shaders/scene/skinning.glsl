@@ -1,5 +1,5 @@
 // Skinning in the vertex shader (rgraph/vk/skin_gpu.py, rgraph/scene/skinning.py): set 0
-// bindings 5-7 of the scene. Included by scene/scene_vertex.glsl (needs scene/scene.glsl).
+// bindings 7-9 of the scene (after scene.glsl's Views 5 and Meshes 6). Included by scene/scene_vertex.glsl (needs scene/scene.glsl).
 //
 // A skinned draw (Draw.info.z & 2) reads, per vertex, 4 joints (uint8) and 4 weights (unorm8)
 // from SkinVertices[vertex index]; bone b of the draw's skeleton is entry
@@ -20,9 +20,9 @@
 #define SKIN_ALPHA skin_frame.alpha  // the interpolation factor (a test shader may override it)
 #endif
 
-layout(set = 0, binding = 5, std430) readonly buffer SkinVertices { uvec2 skin_vertices[]; };
-layout(set = 0, binding = 6, std430) readonly buffer Bones { uvec4 bones[]; };
-layout(set = 0, binding = 7, std140) uniform SkinFrame {
+layout(set = 0, binding = 7, std430) readonly buffer SkinVertices { uvec2 skin_vertices[]; };
+layout(set = 0, binding = 8, std430) readonly buffer Bones { uvec4 bones[]; };
+layout(set = 0, binding = 9, std140) uniform SkinFrame {
     float alpha;          // 0: previous state, 1: current
     uint previous;        // first entry of the previous state's slot in bones[]
     uint current;         // first entry of the current state's slot
@@ -58,15 +58,16 @@ vec3 skin_rotate(vec4 q, vec3 v) {
 }
 
 bool skin_is_skinned(uint draw_index) {
-    return (draws[draw_index].info.z & DRAW_SKINNED) != 0u;
+    return (scene_info(draw_index).z & DRAW_SKINNED) != 0u;
 }
 
 // Posed object-space position (and normal, unnormalised) of vertex `vertex` of a skinned draw.
 void skin_vertex(uint vertex, uint draw_index, inout vec3 position, inout vec3 normal) {
     uvec2 sv = skin_vertices[vertex];
     vec4 w = unpackUnorm4x8(sv.y);
-    uint stride = draws[draw_index].info.z >> 8u, first = draws[draw_index].info.w;
-    uint heads = bones[draws[draw_index].info.y].x;
+    uvec4 info = scene_info(draw_index);  // Draw.info or Instance.info (draw.mode=gpu): same fields
+    uint stride = info.z >> 8u, first = info.w;
+    uint heads = bones[info.y].x;
     vec3 p = vec3(0.0), n = vec3(0.0);
     for (uint k = 0u; k < 4u; ++k) {
         if (w[k] == 0.0) continue;

@@ -13,92 +13,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from locations import ROOT
-from ruamel.yaml import YAML
+from skinning_helpers import LOGIC_HZ, SIZE, clip_of
+from skinning_helpers import readback_pose as _gpu
+from skinning_helpers import reference_pose as _reference
+from skinning_helpers import run_skinned as _run
 
-from rgraph.resources import builtin_passes
-
-builtin_passes()
-from rgraph.passes import skinning_ref as ref  # noqa: E402
-
-from rgraph.scene.animation import logic_tick  # noqa: E402
-from rgraph.scene.build import load_scene_data  # noqa: E402
-from rgraph.scene.skinning import interpolate, unpack_bones  # noqa: E402
-
-SCENE = """scene: 1
-name: skin_case
-camera: {position: [0.0, 1.2, 4.0], look_at: [0.0, 1.0, 0.0], fov_y: 50, near: 0.1}
-lights:
-  - {type: directional, direction: [-0.4, -1.0, -0.6], intensity: 3.0}
-materials:
-  body:  {base_color: [0.72, 0.55, 0.45], roughness: 0.6, metallic: 0}
-  floor: {base_color: [0.35, 0.35, 0.38], roughness: 0.8, metallic: 0}
-meshes:
-  - {shape: plane, params: {size: [20, 20], subdivisions: 1}, material: floor}
-  - {shape: character, material: body, skinned: {bones: BONES, speed: 1.0, seed: 3, amplitude: 2.0},
-     instances: {grid: [2, 1, 1], spacing: 1.8}}
-"""
-SIZE = (64, 48)
-LOGIC_HZ = 30.0
-
-
-def _graph(tmp_path, readback_bytes: int | None, outputs=()):
-    y = YAML()
-    doc = y.load((ROOT / "graphs" / "clustered.yaml").read_text())
-    doc.pop("scene", None)
-    for n in outputs:
-        doc["resources"][n]["lifetime"] = "output"
-    doc["outputs"] = list(doc["outputs"]) + list(outputs)
-    if readback_bytes:
-        doc["resources"]["skinned"] = {"kind": "buffer", "bytes": readback_bytes, "lifetime": "output"}
-        doc["passes"]["skin_readback"] = {"kind": "compute", "impl": "skin_readback",
-                                          "writes": {"skinned": "storage_write"}}
-        doc["outputs"].append("skinned")
-        doc["params"]["skin_readback.alpha"] = -1.0
-    p = tmp_path / "skin_graph.yaml"
-    with p.open("w") as f:
-        y.dump(doc, f)
-    return p
-
-
-def _run(tmp_path, *, bones=256, frames=1, params=None, readback=True, outputs=(), floor=True):
-    from rgraph.compiler.pipeline import compile_graph
-    from rgraph.vk.executor import execute_plan
-
-    scene = tmp_path / "skin_case.yaml"
-    text = SCENE.replace("BONES", str(bones))
-    scene.write_text(text if floor else "\n".join(ln for ln in text.splitlines() if "shape: plane" not in ln))
-    data = load_scene_data(scene, SIZE)
-    mesh = data.skinned[0]
-    size = 2 * mesh.instances * mesh.data.vertex_count * 16
-    plan = compile_graph(_graph(tmp_path, size if readback else None, outputs), scene_path=scene, size=SIZE,
-                         params={"clusters.tile": "16", "clusters.slices": "4", **(params or {})})
-    plan["logic_hz"] = LOGIC_HZ
-    result = execute_plan(plan, validate=True, frames=frames, read_outputs=True)
-    assert [m.text for m in result.messages] == []
-    return data, mesh, result.outputs
-
-
-def _reference(mesh, frame: int, alpha: float | None) -> tuple[np.ndarray, np.ndarray]:
-    """(instances, V, 3) posed positions and unit normals from the half-float states, float64."""
-    tick, frame_alpha = logic_tick(frame / 60.0, LOGIC_HZ)
-    a, b = (unpack_bones(mesh.animator.state(k, LOGIC_HZ)) for k in (tick - 1, tick))
-    pose = interpolate(a, b, frame_alpha if alpha is None else alpha)  # joint transforms
-    rig, out_p, out_n = mesh.animator.rig, [], []
-    for c in range(mesh.instances):
-        joints = [ref.similarity(pose.q[:, j, c], pose.t[:, j, c], pose.s[j, c]) for j in range(rig.skeleton.bones)]
-        skins = ref.skin_matrices(rig.skeleton.heads, joints)
-        out_p.append(ref.skin_vertices(rig.mesh.positions, rig.joints, rig.weights_f, skins))
-        n = np.stack([sum(w * skins[j][:3, :3] / pose.s[j, c] for j, w in zip(js, ws, strict=True) if w)
-                      @ nv for js, ws, nv in zip(rig.joints, rig.weights_f, rig.mesh.normals, strict=True)])
-        out_n.append(n / np.linalg.norm(n, axis=1, keepdims=True))
-    return np.stack(out_p), np.stack(out_n)
-
-
-def _gpu(mesh, outputs) -> tuple[np.ndarray, np.ndarray]:
-    v = np.frombuffer(outputs["skinned"].tobytes(), dtype=np.float32).reshape(2, mesh.instances, -1, 4)
-    n = v[1, ..., :3].astype(np.float64)
-    return v[0, ..., :3].astype(np.float64), n / np.linalg.norm(n, axis=-1, keepdims=True)
+from rgraph.scene.animation import logic_tick
 
 
 @pytest.mark.vulkan
@@ -167,6 +87,6 @@ def test_clustered_draws_skinned_characters_without_depth_holes(tmp_path):
     # pixel is nearer than the nearest vertex, and a vertex facing the camera is covered)
     cam = _data.camera(0)
     world = _reference(mesh, 0, None)[0] + mesh.positions[:, None, :] - cam.position
-    clip = np.concatenate([world, np.ones(world.shape[:-1] + (1,))], axis=-1) @ np.asarray(cam.view_proj).T
+    clip = clip_of(world, cam.view_proj)
     nearest = (clip[..., 2] / clip[..., 3]).max()
     assert nearest * 0.97 < depth.max() <= nearest * 1.0001

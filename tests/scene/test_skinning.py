@@ -184,6 +184,7 @@ def test_threaded_state_is_bit_identical():
     ("{shape: box, material: body, skinned: {bones: 12}}", "5:5: error: skinned meshes must be 'shape: character'"),
     ("{shape: character, material: body, skinned: {bones: 300}}", "5:57: error: 'bones'"),
     ("{shape: character, material: body, deformable: true, skinned: {}}", "either skinned or deformable"),
+    ("{shape: character, material: body, unique: true, skinned: {}}", "5:5: error: skinned meshes share one rig"),
 ])
 def test_bad_skinned_keys_are_one_line_errors(tmp_path, mesh, message):
     from rgraph.errors import RGraphError
@@ -223,3 +224,47 @@ def test_vr_skinned_scene_and_draw_packing():
     box = mesh.world_corners()[5 * 8:6 * 8]  # instance 5's bounding box
     assert np.all(world >= box.min(axis=0)) and np.all(world <= box.max(axis=0))
     assert np.abs(posed - mesh.data.positions).max() > 0.02
+
+
+def test_gpu_instances_carry_skinning_and_spheres_hold_every_pose(tmp_path):
+    """draw.mode=gpu: Instance.info (rgraph.scene.instances) equals the Draws' info (skinned flag,
+    bone stride, first bone entry), and GPU culling's bounding sphere (and the CPU box) holds
+    every character's posed vertices over a whole cycle, rotated and scaled in the scene."""
+    from rgraph.scene import instances, packing
+    from rgraph.scene.build import load_scene_data
+
+    p = tmp_path / "chars.yaml"
+    p.write_text("""scene: 1
+name: chars
+camera: {position: [0, 2, 6], look_at: [0, 1, 0]}
+materials: {m: {base_color: [0.5, 0.5, 0.5]}}
+meshes:
+  - {shape: box, material: m, instances: {grid: [2, 1, 1], spacing: 2}}
+  - {shape: character, material: m, rotation: [0, 40, 10], scale: 1.5, skinned: {bones: 64, amplitude: 3.0, seed: 2},
+     instances: {grid: [3, 1, 2], spacing: 2.5}}
+""")
+    data = load_scene_data(p, (32, 32))
+    (mesh,) = data.skinned
+    draws = np.frombuffer(packing.draws_bytes(data, 0), dtype=np.uint32).reshape(-1, packing.DRAW_BYTES // 4)
+    table = np.frombuffer(instances.instance_bytes(data), dtype=np.uint32).reshape(-1, instances.INSTANCE_BYTES // 4)
+    assert np.array_equal(table[:, 32:36], draws[:, 32:36])
+    assert np.all(table[mesh.first_draw:, 34] == (packing.DRAW_SKINNED | (mesh.instances << 8)))
+    centre, radius = mesh.bounding_sphere()
+    from rgraph.scene.camera import model_matrix
+
+    m = model_matrix(np.zeros(3), mesh.rotation, mesh.scale)[:3, :3]
+    rig, worst, moved = mesh.animator.rig, 0.0, 0.0
+    boxes = mesh.world_corners().reshape(mesh.instances, 8, 3)
+    for seconds in np.linspace(0.0, 1.5, 13):
+        transforms = skin_transforms(rig.skeleton, mesh.animator.pose(seconds))
+        for c in range(mesh.instances):
+            posed, _ = skin(rig.mesh.positions, rig.mesh.normals, rig.joints, rig.weights_f, transforms, c)
+            world = posed @ m.T  # relative to the instance's translation
+            worst = max(worst, float(np.linalg.norm(world - centre, axis=1).max()) / radius)
+            box = boxes[c] - mesh.positions[c]
+            assert np.all(world >= box.min(axis=0) - 1e-9) and np.all(world <= box.max(axis=0) + 1e-9)
+            moved = max(moved, float(np.abs(posed - rig.mesh.positions).max()))
+    assert worst <= 1.0 and moved > 0.1  # inside the sphere, and the poses really move
+    # the sphere is the tight one around the reach, not the box's (sqrt(3) larger)
+    lo, hi = mesh.local_bounds()
+    assert radius < 0.7 * 0.5 * float(np.linalg.norm(hi - lo)) * 1.5

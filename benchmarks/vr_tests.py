@@ -1,0 +1,160 @@
+"""The VR renderer study's benchmarks (issue 18): FPS, GPU busy and render-thread CPU per test.
+
+Tests (graphs/clustered.yaml renders each): ``instanced`` (vr_instanced.yaml, 32,768 instanced
+cubes), ``skinned`` (vr_skinned.yaml, 1,024 characters x 256 bones), ``lighting`` (lighting_test.yaml,
+25 point lights over 968 boxes) and ``unique`` (vr_unique.yaml, 4,096 boxes with their own
+geometry). Each runs mono and stereo (``-p views=2``, VK_KHR_multiview) and in two draw modes:
+``gpu`` (persistent instances, GPU culling, one vkCmdDrawIndexedIndirectCount) and ``naive``
+(``rgraph run --naive-cpu``: per-object CPU culling and one draw call per object).
+
+Per run, after a warm-up of at least ``--warmup`` seconds of frames (the H200 starts at low
+clocks; its first frames run ~3x slow):
+
+- FPS = 1 / wall time per frame over ``--frames`` pipelined frames;
+- GPU busy = the median timestamp span of a frame (first pass start to last pass end) / wall;
+- render-thread CPU = the median per frame of the frame loop's time minus its fence wait
+  (``benchmarks.frame_cpu.frame_parts``: Python and Vulkan calls, the host updates included).
+
+    python3 -m benchmarks.vr_tests [--size 1920x1080] [--frames 300] [--warmup 0.5]
+        [--tests instanced,skinned,lighting,unique] [--views 1,2] [--modes gpu,naive] [--json OUT.json]
+    lavapipe smoke:  python3 -m benchmarks.vr_tests --size 160x90 --frames 3
+"""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from rgraph.resources import builtin_passes
+
+builtin_passes()  # rgraph.passes also from a plain checkout on PYTHONPATH (the GPU machines)
+ROOT = Path(__file__).resolve().parent.parent
+GRAPH = ROOT / "graphs" / "clustered.yaml"
+SCENES = ROOT / "graphs" / "scenes"
+TESTS = {"instanced": "vr_instanced.yaml", "skinned": "vr_skinned.yaml", "lighting": "lighting_test.yaml",
+         "unique": "vr_unique.yaml"}
+#: The study's figures (GTX 1080): GPU utilisation % / FPS of Ultra Engine.
+STUDY = {"instanced": (95, 1206), "skinned": (96, 1179), "lighting": (96, 1456), "unique": (63, 6213)}
+
+
+def available_tests(names: list[str]) -> list[str]:
+    """The asked-for tests whose scene exists (vr_skinned.yaml comes with the skinning work)."""
+    return [n for n in names if (SCENES / TESTS[n]).is_file()]
+
+
+def load_kwargs(gpu: Any, logic_hz: float | None) -> dict[str, Any]:
+    """Keyword arguments of ``gpu.load``: ``logic_hz`` where the runtime has a logic thread."""
+    if logic_hz is None:
+        return {}
+    if "logic_hz" not in inspect.signature(gpu.load).parameters:
+        raise SystemExit("vr_tests: --logic-hz needs the logic thread (rgraph run --logic-hz); this checkout lacks it")
+    return {"logic_hz": logic_hz}
+
+
+def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, frames: int, warmup: float,
+            logic_hz: float | None) -> dict[str, Any]:
+    from benchmarks.frame_cpu import frame_parts
+    from rgraph.compiler.pipeline import compile_graph
+
+    params = {"views": str(views), "draw.mode": mode}
+    plan = compile_graph(GRAPH, scene_path=SCENES / TESTS[test], size=size, params=params,
+                         memory=gpu.memory_requirements())
+    marks: list[float] = []
+    with gpu.load(plan, **load_kwargs(gpu, logic_hz)) as exe:
+        exe.warm_up(warmup)
+        warmed = exe.run(3).frames  # frames run before timing (warm-up included)
+        t0 = time.perf_counter()
+        timings = exe.run(frames, marks=marks).timings
+        wall_ms = (time.perf_counter() - t0) * 1000.0 / frames
+        calls = len(exe.executor.submit_calls[0])
+        draws = exe.executor.scene_gpu.draw_count
+    parts = frame_parts(marks, calls, skip=0)
+    span = timings["total_ms"]
+    cpu_us = statistics.median(parts["runtime"]) if parts["runtime"] else None
+    return {"test": test, "views": views, "mode": mode, "draws": draws, "warmup_frames": warmed,
+            "wall_ms": wall_ms, "fps": 1000.0 / wall_ms, "gpu_span_ms": span,
+            "gpu_busy": (span / wall_ms) if span is not None else None, "render_cpu_us": cpu_us,
+            "passes_ms": timings["passes"]}
+
+
+def _f(v: float | None, fmt: str) -> str:
+    return "-" if v is None else format(v, fmt)
+
+
+def table(rows: list[dict[str, Any]]) -> str:
+    """Markdown: a line per test and view count, gpu and naive side by side."""
+    head = ("| test | views | draws | FPS (gpu) | GPU busy (gpu) | render CPU us (gpu) | GPU ms (gpu) | "
+            "FPS (naive) | GPU busy (naive) | render CPU us (naive) | stereo / mono frame (gpu) | study (Ultra) |")
+    lines = [head, "|" + "---|" * 12]
+    by = {(r["test"], r["views"], r["mode"]): r for r in rows}
+    for (test, views, mode), r in by.items():
+        if mode != "gpu" and (test, views, "gpu") in by:
+            continue
+        n = by.get((test, views, "naive"), {})
+        mono = by.get((test, 1, mode))
+        ratio = (r["wall_ms"] / mono["wall_ms"]) if views > 1 and mono else None
+        study = STUDY.get(test)
+        lines.append(
+            f"| {test} | {views} | {r['draws']} | {_f(r['fps'], '.0f')} | {_f(_pct(r['gpu_busy']), '.1f')}% | "
+            f"{_f(r['render_cpu_us'], '.1f')} | {_f(r['gpu_span_ms'], '.3f')} | {_f(n.get('fps'), '.0f')} | "
+            f"{_f(_pct(n.get('gpu_busy')), '.1f')}% | {_f(n.get('render_cpu_us'), '.1f')} | {_f(ratio, '.2f')} | "
+            f"{'-' if not study or views > 1 else f'{study[0]}% / {study[1]}'} |")
+    return "\n".join(lines)
+
+
+def _pct(v: float | None) -> float | None:
+    return None if v is None else 100.0 * v
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", default="1920x1080")
+    parser.add_argument("--frames", type=int, default=300, help="timed frames per run")
+    parser.add_argument("--warmup", type=float, default=0.5, help="seconds of frames before timing (>= 0.3)")
+    parser.add_argument("--tests", default=",".join(TESTS))
+    parser.add_argument("--views", default="1,2")
+    parser.add_argument("--modes", default="gpu,naive", help="draw.mode values (gpu, naive, cpu)")
+    parser.add_argument("--logic-hz", dest="logic_hz", type=float, default=None,
+                        help="run scene logic on its own thread at this rate (needs rgraph run --logic-hz)")
+    parser.add_argument("--json", type=Path, help="write every figure as JSON")
+    args = parser.parse_args(argv)
+    if args.warmup < 0.3:
+        parser.error("--warmup must be at least 0.3 s")
+    if args.frames < 2:
+        parser.error("--frames must be at least 2")
+    w, h = (int(x) for x in args.size.lower().split("x"))
+    asked = [t.strip() for t in args.tests.split(",") if t.strip()]
+    unknown = [t for t in asked if t not in TESTS]
+    if unknown:
+        parser.error(f"unknown tests {unknown}; known: {', '.join(TESTS)}")
+    tests = available_tests(asked)
+    for missing in sorted(set(asked) - set(tests)):
+        print(f"vr_tests: {missing}: skipped ({TESTS[missing]} does not exist)")
+    import rgraph
+
+    rows = []
+    with rgraph.open_device(validate=False, verbose=False) as gpu:  # one device for every run
+        device = gpu.choice.get("name", "?") if isinstance(gpu.choice, dict) else "?"
+        for test in tests:
+            for views in (int(v) for v in args.views.split(",")):
+                for mode in (m.strip() for m in args.modes.split(",")):
+                    r = measure(gpu, test, (w, h), views, mode, args.frames, args.warmup, args.logic_hz)
+                    rows.append(r)
+                    print(f"{test} views={views} {mode}: {r['fps']:.1f} FPS, GPU busy {_f(_pct(r['gpu_busy']), '.1f')}%, "
+                          f"render CPU {_f(r['render_cpu_us'], '.1f')} us/frame, GPU {_f(r['gpu_span_ms'], '.3f')} ms",
+                          flush=True)
+    print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up")
+    print(table(rows))
+    if args.json:
+        args.json.write_text(json.dumps({"size": [w, h], "device": device, "rows": rows}, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -37,7 +37,8 @@ def test_small_run_alternates_the_plans_on_one_device(tmp_path, monkeypatch):
         def load(plan, **kw):
             exe = original_load(plan, **kw)
             run = exe.run
-            exe.run = lambda n, *a, _name=names[id(plan)], **k: (runs.append(_name), run(n, *a, **k))[1]
+            name = names[id(plan)]
+            exe.run = lambda n, *a, _name=name, **k: (runs.append(_name), run(n, *a, **k))[1]
             return exe
         gpu.load = load
         try:

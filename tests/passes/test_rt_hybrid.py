@@ -123,7 +123,7 @@ def test_visibility_ids_round_trip_and_oversized_scenes_are_refused():
 
     def scene(tris, instances):
         return NS(meshes=[NS(data=NS(triangle_count=t), positions=[0] * n, material=k)
-                          for k, (t, n) in enumerate(zip(tris, instances))])
+                          for k, (t, n) in enumerate(zip(tris, instances, strict=True))])
 
     data = scene([12, 131072], [2, 3])
     bits = prim_bits(data)

@@ -1,0 +1,78 @@
+"""Every bundled graph split across two logical devices of one physical device (lavapipe):
+the composited output equals the one-device output bit for bit, for both splits, with zero
+validation messages (the ray tracing graphs without validation: layer 1.3.239 crashes on RT
+pipelines, see rgraph/vk/rt_device.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from multi_helpers import validated_pair
+
+from rgraph.api import open_device
+from rgraph.compiler.multi_device import Split
+from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
+from rgraph.resources import bundled_graphs
+from rgraph.vk.multi.run import MultiExecutable
+from rgraph.vk.runtime.readback import decode_outputs
+
+SIZE = (32, 24)
+COVERED_ELSEWHERE = {"surgery"}  # tests/vk/test_multi_device.py
+RAY_TRACING = {"rt_standalone", "rt_hybrid", "rt_hybrid_raster"}
+VALIDATED = sorted(set(bundled_graphs()) - COVERED_ELSEWHERE - RAY_TRACING)
+MODES = ["sort-first", "sort-last"]
+
+
+@pytest.fixture(scope="module")
+def gpus():
+    yield from validated_pair()
+
+
+@pytest.fixture(scope="module")
+def rt_gpus():
+    devices = [open_device(validate=False, device=0, verbose=False) for _ in range(2)]
+    try:
+        yield devices
+    finally:
+        for d in devices:
+            d.close()
+
+
+def test_every_bundled_graph_is_listed():
+    assert set(bundled_graphs()) <= set(VALIDATED) | COVERED_ELSEWHERE | RAY_TRACING
+
+
+def _outputs_one_and_split(gpus, graph, mode):
+    plan = compile_graph(graph, size=SIZE, memory=gpus[0].memory_requirements())
+    with gpus[0].load(plan) as exe:
+        exe.run(1)
+        one = decode_outputs(plan, exe.read_back())
+    split = compile_graph_plan(graph, size=SIZE, memory=gpus[0].memory_requirements(), split=Split(2, mode))
+    multi = MultiExecutable(gpus, split)
+    try:
+        multi.run(1)
+        out = decode_outputs(multi.plans[0], multi.read_back())
+    finally:
+        multi.close()
+    return plan, one, out
+
+
+def _assert_equal_outputs(plan, one, out):
+    names = [r["name"] for r in plan["resources"] if r["lifetime"] == "output"]
+    assert names
+    for name in names:
+        assert np.array_equal(np.asarray(one[name]), np.asarray(out[name])), name
+
+
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("graph", VALIDATED)
+def test_bundled_graph_split_equals_one_device(gpus, graph, mode):
+    plan, one, out = _outputs_one_and_split(gpus, graph, mode)
+    _assert_equal_outputs(plan, one, out)
+    assert [str(m) for g in gpus for m in g.instance.log.messages] == []
+
+
+@pytest.mark.parametrize("mode", MODES)
+@pytest.mark.parametrize("graph", sorted(RAY_TRACING & set(bundled_graphs())))
+def test_ray_tracing_graph_split_equals_one_device(rt_gpus, graph, mode):
+    _assert_equal_outputs(*_outputs_one_and_split(rt_gpus, graph, mode))

@@ -200,17 +200,9 @@ class Executable:
         """Run untimed frames for about ``seconds`` of wall time (at least one frame when
         ``seconds`` > 0) so that a GPU that idles at low clocks is at its working clocks when
         timing starts; the frames count (the data check knows them). Returns the frames run."""
-        if seconds <= 0:
-            return 0
-        import time
+        from rgraph.vk.runtime.frames import run_for
 
-        done, start, batch = 0, time.perf_counter(), 1
-        while True:
-            self.executor.run_frames(batch)
-            done += batch
-            if time.perf_counter() - start >= seconds:
-                return done
-            batch = min(2 * batch, 64)
+        return run_for(self.executor.run_frames, seconds) if seconds > 0 else 0
 
     def read_back(self) -> dict[tuple, bytes]:
         """Raw bytes per (resource, mip, layer) of outputs, persistent and imported resources."""

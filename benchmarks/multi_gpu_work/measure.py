@@ -44,12 +44,11 @@ class Config:
         return (f"{self.split} {self.transfer}{' pipe' if self.pipelined else ''}"
                 f"{' dyn' if self.balance == 'dynamic' else ''}")
 
-    def warm(self, seconds: float, batch: int = 2) -> None:
+    def warm(self, seconds: float) -> None:
+        from rgraph.vk.runtime.frames import run_for
+
         t0 = time.perf_counter()
-        frames = 0
-        while frames < 2 or time.perf_counter() - t0 < seconds:
-            self.runner.run(batch)
-            frames += batch
+        frames = run_for(self.runner.run, seconds, min_frames=2)
         self.warmup = {"frames": frames, "seconds": time.perf_counter() - t0}
 
     def serial_frame(self) -> None:

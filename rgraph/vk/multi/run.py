@@ -196,11 +196,9 @@ class MultiExecutable:
 
     def warm_up(self, seconds: float) -> int:
         """Untimed frames for about ``seconds`` (``rgraph.api.Executable.warm_up``); the frames run."""
-        done, start = 0, time.perf_counter()
-        while seconds > 0 and (done == 0 or time.perf_counter() - start < seconds):
-            self.run(2)
-            done += 2
-        return done
+        from rgraph.vk.runtime.frames import run_for
+
+        return run_for(self.run, seconds) if seconds > 0 else 0
 
     def seek(self, frame: int) -> None:
         """Continue at frame ``frame`` on every device (frame-dependent values, frame sets):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 from rgraph.vk.errors import ExecutionError
@@ -11,6 +12,18 @@ from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
 
 #: Vulkan calls bracketed in ``run_frames`` marks before the submits, in order.
 FRAME_CALLS = ("vkWaitForFences", "vkGetQueryPoolResults", "vkResetFences", "vkResetQueryPool")
+
+
+def run_for(run: Callable[[int], Any], seconds: float, min_frames: int = 1, max_batch: int = 64) -> int:
+    """Warm-up: call ``run(n)`` (``Executable.run``, ``MultiExecutable.run``, an executor's
+    ``run_frames``) in batches of 1, 2, 4 ... ``max_batch`` frames until ``seconds`` of wall time
+    have passed and at least ``min_frames`` frames ran. Returns the frames run."""
+    done, batch, start = 0, 1, time.perf_counter()
+    while done < min_frames or time.perf_counter() - start < seconds:
+        run(batch)
+        done += batch
+        batch = min(2 * batch, max_batch)
+    return done
 
 
 def marks_per_frame(submit_calls: int) -> int:

@@ -4,7 +4,8 @@ by the camera rays' own test (shaders/rt/visraster.glsl explains the method):
 
 - ``rt_vis_clear``: ``vis_depth`` and ``visibility`` 0, ``vis_args`` = (0, 1, 1), the job list's
   count and overflow flag (``vis_jobs`` header) 0, and ``ray_args`` = (0, 1, 1) when the pass
-  writes it (one pass fewer than ``rt_reset_rays``);
+  writes it (one pass fewer than ``rt_reset_rays``), likewise the wavefront lists' arguments
+  ``rays_1_args`` .. ``rays_3_args`` it writes (passes/raytrace_wave.py);
 - ``rt_vis_depth``: a thread per triangle, atomicMax of the depth key; triangles whose screen box
   exceeds ``rt.vis_big_pixels`` append a job per 32x32 tile of their box to ``vis_jobs``
   (capacity (bytes - 16) / 8, at most 8 x 65535) after storing its setup in ``vis_tris`` (80
@@ -25,6 +26,7 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.passkit import Binding
 
 from .raytrace_hybrid import prim_bits
+from .raytrace_wave import MAX_WAVE_RESETS, list_args
 from .raytrace_standalone import pack_tables
 from .rt_model import camera_basis
 
@@ -151,12 +153,18 @@ class VisClear(PassImpl):
         super().__init__(setup)
         bindings = [Binding(5, "storage_image", "vis_depth"), Binding(6, "storage_image", "visibility"),
                     Binding(7, "storage_buffer", "vis_args"), Binding(8, "storage_buffer", "vis_jobs")]
-        reset = setup.has("ray_args")  # also reset the compacted ray list (instead of rt_reset_rays)
-        if reset:
+        defines: dict[str, object] = {}
+        if setup.has("ray_args"):  # also reset the compacted ray list (instead of rt_reset_rays)
             bindings.append(Binding(9, "storage_buffer", "ray_args"))
+            defines["RESET_RAYS"] = 1
+        levels = 0  # and the wavefront lists' arguments (passes/raytrace_wave.py)
+        while levels < MAX_WAVE_RESETS and setup.has(list_args(levels + 1)):
+            bindings.append(Binding(10 + levels, "storage_buffer", list_args(levels + 1)))
+            levels += 1
+        if levels:
+            defines["WAVE_LEVELS"] = levels
         self.sets = setup.descriptors(bindings)
-        self.pipeline = setup.compute_pipeline("rt/visclear.comp", [self.sets.layout],
-                                               defines={"RESET_RAYS": 1} if reset else None)
+        self.pipeline = setup.compute_pipeline("rt/visclear.comp", [self.sets.layout], defines=defines or None)
         w, h = setup.extent_of("visibility")
         self.groups = (-(-w // 8), -(-h // 8))
 

@@ -21,6 +21,7 @@ OPTIONAL_CORE = (
     "shaderStorageImageReadWithoutFormat", "drawIndirectFirstInstance", "multiDrawIndirect", "independentBlend",
     "shaderFloat64",  # float64 transform variants (the large-world study)
     "geometryShader",  # gl_PrimitiveID in fragment shaders (the hybrid's visibility buffer)
+    "shaderInt64",  # 64-bit integers (the hybrid's wavefront accumulators, passes/raytrace_wave.py)
 )
 
 
@@ -198,6 +199,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         for fam in distinct
     ]
     enabled_core = {n for n in OPTIONAL_CORE if getattr(core, n)}
+    int64_atomics = bool(f12.shaderBufferInt64Atomics) and "shaderInt64" in enabled_core
     core_features = v.VkPhysicalDeviceFeatures(**{n: v.VK_TRUE for n in enabled_core})
     e13 = v.VkPhysicalDeviceVulkan13Features(synchronization2=v.VK_TRUE, maintenance4=v.VK_TRUE)
     multiview = bool(f11.multiview)  # Vulkan 1.1 (VK_KHR_multiview, core)
@@ -207,6 +209,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         hostQueryReset=v.VK_TRUE,  # timestamp queries are reset from the host (transfer queues cannot)
         shaderOutputLayer=v.VK_TRUE if f12.shaderOutputLayer else v.VK_FALSE,  # gl_Layer in vertex shaders
         bufferDeviceAddress=v.VK_TRUE if ray_tracing else v.VK_FALSE,
+        shaderBufferInt64Atomics=v.VK_TRUE if int64_atomics else v.VK_FALSE,
     )
     extensions: list[str] = []
     head: Any = e12
@@ -230,6 +233,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         enabled_features=enabled_core | set(REQUIRED_12) | set(REQUIRED_13)
         | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set())
         | ({"drawIndirectCount"} if f12.drawIndirectCount else set()) | ({"multiview"} if multiview else set())
+        | ({"shaderBufferInt64Atomics"} if int64_atomics else set())
         | ({"bufferDeviceAddress", "accelerationStructure", "rayTracingPipeline"} if ray_tracing else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},

@@ -60,23 +60,27 @@ void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m) {
     }
 }
 
+// One node of the ray tree: ray r's closest hit; adds its own radiance (the sky where it misses,
+// else the weighted opaque part) to `color` and pushes its children on the stack. The hybrid's
+// wavefront passes (hybrid_wave.rgen) run it once per listed ray.
+void visit(Ray r, inout vec3 color) {
+    Hit h = trace_closest(r.o, r.d);
+    if (h.t < 0.0) { color += r.w * sample_sky(r.d); return; }
+    vec3 p = r.o + h.t * r.d;
+    vec3 ng, ns; uint m;
+    surface(h, r.d, ng, ns, m);
+    bool entering = dot(r.d, ng) < 0.0;
+    vec3 ngf = entering ? ng : -ng, nsf = entering ? ns : -ns;
+    vec4 k = mat[2u * m + 1u];
+    float opaque = 1.0 - k.x - k.y;
+    if (opaque > 0.0) color += r.w * opaque * shade_local(p, ngf, nsf, r.d, m);
+    push_children(r, p, ngf, nsf, entering, m);
+}
+
 // Radiance of every ray on the stack and of their descendants.
 vec3 walk() {
     vec3 color = vec3(0.0);
-    while (top > 0u) {
-        Ray r = stack[--top];
-        Hit h = trace_closest(r.o, r.d);
-        if (h.t < 0.0) { color += r.w * sample_sky(r.d); continue; }
-        vec3 p = r.o + h.t * r.d;
-        vec3 ng, ns; uint m;
-        surface(h, r.d, ng, ns, m);
-        bool entering = dot(r.d, ng) < 0.0;
-        vec3 ngf = entering ? ng : -ng, nsf = entering ? ns : -ns;
-        vec4 k = mat[2u * m + 1u];
-        float opaque = 1.0 - k.x - k.y;
-        if (opaque > 0.0) color += r.w * opaque * shade_local(p, ngf, nsf, r.d, m);
-        push_children(r, p, ngf, nsf, entering, m);
-    }
+    while (top > 0u) visit(stack[--top], color);
     return color;
 }
 

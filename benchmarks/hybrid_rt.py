@@ -12,15 +12,19 @@ rotating), so a clock change hits every plan alike; medians over the chunks' med
 Per scene and camera: stand-alone frame T (graphs/rt_standalone.yaml, the GPU span of the frame);
 the hybrid frame t (graphs/rt_hybrid.yaml: compute visibility buffer; its GPU span), split at
 the end of the visibility buffer: t_b = frame start -> visibility buffer end (the sky pass, tiny
-and independent of it, included), t_a = the rest (ray reset/classification, shading with shadow
-rays, indirect secondary rays); the ``raster`` columns are the same for
-graphs/rt_hybrid_raster.yaml (hardware-raster visibility buffer; ``--no-raster`` skips it); t_a / T,
+and independent of it, included), t_a = the rest (``shade``: every pixel's first surface with
+shadow rays, tree level 0; ``wave_1`` .. ``wave_3``: one indirect trace per tree level over its
+compacted ray list; ``resolve``); the ``raster`` columns are the same for
+graphs/rt_hybrid_raster.yaml (hardware-raster visibility buffer, the older classify + per-pixel
+walk design; ``--no-raster`` skips it); t_a / T,
 t / T; all medians of GPU timestamps over ``--frames`` frames. (Each pass's own timestamp pair
 starts at TOP_OF_PIPE before its barriers, so it overlaps the previous pass still draining:
 summing per-pass times double-counts; the per-pass medians are kept in the JSON as ``passes``.)
 Image agreement hybrid vs stand-alone:
 PSNR and SSIM of the tone-clamped [0, 1] images, FLIP (LDR) when flip-evaluator is installed;
-the share of pixels that traced secondary rays (the compacted list's length / pixels).
+the share of pixels that traced secondary rays (the pixel list's length / pixels) and the rays of
+each wavefront level (``level_rays``; ``level_overflow``: a list was full and its rays walked
+in-thread, correct but slower).
 Output: a Markdown table on stdout and JSON lines (``--json``).
 """
 
@@ -42,6 +46,7 @@ GBUFFER_PASSES = ("gbuffer", "vis_clear", "vis_depth", "vis_depth_tiles", "vis_i
 RASTER_GRAPH = "rt_hybrid_raster"
 WARMUP_S = 0.3  # seconds of frames of every plan before timing (GPU clocks ramp up); rgraph.api.WARMUP_S
 CHUNK = 5       # frames per timed run; the plans alternate run by run
+WAVE_LEVELS = 3  # the wavefront ray lists of graphs/rt_hybrid.yaml (rays_1 .. rays_3)
 
 
 def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: int, params: dict[str, str],
@@ -127,7 +132,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
     params = {"rt.max_depth": str(depth)}
-    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs"))}
+    levels = tuple(f"rays_{k}_args" for k in range(1, WAVE_LEVELS + 1))
+    graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs", *levels))}
     if raster:
         graphs["raster"] = (RASTER_GRAPH, ("visibility",))
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=params,
@@ -137,11 +143,13 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     alone, hybrid = runs["alone"], runs["hybrid"]
     T = alone["timings"]["total_ms"]
     out = hybrid["outputs"]
-    traced = int(np.frombuffer(out["ray_args"].tobytes()[:4], dtype=np.uint32)[0]) if "ray_args" in out else 0
+    traced = int(np.frombuffer(out["ray_args"].tobytes()[:16], dtype=np.uint32)[3]) if "ray_args" in out else 0
     row = {"scene": scene, "camera": camera, "size": list(size), "frames": frames, "max_depth": depth,
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
+    lists = [np.frombuffer(out[name].tobytes()[:16], dtype=np.uint32) for name in levels if name in out]
+    row.update(level_rays=[traced] + [int(a[0]) for a in lists], level_overflow=any(bool(a[3]) for a in lists))
     if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
         header = np.frombuffer(out["vis_jobs"].tobytes()[:8], dtype=np.uint32)
         row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
@@ -195,21 +203,37 @@ def _fmt(x: Any, spec: str) -> str:
     return "-" if x is None else format(x, spec)
 
 
+def _levels(row: dict[str, Any]) -> str:
+    rays = row.get("level_rays")
+    return "-" if not rays else " / ".join(str(n) for n in rays) + (" (overflow)" if row.get("level_overflow") else "")
+
+
 def table(rows: list[dict[str, Any]]) -> str:
     raster = any("raster_t_ms" in r for r in rows)
     head = ("| scene | camera | T (ms) | t_a (ms) | t_a/T | t_b (ms) | t (ms) | t/T | PSNR (dB) | SSIM | FLIP "
-            "| traced | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
-            + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else ""))
+            "| traced | rays per level | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
+            + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else ""))
     lines = [head]
     for r in rows:
         line = (f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
                 f"| {r['t_b_ms']:.3f} | {r['t_ms']:.3f} | {r['t_over_T']:.2f} | {_fmt(r['psnr_db'], '.1f')} "
                 f"| {_fmt(r['ssim'], '.4f')} | {_fmt(r['flip'], '.4f')} | {r['traced_share']:.1%} "
-                f"| {r['boundary_share']:.1%} |")
+                f"| {_levels(r)} | {r['boundary_share']:.1%} |")
         if raster:
             line += (f" {r['raster_t_b_ms']:.3f} | {r['raster_t_ms']:.3f} | {r['raster_t_over_T']:.2f} "
                      f"| {_fmt(r['raster_psnr_db'], '.1f')} |") if "raster_t_ms" in r else " - | - | - | - |"
         lines.append(line)
+    return "\n".join(lines)
+
+
+def pass_table(rows: list[dict[str, Any]]) -> str:
+    """The hybrid's per-pass medians (ms; each pass's timestamp pair, so overlapping passes
+    overlap here too)."""
+    names = [n for n in rows[0].get("passes", {}) if n not in ("build_as",)] if rows else []
+    lines = ["| scene | camera | " + " | ".join(names) + " |", "|---|---:|" + "---:|" * len(names)]
+    for r in rows:
+        lines.append(f"| {r['scene']} | {r['camera']} | "
+                     + " | ".join(_fmt(r["passes"].get(n), ".3f") for n in names) + " |")
     return "\n".join(lines)
 
 
@@ -256,6 +280,8 @@ def main(argv: list[str] | None = None) -> int:
                   f"{_fmt(r['psnr_db'], '.1f')} | {_fmt(r['ssim'], '.4f')} |")
     else:
         print(table(rows))
+        print("\nHybrid passes (median ms):\n")
+        print(pass_table(rows))
     return 0
 
 

@@ -82,12 +82,16 @@ def shade_local(t: Tables, p: np.ndarray, ng: np.ndarray, ns: np.ndarray, d: np.
     return color
 
 
-def trace_pixel(t: Tables, cube: np.ndarray, d0: np.ndarray, max_depth: int) -> np.ndarray:
-    """The radiance of one camera ray: the ray tree walked depth first with an explicit stack."""
+def trace_pixel(t: Tables, cube: np.ndarray, d0: np.ndarray, max_depth: int, stats: dict | None = None) -> np.ndarray:
+    """The radiance of one camera ray: the ray tree walked depth first with an explicit stack.
+    ``stats`` (optional) counts the tree's nodes per depth (``levels``) and total internal
+    reflections (``tir``)."""
     color = np.zeros(3)
     stack = [(np.zeros(3), d0, np.ones(3), 0)]
     while stack:
         o, d, weight, depth = stack.pop()
+        if stats is not None:
+            stats["levels"][depth] = stats["levels"].get(depth, 0) + 1
         hit = intersect(t, o, d)
         if hit is None:
             color = color + weight * sample_sky(cube, d)
@@ -114,6 +118,8 @@ def trace_pixel(t: Tables, cube: np.ndarray, d0: np.ndarray, max_depth: int) -> 
             refr = _refract(d, ns_f, eta)
             if refr is None:
                 reflect_w = reflect_w + weight * mat.kt
+                if stats is not None:
+                    stats["tir"] = stats.get("tir", 0) + 1
             else:
                 stack.append((offset_ray(p, -ng_f), _normalize(refr, d), weight * mat.kt * mat.albedo, depth + 1))
         if float(reflect_w.max()) > 0.0:
@@ -123,11 +129,11 @@ def trace_pixel(t: Tables, cube: np.ndarray, d0: np.ndarray, max_depth: int) -> 
     return color
 
 
-def render(t: Tables, cube: np.ndarray, size: tuple[int, int], max_depth: int) -> np.ndarray:
-    """(h, w, 3) float64 radiance."""
+def render(t: Tables, cube: np.ndarray, size: tuple[int, int], max_depth: int, stats: dict | None = None) -> np.ndarray:
+    """(h, w, 3) float64 radiance (``stats``: as ``trace_pixel``, summed over the pixels)."""
     w, h = size
     out = np.zeros((h, w, 3))
     for y in range(h):
         for x in range(w):
-            out[y, x] = trace_pixel(t, cube, primary_dir(t, x, y, w, h), max_depth)
+            out[y, x] = trace_pixel(t, cube, primary_dir(t, x, y, w, h), max_depth, stats)
     return out

@@ -57,7 +57,9 @@ def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels(gr
     instance, _prim = decode_visibility(ids, prim_bits(data))
     assert (instance < len(mask)).all()
     expected = int(mask[instance[instance >= 0]].sum())
-    traced = int(np.frombuffer(hybrid["ray_args"].tobytes()[:4], dtype=np.uint32)[0])
+    args = np.frombuffer(hybrid["ray_args"].tobytes()[:16], dtype=np.uint32)
+    # the wavefront's pixel list: (resolve groups, 1, 1, count); the raster variant's: (count, 1, 1)
+    traced = int(args[3] if graph == "rt_hybrid" else args[0])
     assert 0 < traced == expected < ids.size
 
 
@@ -67,10 +69,12 @@ def test_no_reflective_or_refractive_materials_culls_the_secondary_rays(tmp_path
                      .replace("refractive: 0.9, ", ""))
     plan = compile_graph("rt_hybrid", scene_path=scene, size=(16, 16))
     culled = {c["pass"]: c["reason"] for c in plan["culled"]}
-    assert set(culled) == {"classify", "secondary"}
+    assert set(culled) == {"wave_1", "wave_2", "wave_3", "resolve"}
     assert all(reason == "scene has none of reflective_materials, refractive_materials" for reason in culled.values())
     assert {p["name"] for p in plan["passes"]} == {"build_as", "sky", "vis_clear", "vis_depth", "vis_depth_tiles",
                                                    "vis_id", "vis_id_tiles", "shade"}
+    sizes = {r["name"]: r["bytes"] for r in plan["resources"]}
+    assert sizes["wave_color"] == 24 and sizes["rays_1"] == 48  # the wavefront's buffers shrink to one entry
     full = compile_graph("rt_hybrid", scene_path=SCENE, size=(16, 16))
     assert not full["culled"]
     raster = compile_graph("rt_hybrid_raster", scene_path=scene, size=(16, 16))

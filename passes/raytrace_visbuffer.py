@@ -62,6 +62,20 @@ def groups_for(items: int, per_group: int = GROUP) -> tuple[int, int]:
     return x, -(-groups // x)
 
 
+def atomic64(setup: Any) -> bool:
+    """Whether the visibility buffer takes the one-pass 64-bit path: the device has 64-bit buffer
+    atomics, ``rt.vis_atomic64`` is not 0 and the graph's ``vis_keys`` holds a uint64 per pixel
+    (else the two-pass 32-bit path). Every pass of the visibility buffer decides alike."""
+    if int(setup.param("rt.vis_atomic64", 1)) == 0 or "shaderBufferInt64Atomics" not in setup.device.enabled_features:
+        return False
+    try:
+        keys = int(setup.resource_plan("vis_keys")["bytes"])
+    except KeyError:
+        return False
+    w, h = setup.extent_of("visibility")
+    return keys >= 8 * w * h
+
+
 class VisPass(PassImpl):
     """Common setup: geometry tables (device-local), the per-instance triangle starts, the
     visibility-buffer images and the job list, the push constants."""
@@ -90,6 +104,9 @@ class VisPass(PassImpl):
         bindings.append(Binding(8, "storage_buffer", "vis_jobs"))
         if self.uses_records:
             bindings.append(Binding(10, "storage_buffer", "vis_tris"))
+        wide = atomic64(setup) and not self.mode_id
+        if wide:
+            bindings.append(Binding(15, "storage_buffer", "vis_keys"))
         self.sets = setup.descriptors(bindings)
         records = int(setup.resource_plan("vis_tris")["bytes"]) // RECORD_BYTES if self.uses_records else 1
         capacity = min(MAX_JOBS, (int(setup.resource_plan("vis_jobs")["bytes"]) - JOB_HEADER) // 8)
@@ -102,6 +119,8 @@ class VisPass(PassImpl):
                                       "JOBS_PER_GROUP": f"{JOBS_PER_GROUP}u", "TRI_CAPACITY": f"{records}u"}
         if self.mode_id:
             defines["MODE_ID"] = 1
+        if wide:
+            defines["ATOMIC64"] = 1
         self.pipeline = setup.compute_pipeline(self.shader, [self.sets.layout], defines=defines, push_constant_bytes=64)
         self.push = raster_constants(self.data, setup.extent_of("visibility"))
         self.groups = groups_for(struct.unpack_from("<I", self.push, 56)[0])
@@ -130,11 +149,37 @@ class VisDepth(VisPass):
     pass
 
 
-@register("rt_vis_id")
+class VisResolve64(PassImpl):
+    """The 64-bit path's id pass: the ids unpacked from ``vis_keys`` (rt/visresolve.comp)."""
+
+    def __init__(self, setup: Any) -> None:
+        super().__init__(setup)
+        self.sets = setup.descriptors([Binding(6, "storage_image", "visibility"),
+                                       Binding(15, "storage_buffer", "vis_keys")])
+        self.pipeline = setup.compute_pipeline("rt/visresolve.comp", [self.sets.layout])
+        w, h = setup.extent_of("visibility")
+        self.groups = (-(-w // 8), -(-h // 8))
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        rec.bind(self.pipeline, [self.sets[frame_set]])
+        rec.dispatch(*self.groups)
+
+
+class Idle(PassImpl):
+    """The 64-bit path's id tile pass: nothing left to do (the depth passes wrote the ids)."""
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        return
+
+
 class VisId(VisPass):
     mode_id = True
     uses_args = False
     uses_records = False
+
+
+class VisIdTiles(VisTiles):
+    mode_id = True
 
 
 @register("rt_vis_depth_tiles")
@@ -142,9 +187,20 @@ class VisDepthTiles(VisTiles):
     pass
 
 
+@register("rt_vis_id")
+class VisIdPass(PassImpl):
+    """The id pass: unpacking on the 64-bit path, else the second rasterization."""
+
+    def __new__(cls, setup: Any) -> PassImpl:  # type: ignore[misc]
+        return VisResolve64(setup) if atomic64(setup) else VisId(setup)
+
+
 @register("rt_vis_id_tiles")
-class VisIdTiles(VisTiles):
-    mode_id = True
+class VisIdTilesPass(PassImpl):
+    """The id tile pass: nothing on the 64-bit path, else the big triangles' second rasterization."""
+
+    def __new__(cls, setup: Any) -> PassImpl:  # type: ignore[misc]
+        return Idle(setup) if atomic64(setup) else VisIdTiles(setup)
 
 
 @register("rt_vis_clear")
@@ -163,6 +219,9 @@ class VisClear(PassImpl):
             levels += 1
         if levels:
             defines["WAVE_LEVELS"] = levels
+        if atomic64(setup) and setup.has("vis_keys"):
+            bindings.append(Binding(15, "storage_buffer", "vis_keys"))
+            defines["CLEAR_KEYS"] = 1
         self.sets = setup.descriptors(bindings)
         self.pipeline = setup.compute_pipeline("rt/visclear.comp", [self.sets.layout], defines=defines or None)
         w, h = setup.extent_of("visibility")

@@ -1,8 +1,12 @@
 #version 460
+#ifdef CLEAR_KEYS
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#endif
 // Compute visibility buffer, first pass: depth keys and ids 0 (nothing), the tile jobs' indirect
 // arguments (0, 1, 1), the job list's count and overflow flag 0; with RESET_RAYS (the pass
 // writes ray_args) also the compacted ray list's arguments (0, 1, 1), saving rt_reset_rays; with
-// WAVE_LEVELS n (1..3) the wavefront lists' arguments (bindings 10.., rays_1_args..) (0, 1, 1, 0).
+// WAVE_LEVELS n (1..3) the wavefront lists' arguments (bindings 10.., rays_1_args..) (0, 1, 1, 0);
+// with CLEAR_KEYS the 64-bit path's packed keys (binding 15) 0.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 5, r32ui) uniform writeonly uimage2D depth_keys;
 layout(set = 0, binding = 6, r32ui) uniform writeonly uimage2D visibility;
@@ -10,6 +14,9 @@ layout(set = 0, binding = 7, std430) writeonly buffer Args { uint args[4]; };
 layout(set = 0, binding = 8, std430) writeonly buffer Jobs { uint header[4]; };
 #ifdef RESET_RAYS
 layout(set = 0, binding = 9, std430) writeonly buffer RayArgs { uint ray_args[4]; };
+#endif
+#ifdef CLEAR_KEYS
+layout(set = 0, binding = 15, std430) writeonly buffer VisKeys { uint64_t vis_keys[]; };
 #endif
 #if WAVE_LEVELS >= 1
 layout(set = 0, binding = 10, std430) writeonly buffer Wave1 { uint wave1[4]; };
@@ -42,4 +49,7 @@ void main() {
     if (any(greaterThanEqual(px, imageSize(depth_keys)))) return;
     imageStore(depth_keys, px, uvec4(0u));
     imageStore(visibility, px, uvec4(0u));
+#ifdef CLEAR_KEYS
+    vis_keys[px.y * imageSize(depth_keys).x + px.x] = 0ul;
+#endif
 }

@@ -12,6 +12,9 @@
 // pass (atomicMax of the id where the key equals the stored one); big triangles are left to the
 // tile jobs unless the depth pass overflowed: then every big triangle is also done here (the
 // jobs that did run write the same ids again: atomicMax is idempotent).
+// ATOMIC64 (the depth pass only): one 64-bit atomicMax of (key << 32 | id) per covered pixel into
+// vis_keys (rt/visraster.glsl: visit64), so depth and id come from one pass; rt/visresolve.comp
+// then unpacks the ids.
 #include "rt/visraster.glsl"
 layout(local_size_x = 64) in;
 #ifdef MODE_ID
@@ -30,6 +33,8 @@ void visit(Tri tri, ivec2 px) {
     if (!cover(tri, px, key)) return;
 #ifdef MODE_ID
     if (key_matches(key, imageLoad(depth_keys, px).r)) imageAtomicMax(visibility, px, tri.id);
+#elif defined(ATOMIC64)
+    visit64(px, key, tri.id);
 #else
     if (imageLoad(depth_keys, px).r < key) imageAtomicMax(depth_keys, px, key);
 #endif

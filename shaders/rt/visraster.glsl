@@ -25,6 +25,10 @@
 // the larger id, deterministic). Both evaluate the key with the same `precise` code.
 // The screen bounding box only bounds the pixels tested (screen_box: the triangle clipped to the
 // view frustum, near plane z >= forward.w, tiny: the coverage test decides).
+#ifdef ATOMIC64
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#endif
 #include "rt/tables.glsl"
 #include "rt/gbuffer.glsl"
 
@@ -185,3 +189,16 @@ Tri unpack_tri(TriRecord r) {
 }
 
 uint pixels_of(Tri tri) { return uint(tri.box.z - tri.box.x + 1) * uint(tri.box.w - tri.box.y + 1); }
+
+#ifdef ATOMIC64
+// One 64-bit atomicMax per covered pixel: the nearest key wins, equal keys the larger id (the
+// two-pass path's rule, without its cross-pass key tolerance: key and id come from one
+// evaluation). The plain load skips most atomics: the stored value only grows, so a stale read
+// can only under-estimate it.
+layout(set = 0, binding = 15, std430) buffer VisKeys { uint64_t vis_keys[]; };
+void visit64(ivec2 px, uint key, uint id) {
+    uint i = uint(px.y) * frame.info.x + uint(px.x);
+    uint64_t v = (uint64_t(key) << 32) | uint64_t(id);
+    if (vis_keys[i] < v) atomicMax(vis_keys[i], v);
+}
+#endif

@@ -5,7 +5,7 @@
 // that pass set); per job the group reads the triangle's setup record that pass stored, drops the
 // job when the tile lies outside one of the triangle's edges (corner test), then each
 // thread does (TILE / 16)^2 pixels of the TILE x TILE tile (tiles counted from the triangle's box
-// corner). MODE_ID as there; both passes read the same record, so the same keys.
+// corner). MODE_ID and ATOMIC64 as there; both passes read the same record, so the same keys.
 #include "rt/visraster.glsl"
 layout(local_size_x = 16, local_size_y = 16) in;
 #ifdef MODE_ID
@@ -32,6 +32,8 @@ void main() {
             if (!cover(tri, px, key)) continue;
 #ifdef MODE_ID
             if (key_matches(key, imageLoad(depth_keys, px).r)) imageAtomicMax(visibility, px, tri.id);
+#elif defined(ATOMIC64)
+            visit64(px, key, tri.id);
 #else
             if (imageLoad(depth_keys, px).r < key) imageAtomicMax(depth_keys, px, key);
 #endif

@@ -88,13 +88,17 @@ class WaveShade(WaveImpl):
 
     def __init__(self, setup: Any) -> None:
         bindings = [Binding(7, "storage_image", "color"), *GBUFFER]
-        defines: dict[str, object] = {}
+        defines: dict[str, object] = {"SHADE_WALKS": 1}
         if wavefront(setup) and setup.has("wave_color"):
             extent = setup.extent_of("visibility")
             more, defines = wave_bindings(setup, 1)
             pixels = min(extent[0] * extent[1], capacity(setup, "wave_color", ACCUM))
             bindings += [Binding(9, "storage_image", "ray_list"), Binding(10, "storage_buffer", "ray_args"), *more]
             defines.update(WAVEFRONT=1, PIXEL_CAPACITY=f"{pixels}u")
+            fits = pixels == extent[0] * extent[1] and "NEXT_LIST" in defines \
+                and capacity(setup, list_name(1), RAY_RECORD) >= 2 * pixels
+            if not fits:  # a pixel or a child may not find room: the in-thread walk is needed
+                defines["SHADE_WALKS"] = 1
         super().__init__(setup, bindings, defines, True)
         self.extent = setup.extent_of("color")
 

@@ -85,9 +85,10 @@ def test_every_tree_node_is_traced_once_and_the_image_matches(alone):
 
 @pytest.mark.vulkan
 def test_full_lists_and_accumulators_fall_back_to_in_thread_walks(alone):
-    out = _run("rt_hybrid", **{"rt.wave_rays": "16", "rt.wave_pixels": "40"})
-    assert _args(out, "ray_args")[3] > 40  # more pixels with children than accumulators
-    assert _args(out, "rays_1_args")[3] == 1 and 0 < _args(out, "rays_1_args")[0] <= 16  # list 1 full
+    out = _run("rt_hybrid", **{"rt.wave_rays": "8", "rt.wave_pixels": "150"})
+    assert _args(out, "ray_args")[3] > 150  # more pixels with children than accumulators
+    assert _args(out, "rays_1_args")[3] == 0 and _args(out, "rays_1_args")[0] <= 300  # list 1: 2 rays per slot
+    assert _args(out, "rays_2_args")[3] == 1 and 0 < _args(out, "rays_2_args")[0] <= 8  # list 2 full
     assert np.abs(_rgb(out) - alone).max() < 2e-3 and psnr(alone, _rgb(out)) > 70
 
 

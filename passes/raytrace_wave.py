@@ -97,7 +97,9 @@ class WaveShade(WaveImpl):
             defines.update(WAVEFRONT=1, PIXEL_CAPACITY=f"{pixels}u")
             fits = pixels == extent[0] * extent[1] and "NEXT_LIST" in defines \
                 and capacity(setup, list_name(1), RAY_RECORD) >= 2 * pixels
-            if not fits:  # a pixel or a child may not find room: the in-thread walk is needed
+            if fits:  # every pixel has a slot and list 1 room for its children: no in-thread walk
+                defines["LIST_FITS"] = 1
+            else:
                 defines["SHADE_WALKS"] = 1
         super().__init__(setup, bindings, defines, True)
         self.extent = setup.extent_of("color")

@@ -33,13 +33,18 @@ layout(set = 0, binding = 14, std430) buffer NextArgs { uint next_count; uint ne
 // The children on the stack (push_children) go to the next list when they fit (one reservation
 // for all of them; a reservation past RAY_CAPACITY is undone, so the list stays contiguous and
 // its count within the capacity); whatever stays on the stack is walked here. Returns the
-// radiance walked in-thread.
+// radiance walked in-thread. LIST_FITS: the list has room for every parent's children (two per
+// parent slot), so there is no fallback walk to compile.
 vec3 spill_and_walk(uint owner) {
 #ifdef NEXT_LIST
     if (top > 0u) {
         uint n = top;
         uint first = atomicAdd(next_count, n);
+#ifdef LIST_FITS
+        if (true) {
+#else
         if (first + n <= RAY_CAPACITY) {
+#endif
             for (uint i = 0u; i < n; ++i) {
                 Ray r = stack[i];
                 next_rays[first + i] = RayRecord(vec4(r.o, uintBitsToFloat(owner)), vec4(r.d, r.w.x), vec4(r.w.yz, 0.0, 0.0));
@@ -51,5 +56,9 @@ vec3 spill_and_walk(uint owner) {
         }
     }
 #endif
+#ifdef LIST_FITS
+    return vec3(0.0);
+#else
     return walk();
+#endif
 }

@@ -17,6 +17,9 @@
 // then unpacks the ids.
 #include "rt/visraster.glsl"
 layout(local_size_x = 64) in;
+#ifndef CULL_TILES
+#define CULL_TILES 64u
+#endif
 #ifdef MODE_ID
 layout(set = 0, binding = 5, r32ui) uniform readonly uimage2D depth_keys;
 layout(set = 0, binding = 6, r32ui) uniform uimage2D visibility;
@@ -51,6 +54,16 @@ void main() {
 #else
         ivec2 tiles = (tri.box.zw - tri.box.xy + TILE) / TILE;
         uint n = uint(tiles.x * tiles.y);
+        // Boxes of at most CULL_TILES tiles (slivers: long thin triangles cross few of their
+        // box's tiles) get jobs only for the tiles the triangle may cover: the tile pass's own
+        // corner test, done here once instead of a job per tile.
+        bool cull = n <= CULL_TILES;
+        if (cull) {
+            n = 0u;
+            for (int ty = 0; ty < tiles.y; ++ty)
+                for (int tx = 0; tx < tiles.x; ++tx) n += tile_may_cover(tri, ivec2(tx, ty)) ? 1u : 0u;
+            if (n == 0u) return;  // no pixel centre covered
+        }
         uint rec = atomicAdd(tri_count, 1u);  // a record slot past the capacity is never written
         if (rec < TRI_CAPACITY) {
             uint first = atomicAdd(job_count, n);
@@ -58,7 +71,8 @@ void main() {
                 records[rec] = pack_tri(tri);
                 uint k = first;
                 for (int ty = 0; ty < tiles.y; ++ty)
-                    for (int tx = 0; tx < tiles.x; ++tx) jobs[k++] = uvec2(rec, (uint(ty) << 16) | uint(tx));
+                    for (int tx = 0; tx < tiles.x; ++tx)
+                        if (!cull || tile_may_cover(tri, ivec2(tx, ty))) jobs[k++] = uvec2(rec, (uint(ty) << 16) | uint(tx));
                 atomicMax(args.groups, (first + n + JOBS_PER_GROUP - 1u) / JOBS_PER_GROUP);
                 return;
             }

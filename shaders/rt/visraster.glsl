@@ -170,6 +170,13 @@ bool rect_may_cover(Tri tri, ivec2 lo, ivec2 hi) {
     return all(greaterThanEqual(m, -2.0 * tri.eps - 1e-6 * abs(m)));
 }
 
+// Whether tile t (TILE x TILE pixels counted from the triangle's box corner, clipped to the box)
+// may hold a covered pixel centre (the tile jobs' test, rt/vistiles.comp).
+bool tile_may_cover(Tri tri, ivec2 t) {
+    ivec2 tile = tri.box.xy + t * TILE;
+    return rect_may_cover(tri, tile, min(tile + (TILE - 1), tri.box.zw));
+}
+
 // The id pass's test against the stored (largest) key: equal within KEY_ULPS float ulps, so the
 // nearest triangle keeps its pixel even if two compilations (depth / id pass, thread / tile path)
 // round its key differently; a triangle that close in depth (a neighbour across a shared edge,

@@ -23,7 +23,7 @@ void main() {
         uvec2 job = jobs[j];
         Tri tri = unpack_tri(records[job.x]);  // the depth pass's setup (one broadcast load)
         ivec2 tile = tri.box.xy + ivec2(job.y & 0xFFFFu, job.y >> 16) * TILE;
-        if (!rect_may_cover(tri, tile, min(tile + (TILE - 1), tri.box.zw))) continue;  // outside an edge
+        if (!tile_may_cover(tri, ivec2(job.y & 0xFFFFu, job.y >> 16))) continue;  // outside an edge
         ivec2 origin = tile + ivec2(gl_LocalInvocationID.xy);
         for (int k = 0; k < (TILE / 16) * (TILE / 16); ++k) {
             ivec2 px = origin + 16 * ivec2(k % (TILE / 16), k / (TILE / 16));

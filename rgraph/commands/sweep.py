@@ -50,11 +50,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.sweep import flip
     from rgraph.sweep.parallel import make_executor
     from rgraph.sweep.runner import SweepRequest, run_sweep
     from rgraph.sweep.settings import parse_assignments, parse_knob
-    from rgraph.sweep.writers import plot_metric, write_all
+    from rgraph.sweep.writers import write_sweep
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
 
     if args.frames < 1:
@@ -79,13 +78,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if executor is not None:
             executor.close()
-    note = flip.missing_note()
-    if note and note not in result.notes:
-        result.notes.append(note)
-    chosen = plot_metric(result, args.metric)
-    if args.metric and chosen != args.metric:
-        result.notes.append(f"--metric {args.metric}: no values; plots show {chosen or 'nothing'}")
-    written = write_all(result, args.out, chosen)
+    written, _ = write_sweep(result, args.out, args.metric)
     for line in result.notes:
         print(f"rgraph: note: {line}", file=sys.stderr)
     messages = result.messages()

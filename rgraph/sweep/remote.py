@@ -64,19 +64,30 @@ def _graph_impls(request: Any) -> set[str]:
     return {p.model.impl for p in source.passes.values() if getattr(p.model, "impl", None)}
 
 
-def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
-         env: Mapping[str, str] | None = None) -> Iterator[tuple[Any, RenderJob]]:
-    """(params key, job) per distinct setting, in the given order (the reference first).
-    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
-    so its worker computes the metrics too."""
+def job_maker(request: Any, env: Mapping[str, str] | None = None) -> Callable[[Setting, Any], RenderJob]:
+    """``make(setting, reference_images)``: the job of one setting of ``request`` (graph and
+    scene paths made absolute, the caller's ``sys.path`` and implementation modules)."""
     env = os.environ if env is None else env
     fault = env.get(KILL_ENV) or None
     request = dataclasses.replace(request, graph=_absolute(request.graph), scene=_absolute(request.scene))
     sys_path = tuple(p for p in sys.path if p)
     modules = implementation_modules(_graph_impls(request))
+
+    def make(setting: Setting, reference: Any = None) -> RenderJob:
+        return RenderJob(request, setting, sys_path, modules, fault,
+                         None if setting.label == "reference" else reference)
+
+    return make
+
+
+def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
+         env: Mapping[str, str] | None = None) -> Iterator[tuple[Any, RenderJob]]:
+    """(params key, job) per distinct setting, in the given order (the reference first).
+    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
+    so its worker computes the metrics too."""
+    make = job_maker(request, env)
     for key, setting in settings.items():
-        images = reference() if reference is not None and setting.label != "reference" else None
-        yield key, RenderJob(request, setting, sys_path, modules, fault, images)
+        yield key, make(setting, reference() if reference is not None and setting.label != "reference" else None)
 
 
 def _absolute(path: str | None) -> str | None:

@@ -127,14 +127,18 @@ def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: boo
     return labels
 
 
-def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
-              executor: Executor | None = None) -> SweepResult:
-    """Render every setting of ``request``; write images and error maps under ``out_dir``.
+@dataclass
+class Prepared:
+    """A sweep ready to render: its distinct settings (params key -> first setting with
+    those params, the reference first) and the collector that takes their renderings."""
 
-    ``executor`` (``rgraph.sweep.parallel``): every distinct setting in its own worker
-    process, compiled and rendered there; a setting that fails twice is reported in
-    ``SweepResult.failures`` and its row left empty. Without one, every setting renders here,
-    one after the other, and the first failure raises."""
+    request: SweepRequest
+    distinct: dict[tuple, Setting]
+    collector: Any  # rgraph.sweep.collect.Collector
+
+
+def prepare(request: SweepRequest, out_dir: Path) -> Prepared:
+    """Expand ``request``'s settings (bad knobs fail here, before anything renders)."""
     from rgraph.sweep.collect import Collector
 
     source = load_graph(resolve_graph(request.graph))
@@ -143,8 +147,21 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
     distinct: dict[tuple, Setting] = {}
     for s in settings:
         distinct.setdefault(params_key(resolved_params[s.label]), s)
-    collector = Collector(request, settings, resolved_params, out_dir)
-    with _progress_bar(progress, len(distinct)) as bar:
+    return Prepared(request, distinct, Collector(request, settings, resolved_params, out_dir))
+
+
+def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
+              executor: Executor | None = None) -> SweepResult:
+    """Render every setting of ``request``; write images and error maps under ``out_dir``.
+
+    ``executor`` (``rgraph.sweep.parallel``): every distinct setting in its own worker
+    process, compiled and rendered there; a setting that fails twice is reported in
+    ``SweepResult.failures`` and its row left empty. Without one, every setting renders here,
+    one after the other, and the first failure raises. Several sweeps through one pool of
+    workers: :func:`rgraph.sweep.pool.run_groups`."""
+    sweep = prepare(request, out_dir)
+    distinct, collector = sweep.distinct, sweep.collector
+    with progress_bar(progress, len(distinct)) as bar:
         if executor is None:
             from rgraph.api import open_device
 
@@ -197,7 +214,7 @@ def _render(request: SweepRequest, plan: dict, gpu: Any) -> _Rendering:
                       None if ldr is None else image_io.png_bytes(ldr))
 
 
-class _progress_bar:
+class progress_bar:
     """A rich progress bar on stderr (or nothing): ``step`` names the next rendering here,
     ``finished`` counts one that a worker finished."""
 
@@ -206,7 +223,7 @@ class _progress_bar:
         self.bar: Any = None
         self.task: Any = None
 
-    def __enter__(self) -> _progress_bar:
+    def __enter__(self) -> progress_bar:
         if self.enabled:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn

@@ -178,6 +178,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--validate", action="store_true", help="validation layers on (times not representative)")
     parser.add_argument("--workers", type=int, metavar="N",
                         help="every setting of every group in its own worker process, through one pool of N")
+    parser.add_argument("--per-worker", type=int, default=1, metavar="K",
+                        help="with --workers: settings a worker process renders, one after another on one "
+                             "device, before a fresh process takes its place (default 1)")
     parser.add_argument("--no-progress", dest="progress", action="store_false")
     parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     args = parser.parse_args(argv)
@@ -190,6 +193,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"unknown group(s) {', '.join(unknown)}; known: {', '.join(known)}")
     if args.workers is not None and args.workers < 1:
         parser.error("--workers must be at least 1")
+    if args.per_worker < 1:
+        parser.error("--per-worker must be at least 1")
 
     from rgraph.errors import RGraphError
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
@@ -264,7 +269,7 @@ def run_pool(chosen: list[Group], args, size, progress: bool, done: dict, report
         done[group.name] = (result, *write_group(result, group.out_dir))
         report(group.name, result, time.perf_counter() - start, " (done since the start)")
 
-    with make_executor(args.workers) as executor:
+    with make_executor(args.workers, tasks_per_worker=args.per_worker) as executor:
         run_groups(pool, executor, done=finished, progress=progress)
         return f"one pool of {executor.description} for all groups"
 

@@ -36,12 +36,12 @@ class Group:
 Done = Callable[[Group, "SweepResult | Exception"], None]
 
 
-def _items(groups: list[Group], sweeps: dict[str, Prepared]) -> Iterator[tuple[tuple[str, tuple], Any]]:
+def _items(groups: list[Group], sweeps: dict[str, Prepared], timing_lock: str | None) -> Iterator[tuple[tuple[str, tuple], Any]]:
     """(group name, params key) and job of every distinct setting: all references first, then
     the groups in turn (those whose reference rendered first). Read lazily by the executor."""
     from rgraph.sweep.remote import job_maker
 
-    makers = {g.name: job_maker(g.request) for g in groups}
+    makers = {g.name: job_maker(g.request, timing_lock=timing_lock) for g in groups}
     left: dict[str, deque[tuple]] = {}
     for g in groups:
         sweep = sweeps[g.name]
@@ -78,7 +78,7 @@ def run_groups(groups: list[Group], executor: Executor, *, done: Done | None = N
     from rgraph.sweep.remote import render_job
 
     with progress_bar(progress, sum(left.values())) as bar:
-        for outcome in executor.run(render_job, _items(groups, sweeps)):
+        for outcome in executor.run(render_job, _items(groups, sweeps, executor.timing_lock)):
             name, key = outcome.key
             sweep = sweeps[name]
             sweep.collector.add(key, outcome.value, outcome.error)

@@ -8,6 +8,7 @@ as it comes, in any order, and orders the rows as the settings.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -173,7 +174,8 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
         else:
             from rgraph.sweep.remote import jobs, render_job
 
-            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images)):
+            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images,
+                                                         timing_lock=executor.timing_lock)):
                 collector.add(outcome.key, outcome.value, outcome.error)
                 bar.finished(distinct[outcome.key].label + ("" if outcome.ok else " (failed)"))
     return collector.result()
@@ -194,8 +196,13 @@ def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> di
     return plans
 
 
-def _render(request: SweepRequest, plan: dict, gpu: Any) -> _Rendering:
-    result = gpu.load(plan).run_and_check(request.frames, check_data=False, read_outputs=True,
+def _render(request: SweepRequest, plan: dict, gpu: Any, timing: Any = None) -> _Rendering:
+    """Load ``plan`` on ``gpu``, warm up, time ``request.frames`` frames and read back; ``timing``:
+    a context manager held around the warm-up, the timed frames and the read-back (the lock
+    that keeps other local workers' frames off the GPU meanwhile: :mod:`rgraph.sweep.remote`)."""
+    executable = gpu.load(plan)
+    with timing or contextlib.nullcontext():
+        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True,
                                           warmup_s=request.warmup_s)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)

@@ -3,14 +3,14 @@ group: throughput, identical outputs, GPU memory per worker, and what sharing on
 to the measured times.
 
     python3 benchmarks/sweep_throughput.py [--size 1280x720] [--frames 10]
-        [--groups hbao,sss,rt,clusters] [--workers 4,8] [--per-worker 8,1] -o DIR [--json FILE]
+        [--groups hbao,sss,rt,clusters] [--pools 4x8,8x8,8x1] -o DIR [--json FILE]
 
 Baseline: every group in its own process, one after the other (``benchmarks/sweeps.py
 --groups G``, the one-process ``rgraph sweep`` of each group; the NVIDIA driver refuses
 instances after ~40 in one process, so one process for all groups is not possible there).
-Then, for each K of ``--per-worker`` and each N of ``--workers``, the same groups in ONE
-command through one pool of N worker processes, each rendering K settings before a fresh one
-takes its place (``benchmarks/sweeps.py --groups ... --workers N --per-worker K``). Per run: wall seconds,
+Then, for each ``NxK`` of ``--pools``, the same groups in ONE command through one pool of N
+worker processes, each rendering K settings before a fresh one takes its place
+(``benchmarks/sweeps.py --groups ... --workers N --per-worker K``). Per run: wall seconds,
 renderings per second and the ratio to the baseline's; the peak GPU memory in use above the
 idle level and its share per worker, and the mean GPU utilization (``nvidia-smi``, sampled
 every 0.5 s; empty without it); per group, whether every output but the times equals the
@@ -140,8 +140,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--size", default="1280x720")
     parser.add_argument("--frames", type=int, default=10)
     parser.add_argument("--groups", default="hbao,sss,rt,clusters", help="groups of benchmarks/sweeps.py")
-    parser.add_argument("--workers", default="4,8", help="comma-separated pool sizes")
-    parser.add_argument("--per-worker", default="8,1", help="comma-separated settings per worker process")
+    parser.add_argument("--pools", default="4x8,8x8,8x1",
+                        help="comma-separated NxK: N worker processes, K settings each (default 4x8,8x8,8x1)")
     parser.add_argument("-o", "--out", type=Path, required=True, help="folder of every run's sweeps and logs")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
@@ -166,8 +166,10 @@ def main(argv: list[str] | None = None) -> int:
     runs.append({"workers": 1, "how": "one process per group", "wall_s": round(wall, 2), "renderings": renderings,
                  "per_s": round(renderings / wall, 4) if wall else 0.0, **sampler.summary(idle_mib, 1)})
     save()
-    pools = [(n, k) for k in [int(x) for x in args.per_worker.split(",") if x]
-             for n in [int(x) for x in args.workers.split(",") if x]]
+    try:
+        pools = [(int(n), int(k)) for n, _, k in (x.lower().partition("x") for x in args.pools.split(",") if x)]
+    except ValueError:
+        parser.error(f"--pools: NxK expected, got {args.pools!r}")
     for n, k in pools:
         out = args.out / f"pool{n}x{k}"
         with GpuSampler() as sampler:

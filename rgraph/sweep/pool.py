@@ -1,9 +1,10 @@
 """Several sweeps ("groups") through one pool of worker processes.
 
-Every group's reference is submitted first; then the other settings of all groups, one group
-after another in turn, a group whose reference has rendered before one whose reference has
-not (its jobs carry the reference's images, so their workers compute the metrics). The pool
-thus never waits for one group's reference while another group has settings left. Every
+Every group's reference is submitted first; then, whenever a worker is free, the next
+setting of the first group (in the given order) whose reference has rendered (its jobs carry
+the reference's images, so their workers compute the metrics), else of the first group with
+settings left. The pool thus never waits for one group's reference while any group has
+settings left, and groups finish roughly in order (a run cut short keeps the first). Every
 rendering goes to its own group's collector (:mod:`rgraph.sweep.collect`), and the moment a
 group's last rendering lands its :class:`~rgraph.sweep.runner.SweepResult` is handed to
 ``done`` (which writes its outputs), so a run cut short keeps the groups that finished.
@@ -38,7 +39,8 @@ Done = Callable[[Group, "SweepResult | Exception"], None]
 
 def _items(groups: list[Group], sweeps: dict[str, Prepared], timing_lock: str | None) -> Iterator[tuple[tuple[str, tuple], Any]]:
     """(group name, params key) and job of every distinct setting: all references first, then
-    the groups in turn (those whose reference rendered first). Read lazily by the executor."""
+    the first group (in the given order) whose reference rendered and that has settings left,
+    else the first with settings left. Read lazily by the executor, one item per free worker."""
     from rgraph.sweep.remote import job_maker
 
     makers = {g.name: job_maker(g.request, timing_lock=timing_lock) for g in groups}
@@ -48,13 +50,10 @@ def _items(groups: list[Group], sweeps: dict[str, Prepared], timing_lock: str | 
         reference = sweep.collector.reference_key
         left[g.name] = deque(k for k in sweep.distinct if k != reference)
         yield (g.name, reference), makers[g.name](sweep.distinct[reference], None)
-    turn = deque(g.name for g in groups)
     while any(left.values()):
-        waiting = [n for n in turn if left[n]]
+        waiting = [g.name for g in groups if left[g.name]]
         ready = [n for n in waiting if sweeps[n].collector.reference_images() is not None]
         name = (ready or waiting)[0]
-        turn.remove(name)
-        turn.append(name)
         key = left[name].popleft()
         sweep = sweeps[name]
         yield (name, key), makers[name](sweep.distinct[key], sweep.collector.reference_images())

@@ -2,7 +2,7 @@
 validation: every group's outputs equal its own one-process ``rgraph sweep`` except measured
 times, whatever the pool (a process per setting, or several settings per process); a setting
 killed twice is reported in its group while every other setting of every group renders; all
-references are scheduled first and groups whose reference landed go first."""
+references are scheduled first, then groups in order, those whose reference landed first."""
 
 from __future__ import annotations
 
@@ -97,10 +97,10 @@ def test_references_first_then_groups_in_turn_ready_ones_first(tmp_path):
     assert {job.setting.label for _, job in rest} == {"default", "aa.samples=1"}
 
 
-def test_groups_take_turns_while_no_reference_landed(tmp_path):
+def test_groups_in_order_while_no_reference_landed(tmp_path):
     sweeps = {g.name: prepare(g.request, g.out_dir) for g in groups(tmp_path)}
     names = [k[0] for k, _ in _items(groups(tmp_path), sweeps, None)]
-    assert names == ["a", "b", "a", "b", "a", "b"]
+    assert names == ["a", "b", "a", "a", "b", "b"]  # references, then a's settings, then b's
 
 
 def test_group_names_must_differ(tmp_path):

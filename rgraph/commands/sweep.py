@@ -44,6 +44,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help="every setting a Ray task in its own worker process (one GPU each on a GPU "
                             "cluster); ADDRESS of a running cluster, else RAY_ADDRESS or a new local one "
                             "(pip install 'rgraph[ray]')")
+    parser.add_argument("--per-worker", type=int, default=1, metavar="K",
+                        help="with --workers: settings one worker process renders on one device before a "
+                             "fresh process takes its place (default 1)")
     parser.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     parser.set_defaults(func=run)
@@ -65,8 +68,11 @@ def run(args: argparse.Namespace) -> int:
         policy=args.policy, hdr=args.hdr, validate=args.validate)
     if args.workers is not None and args.workers < 1:
         raise RGraphError.in_file("<command line>", f"--workers must be at least 1, got {args.workers}")
+    if args.per_worker < 1:
+        raise RGraphError.in_file("<command line>", f"--per-worker must be at least 1, got {args.per_worker}")
     try:
-        executor = make_executor(args.workers, args.ray, use_ray=args.ray is not None)
+        executor = make_executor(args.workers, args.ray, use_ray=args.ray is not None,
+                                 tasks_per_worker=args.per_worker)
     except ImportError:
         print("rgraph: error: --ray needs Ray: pip install 'rgraph[ray]'", file=sys.stderr)
         return 2

@@ -142,6 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--groups", default="hbao,sss,rt,clusters", help="groups of benchmarks/sweeps.py")
     parser.add_argument("--pools", default="4x8,8x8,8x1",
                         help="comma-separated NxK: N worker processes, K settings each (default 4x8,8x8,8x1)")
+    parser.add_argument("--workers", help="comma-separated N: the pools Nx1 (session 7's form; overrides --pools)")
     parser.add_argument("-o", "--out", type=Path, required=True, help="folder of every run's sweeps and logs")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
@@ -166,6 +167,8 @@ def main(argv: list[str] | None = None) -> int:
     runs.append({"workers": 1, "how": "one process per group", "wall_s": round(wall, 2), "renderings": renderings,
                  "per_s": round(renderings / wall, 4) if wall else 0.0, **sampler.summary(idle_mib, 1)})
     save()
+    if args.workers:
+        args.pools = ",".join(f"{n}x1" for n in args.workers.split(",") if n)
     try:
         pools = [(int(n), int(k)) for n, _, k in (x.lower().partition("x") for x in args.pools.split(",") if x)]
     except ValueError:

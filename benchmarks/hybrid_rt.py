@@ -125,9 +125,11 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 
 
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
-            warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True) -> dict[str, Any]:
-    """One table row: stand-alone, the hybrid (compute visibility buffer) and, with ``raster``,
-    the hybrid with the hardware-raster visibility buffer, side by side on ``gpu``."""
+            warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
+            hybrid_params: dict[str, str] | None = None) -> dict[str, Any]:
+    """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
+    its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
+    side by side on ``gpu``."""
     from rgraph.compiler.pipeline import compile_graph
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
@@ -136,7 +138,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs", *levels))}
     if raster:
         graphs["raster"] = (RASTER_GRAPH, ("visibility",))
-    plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=params,
+    plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera,
+                                 params={**params, **(hybrid_params or {})} if name == "hybrid" else params,
                                  extra_outputs=list(extra), memory=gpu.memory_requirements())
              for name, (graph, extra) in graphs.items()}
     runs = side_by_side(gpu, plans, frames, warmup_s, chunk)
@@ -145,6 +148,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     out = hybrid["outputs"]
     traced = int(np.frombuffer(out["ray_args"].tobytes()[:16], dtype=np.uint32)[3]) if "ray_args" in out else 0
     row = {"scene": scene, "camera": camera, "size": list(size), "frames": frames, "max_depth": depth,
+           "hybrid_params": hybrid_params or {},
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
@@ -249,6 +253,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--cameras", default="0,1,2,3,4")
     parser.add_argument("--max-depth", type=int, default=4)
+    parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                        help="a param of graphs/rt_hybrid.yaml for the hybrid (repeatable), e.g. rt.wave_subgroup=1")
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
     args = parser.parse_args(argv)
@@ -257,6 +263,7 @@ def main(argv: list[str] | None = None) -> int:
     frames = args.frames or (2 if small else 50)
     raster = not args.no_raster and (ROOT / "graphs" / f"{RASTER_GRAPH}.yaml").exists()
     scenes = [s for s in args.scenes.split(",") if s]
+    hybrid_params = dict(kv.split("=", 1) for kv in args.param)
     rows: list[dict[str, Any]] = []
     if args.depth_sweep:
         for scene in scenes:
@@ -269,7 +276,7 @@ def main(argv: list[str] | None = None) -> int:
             for scene in scenes:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
-                                        chunk=max(1, args.chunk), raster=raster))
+                                        chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

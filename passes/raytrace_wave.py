@@ -48,6 +48,23 @@ def wavefront(setup: Any) -> bool:
     return int(setup.param("rt.wavefront", 1)) != 0 and "shaderBufferInt64Atomics" in setup.device.enabled_features
 
 
+def raygen_subgroups(device: Any) -> bool:
+    """Whether ray generation shaders have subgroup ballot + arithmetic operations."""
+    from rgraph.vk.loader import vk
+
+    v = vk()
+    props = v.VkPhysicalDeviceSubgroupProperties()
+    v.vkGetPhysicalDeviceProperties2(device.physical.handle, v.VkPhysicalDeviceProperties2(pNext=props))
+    ops = v.VK_SUBGROUP_FEATURE_BALLOT_BIT | v.VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | v.VK_SUBGROUP_FEATURE_BASIC_BIT
+    return bool(props.supportedStages & v.VK_SHADER_STAGE_RAYGEN_BIT_KHR) and props.supportedOperations & ops == ops
+
+
+def append_defines(setup: Any) -> dict[str, object]:
+    """``SUBGROUP_APPEND`` with ``rt.wave_subgroup`` 1 where the device can (shaders/rt/wave.glsl)."""
+    wanted = int(setup.param("rt.wave_subgroup", 0)) != 0
+    return {"SUBGROUP_APPEND": 1} if wanted and raygen_subgroups(setup.device) else {}
+
+
 def capacity(setup: Any, resource: str, unit: int) -> int:
     return int(setup.resource_plan(resource)["bytes"]) // unit
 
@@ -60,6 +77,7 @@ def wave_bindings(setup: Any, next_level: int) -> tuple[list[Binding], dict[str,
         bindings += [Binding(13, "storage_buffer", list_name(next_level)),
                      Binding(14, "storage_buffer", list_args(next_level))]
         defines.update(NEXT_LIST=1, RAY_CAPACITY=f"{capacity(setup, list_name(next_level), RAY_RECORD)}u")
+    defines.update(append_defines(setup))
     return bindings, defines
 
 

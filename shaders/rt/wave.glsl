@@ -9,9 +9,21 @@
 // stack walk (shade.glsl: walk) and added with its parent's radiance.
 // Needs common.glsl and shade.glsl (stack, push_children, walk) included before; bindings:
 // 12 = the accumulators (3 uint64 per listed pixel), NEXT_LIST: 13 = list k + 1, 14 = its
-// indirect arguments (count, 1, 1, overflow flag).
+// indirect arguments (count, 1, 1, overflow flag). SUBGROUP_APPEND (rt.wave_subgroup, where the
+// device has subgroup operations in ray generation shaders) reserves list slots with one atomic
+// per subgroup instead of one per invocation; the slots stay contiguous either way.
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #extension GL_EXT_shader_atomic_int64 : require
+#ifdef SUBGROUP_APPEND
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+// One atomic per subgroup: the active invocations' n summed, their slots by an exclusive scan.
+#define APPEND(counter, n, first) { uint total_ = subgroupAdd(n); uint base_ = 0u; \
+    if (subgroupElect()) base_ = atomicAdd(counter, total_); \
+    first = subgroupBroadcastFirst(base_) + subgroupExclusiveAdd(n); }
+#else
+#define APPEND(counter, n, first) { first = atomicAdd(counter, n); }
+#endif
 
 layout(set = 0, binding = 12, std430) buffer Accum { uint64_t acc[]; };
 
@@ -39,7 +51,8 @@ vec3 spill_and_walk(uint owner) {
 #ifdef NEXT_LIST
     if (top > 0u) {
         uint n = top;
-        uint first = atomicAdd(next_count, n);
+        uint first;
+        APPEND(next_count, n, first);
 #ifdef LIST_FITS
         if (true) {
 #else

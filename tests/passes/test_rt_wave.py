@@ -9,6 +9,7 @@ lists (levels 4 and 5 are walked in-thread by the last list's rays):
   brightens it) and the reference's;
 - full lists and full accumulators (tiny capacities) fall back to in-thread walks: same image;
 - ``rt.wavefront: 0`` (the path of devices without 64-bit atomics): same image, empty lists;
+- ``rt.wave_subgroup: 1`` (subgroup appends where the device has them): same lists and image;
 - the fixed-point accumulation is order-independent: two runs are bit-identical.
 Ray tracing passes run without the validation layer (docs/raytracing.md: the 1.3.239 layer
 crashes on ray tracing pipelines); the run's message log must still be empty.
@@ -96,4 +97,13 @@ def test_full_lists_and_accumulators_fall_back_to_in_thread_walks(alone):
 def test_without_the_wavefront_the_shade_pass_walks_every_tree(alone):
     out = _run("rt_hybrid", **{"rt.wavefront": "0"})
     assert [int(_args(out, name)[0]) for name in ("ray_args", *LISTS)] == [0, 0, 0, 0]
+    assert np.abs(_rgb(out) - alone).max() < 2e-3 and psnr(alone, _rgb(out)) > 70
+
+
+@pytest.mark.vulkan
+def test_subgroup_appends_give_the_same_lists_and_image(alone):
+    """rt.wave_subgroup 1: one list atomic per subgroup where ray generation shaders have subgroup
+    operations (a GPU), else (lavapipe) per-ray atomics; either way the same trees and image."""
+    out = _run("rt_hybrid", **{"rt.wave_subgroup": "1"})
+    assert [int(_args(out, name)[0]) for name in LISTS] == [int(_args(_run("rt_hybrid"), name)[0]) for name in LISTS]
     assert np.abs(_rgb(out) - alone).max() < 2e-3 and psnr(alone, _rgb(out)) > 70

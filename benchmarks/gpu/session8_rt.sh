@@ -4,6 +4,6 @@
 # Then one A/B: list appends with one atomic per subgroup (rt.wave_subgroup=1), living room only.
 set -u
 for s in rt_living_room rt_conference rt_gallery; do
-  timeout 170 python3 -m benchmarks.hybrid_rt --scenes $s --frames 20 --json $OUT/hybrid_$s.jsonl > $OUT/hybrid_$s.md 2>&1; echo "hybrid $s rc=$?"
+  timeout 150 python3 -m benchmarks.hybrid_rt --scenes $s --frames 20 --json $OUT/hybrid_$s.jsonl > $OUT/hybrid_$s.md 2>&1; echo "hybrid $s rc=$?"
 done
-timeout 120 python3 -m benchmarks.hybrid_rt --scenes rt_living_room --frames 20 --no-raster --param rt.wave_subgroup=1 --json $OUT/hybrid_subgroup_rt_living_room.jsonl > $OUT/hybrid_subgroup_rt_living_room.md 2>&1; echo "subgroup rc=$?"
+timeout 80 python3 -m benchmarks.hybrid_rt --scenes rt_living_room --cameras 0,1,4 --frames 20 --no-raster --param rt.wave_subgroup=1 --json $OUT/hybrid_subgroup_rt_living_room.jsonl > $OUT/hybrid_subgroup_rt_living_room.md 2>&1; echo "subgroup rc=$?"

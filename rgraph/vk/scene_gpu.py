@@ -38,7 +38,6 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
 from rgraph.vk.resources import HostBuffer
-from rgraph.vk.runtime.logic import interpolation_alpha
 from rgraph.vk.scene_modes import draw_mode, view_count
 from rgraph.vk.skin_gpu import BINDING_BONES, BINDING_SKIN_FRAME, BINDING_SKIN_VERTICES, SkinGPU
 
@@ -82,7 +81,6 @@ class SceneGPU:
         self.set_layout = None
         self._sets: list[Any] = []
         self._submit_once = submit_once
-        self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread (attach_logic)
         self.ticks_taken: list[tuple[int, int] | None] = [None] * sets  # per set: the logic ticks its frame mixes
         self.alpha_range = [1.0, 0.0]
@@ -220,6 +218,9 @@ class SceneGPU:
                                     host_buffer=self._host_buffer, upload=lambda ups: self._upload(submit_once, ups))
         self._make_descriptors(materials_size=len(materials), lights_size=len(scene_lights), draws_size=draws_size,
                                decals_size=decals_size, views_size=views_size, meshes_size=len(meshes))
+        from rgraph.vk.scene_frame import SceneFrames
+
+        self.frames = SceneFrames(self)
         for s in range(self.sets):
             self.update(0, s)
 
@@ -263,64 +264,31 @@ class SceneGPU:
 
     # ----------------------------------------------------------------- per frame
     def update(self, frame: int, frame_set: int) -> None:
-        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished).
-        ``draw.mode=gpu`` writes no per-object data (the instances are persistent);
-        ``naive`` culls every object on the CPU and writes one draw command per object."""
-        data = self.data
-        logic = self.logic
-        if logic is None:
-            seconds = data.seconds(frame)
-        else:  # between the logic thread's last two states
-            prev, cur = logic.latest() if self.deform is None else self.deform.take(frame_set, logic.latest)
-            alpha = interpolation_alpha(logic.clock(), cur.wall, logic.hz)
-            seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
-            self.alpha_range[0] = min(self.alpha_range[0], alpha)
-            self.alpha_range[1] = max(self.alpha_range[1], alpha)
-        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame, seconds))
-        camera = data.camera(frame).position.tobytes()
-        # camera-relative tables change with the camera only; naive mode (the engines' way) writes
-        # every object's matrix every frame
-        if self._camera_written[frame_set] != camera or self.mode == "naive":
-            if self.mode != "gpu":
-                self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
-            if data.decals:
-                self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
-            self._camera_written[frame_set] = camera
-        if self.views > 1:
-            self.view_buffers[frame_set].write(scene_instances.cached_views_bytes(data, frame, self.views, self.ipd))
-        if self.mode == "naive":
-            self.naive_buffers[frame_set].write(scene_instances.naive_commands(data, frame, self.calls, self.views,
-                                                                               self.ipd))
-        if logic is None:
-            if self.skin is not None:
-                self.skin.update(seconds, frame_set)
-            if self.deform is not None:
-                self.deform.write(seconds, frame_set)
-            return
-        if self.skin is not None:  # the logic thread packed these states (logic_step)
-            self.skin.show(frame_set, prev.tick, cur.tick, alpha)
-        if self.deform is not None:
-            self.deform.set_header(frame_set, alpha, prev.value, cur.value)  # the logic wrote the slots
-        self.ticks_taken[frame_set] = (prev.tick, cur.tick)
+        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished):
+        ``rgraph.vk.scene_frame.SceneFrames.update``. ``draw.mode=gpu`` writes no per-object
+        data (the instances are persistent); ``naive`` culls every object on the CPU and
+        writes one draw command per object."""
+        self.frames.update(frame, frame_set)
 
     def attach_logic(self, logic: Any) -> None:
-        """Take scene time and deformable positions from ``logic`` (a started-on-demand
+        """Take scene time, deformable positions and bones from ``logic`` (a started-on-demand
         ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step`` and whose lock is
-        ``deform.lock``)."""
+        ``lock``)."""
         self.logic = logic
         if self.skin is not None:
             self.skin.logic_hz = float(logic.hz)  # skinning's logic ticks are this thread's
         self.ticks_taken = [None] * self.sets
         self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
 
+    @property
+    def lock(self) -> Any:
+        """The lock the logic thread publishes states under (ring slots change hands under it)."""
+        return self.frames.lock
+
     def logic_step(self, seconds: float) -> Any:
-        """One logic tick at scene time ``seconds`` (the logic thread): the deformable positions
-        written into a free ring slot; the slot (None: no deformable meshes)."""
-        if self.skin is not None and self.skin.active:  # packed here, copied by the render thread
-            self.skin.state(round(seconds * self.logic.hz))
-        if self.deform is None:
-            return None
-        return self.deform.write_slot(seconds, self.logic.published)
+        """One logic tick at scene time ``seconds`` (the logic thread): (deformable slot, bones
+        slot) of the ring slots it wrote (``SceneFrames.logic_step``)."""
+        return self.frames.logic_step(seconds)
 
     def record_deform(self, cb: Any, frame_set: int) -> None:
         """The deformable vertices' compute pass and its barriers (nothing without deformable meshes)."""
@@ -334,7 +302,7 @@ class SceneGPU:
         idle (frames in flight read the table), so it suits rare changes."""
         for cache in ("_instance_arrays", "_packed_draw_table", "_frame_cache", "_views_cache"):
             self.data.__dict__.pop(cache, None)
-        self._camera_written = [None] * self.sets  # the Draws are written again at the next update
+        self.frames.forget_camera()  # the camera-relative tables are written again at the next update
         if self.mode == "gpu":
             vk().vkDeviceWaitIdle(self.device.handle)
             self._upload(self._submit_once, [(self.instance_buffer, scene_instances.instance_bytes(self.data))])

@@ -35,6 +35,7 @@ class Deformer:
     _basis: np.ndarray = field(init=False, repr=False)
     _basis32: np.ndarray = field(init=False, repr=False)
     topology: SmoothingTopology = field(init=False, repr=False)
+    _scratch: np.ndarray | None = field(init=False, default=None, repr=False)
 
     def __post_init__(self) -> None:
         p = self.rest.positions
@@ -68,11 +69,20 @@ class Deformer:
 
     def write_positions(self, seconds: float, out: np.ndarray) -> None:
         """``positions(seconds)`` in float32 into ``out`` ((n, 3) float32, C-contiguous: e.g.
-        mapped memory), one matrix-vector product without allocating (the per-frame path;
-        within about one float32 ulp of ``positions``)."""
+        mapped memory) without allocating (the per-frame path; within about one float32 ulp of
+        ``positions``): rest + c1 radial + c2 dent as three single-threaded array operations,
+        not a BLAS product, whose thread pool would wake on the render thread every frame.
+        One writer at a time (the render thread, or the logic thread with ``--logic-hz``)."""
         if not out.flags.c_contiguous or out.dtype != np.float32 or out.size != self._basis32.shape[1]:
             raise ValueError("write_positions: out must be a C-contiguous (n, 3) float32 array")
-        np.dot(self._coefficients(seconds).astype(np.float32), self._basis32, out=out.reshape(-1))
+        c = self._coefficients(seconds).astype(np.float32)
+        flat, basis = out.reshape(-1), self._basis32
+        if self._scratch is None:
+            self._scratch = np.empty(basis.shape[1], dtype=np.float32)
+        np.multiply(basis[1], c[1], out=flat)
+        flat += basis[0]  # c[0] is 1
+        np.multiply(basis[2], c[2], out=self._scratch)
+        flat += self._scratch
 
     def at(self, seconds: float) -> MeshData:
         """The deformed mesh with its reference normals (float64; ``tangents_at`` for tangents)."""

@@ -44,8 +44,12 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     a frame into blocked, Vulkan calls and Python from them.
 
     The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
-    wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
-    timeline values, and one vkQueueSubmit2 per call of ``submit_calls``.
+    wait and reset, one query read into a preallocated buffer (copied into a numpy row; with
+    ``ex.timestamp_every`` = k > 1 only every k-th use of a frame set reads its timestamps, the
+    per-pass medians then come from 1 / k of the frames), the timeline values, and one
+    vkQueueSubmit2 per call of ``submit_calls``. The timestamp queries are reset by each pass
+    in its command buffer (``rgraph.vk.runtime.commands``), from the host only where a pass
+    runs on a transfer-only queue family.
 
     With a logic thread (``ex.logic``: ``rgraph run --logic-hz``) it runs while the frames do
     (started here, stopped when they end or fail); an error there stops the loop. The timings
@@ -64,6 +68,8 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     fence_arrays = ex.fence_arrays
     pools = ex.query_pools
     timestamps = n > 0 and all(dev.timestamp_valid_bits.get(p["queue"], 0) > 0 for p in ex.plan["passes"])
+    host_reset = timestamps and getattr(ex, "host_query_reset", True)
+    every = max(1, int(getattr(ex, "timestamp_every", 1)))  # read one frame's timestamps in this many
     query_buffer = ffi.new("uint64_t[]", max(2 * n, 1))
     query_view = np.frombuffer(ffi.buffer(query_buffer), dtype=np.uint64)
     rows = np.zeros((frames, 2 * n), dtype=np.uint64)
@@ -104,7 +110,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if timed:
                 mark(perf())
                 mark(perf())
-            if fenced and submitted[s] and timestamps:
+            if fenced and submitted[s] and timestamps and (frame // FRAMES_IN_FLIGHT) % every == 0:
                 read = get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0
                 if timed:
                     mark(perf())
@@ -120,7 +126,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if timed:
                 mark(perf())
                 mark(perf())
-            if fenced and timestamps:
+            if fenced and host_reset:  # otherwise each pass resets its queries on the GPU
                 reset_queries(handle, pools[s], 0, 2 * n)
             if timed:
                 mark(perf())

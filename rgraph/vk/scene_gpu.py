@@ -11,7 +11,8 @@ Built once per run from ``plan["scene_source"]`` by the executor (``Executor._sc
 - per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
   uniform, the Views uniform (binding 5, ``views=2``), the Draws (draw modes cpu and naive) and
   Decals storage buffers (camera-relative, float64 on the CPU; cpu mode rewrites them only when
-  the camera moves, naive every frame), naive mode's per-object draw commands, and the
+  the camera moves, naive every frame: ``rgraph.vk.scene_naive`` copies naive mode's tables to
+  device memory at the start of each frame), naive mode's per-object draw commands, and the
   deformable meshes' positions (deformed on the CPU every frame); their normals and tangents
   are computed on the GPU (``rgraph.vk.scene_deform``: ``record_deform`` at the start of the
   frame's first scene batch on the graphics queue), into the vertex buffers the draws bind.
@@ -201,12 +202,19 @@ class SceneGPU:
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]
         draws_size = len(instances) if gpu else len(packing.draws_bytes(data, 0))
-        self.draw_buffers = [] if gpu else [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
+        self.naive = None  # rgraph.vk.scene_naive.NaiveTables (draw.mode=naive)
+        if self.mode == "naive":
+            from rgraph.vk.scene_naive import NaiveTables
+
+            self.naive = NaiveTables(self.sets, draws_size, data.draw_count, device_buffer=self._device_buffer,
+                                     host_buffer=self._host_buffer)
+            self.draw_buffers = self.naive.host_draws
+        else:
+            self.draw_buffers = [] if gpu else [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
         views_size = scene_instances.views_size(self.views)
         self.view_buffers = [self._host_buffer(views_size, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                              for _ in range(self.sets)]
-        self.naive_buffers = ([self._host_buffer(data.draw_count * 20, v.VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)
-                               for _ in range(self.sets)] if self.mode == "naive" else [])
+        self.naive_buffers = self.naive.host_commands if self.naive is not None else []
         decals_size = max(len(data.decals), 1) * packing.DECAL_BYTES
         self.decal_buffers = [self._host_buffer(decals_size, storage) for _ in range(self.sets)]
         if deform_base:
@@ -247,8 +255,7 @@ class SceneGPU:
             descriptorPool=self._pool, descriptorSetCount=self.sets, pSetLayouts=[self.set_layout] * self.sets)))
         for s in range(self.sets):
             sources = [(BINDING_FRAME, ubo, self.frame_buffers[s].handle, packing.FRAME_BYTES),
-                       (BINDING_DRAWS, ssbo, (self.instance_buffer if self.mode == "gpu" else self.draw_buffers[s]).handle,
-                        draws_size),
+                       (BINDING_DRAWS, ssbo, self._draws_of(s).handle, draws_size),
                        (BINDING_MATERIALS, ssbo, self.materials_buffer.handle, materials_size),
                        (BINDING_SCENE_LIGHTS, ssbo, self.scene_lights_buffer.handle, lights_size),
                        (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size),
@@ -261,6 +268,13 @@ class SceneGPU:
                                              pBufferInfo=[info])
                       for (b, t, _h, _size), info in zip(sources, infos, strict=True)]
             v.vkUpdateDescriptorSets(dev, len(writes), writes, 0, None)
+
+    def _draws_of(self, frame_set: int) -> Any:
+        """The buffer binding 1 reads: the persistent instances (gpu), the device copy of the
+        host-written Draws (naive), the host-written Draws (cpu)."""
+        if self.mode == "gpu":
+            return self.instance_buffer
+        return self.naive.draws[frame_set] if self.naive is not None else self.draw_buffers[frame_set]
 
     # ----------------------------------------------------------------- per frame
     def update(self, frame: int, frame_set: int) -> None:
@@ -290,10 +304,13 @@ class SceneGPU:
         slot) of the ring slots it wrote (``SceneFrames.logic_step``)."""
         return self.frames.logic_step(seconds)
 
-    def record_deform(self, cb: Any, frame_set: int) -> None:
-        """The deformable vertices' compute pass and its barriers (nothing without deformable meshes)."""
+    def record_frame(self, cb: Any, frame_set: int) -> None:
+        """The scene's per-frame GPU work before the frame's draws, with its barriers: the
+        deformable vertices' compute pass, draw.mode=naive's table copies (nothing otherwise)."""
         if self.deform is not None:
             self.deform.record(cb, frame_set)
+        if self.naive is not None:
+            self.naive.record(cb, frame_set)
 
     def refresh_instances(self) -> None:
         """After instances moved (``SceneMesh.positions`` changed in ``self.data``): drop the
@@ -330,6 +347,9 @@ class SceneGPU:
         if any(call.deformable for call in calls) and not self.deform.recorded[frame_set]:
             raise ExecutionError("deformable meshes drawn before their compute pass was recorded (the draw is not "
                                  "on the graphics queue after the frame's first scene batch)")
+        if self.naive is not None and not self.naive.recorded[frame_set]:
+            raise ExecutionError("draw.mode=naive: scene drawn before the frame's table copies were recorded (the draw "
+                                 "is not on the graphics queue after the frame's first scene batch)")
         if args is not None and self.mode == "gpu" and share is None:
             rec.bind_vertex_buffers([self.vertex_buffer.handle])
             bound = self.vertex_buffer.handle
@@ -341,8 +361,9 @@ class SceneGPU:
                 rec.bind_vertex_buffers([want])
                 bound = want
             if self.mode == "naive" and not call.deformable:
+                commands = self.naive.commands[frame_set].handle
                 for d in range(call.first_instance, call.first_instance + call.instances):
-                    rec.draw_indexed_indirect(self.naive_buffers[frame_set].handle, 20 * d)
+                    rec.draw_indexed_indirect(commands, 20 * d)
                 continue
             rec.draw_indexed(call.index_count, call.instances, call.first_index, call.vertex_offset,
                              call.first_instance)

@@ -2,8 +2,9 @@
 
 Per pass: a debug label, the reset of its two timestamp queries (on graphics and compute
 queue families; a pass on a transfer-only family leaves ``ex.host_query_reset`` set and the
-frame loop resets the set's pool from the host), a start timestamp, (the first scene pass on the graphics queue: the
-scene's deformable vertices, ``SceneGPU.record_deform``), the pass's lowered barrier calls, its commands
+frame loop resets the set's pool from the host), a start timestamp, (the first scene pass on
+the graphics queue: the scene's per-frame GPU work, ``SceneGPU.record_frame``: deformable
+vertices, naive mode's table copies), the pass's lowered barrier calls, its commands
 (``ImplPass.record``), its lowered releases, an end timestamp. Nothing here decides a
 barrier (``rgraph.vk.lower``); ``rgraph.vk.record`` builds the structs.
 """
@@ -51,7 +52,7 @@ def record(ex: Any) -> None:
                         v.vkCmdResetQueryPool(cb, ex.query_pools[s], 2 * i, 2)
                     v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, ex.query_pools[s], 2 * i)
                 if bi == deform_batch and i == batch.passes[0]:  # counted in this pass's GPU time
-                    ex.scene_gpu.record_deform(cb, s)
+                    ex.scene_gpu.record_frame(cb, s)
                 for barriers in barrier_batches(ex.resources, s, lowered.before):
                     ex.barrier_batches.append(barriers)
                     v.vkCmdPipelineBarrier2(cb, barriers.dependency)
@@ -68,7 +69,7 @@ def record(ex: Any) -> None:
 
 def scene_batch(ex: Any) -> int | None:
     """The first batch (submit order) on the graphics VkQueue with a pass that uses the scene:
-    the scene's per-frame compute work (``SceneGPU.record_deform``) goes at its start."""
+    the scene's per-frame compute work (``SceneGPU.record_frame``) goes at its start."""
     if ex.scene_gpu is None:
         return None
     graphics = ex.device.queues["graphics"]

@@ -97,10 +97,13 @@ class DeformGPU:
         # numpy views of the mapped memory: the ring (SLOTS, total, 3); per set (alpha, slots)
         self.slots = np.frombuffer(self.ring.mapped, dtype=np.float32, count=self.ring_bytes // 4).reshape(
             SLOTS, self.total, 3)
-        self.header_views = []
+        self.header_views = []  # NumPy views (reading); header_words: cffi pointers (the per-frame writes)
+        self.header_words = []
         for buf in self.headers:
             f = np.frombuffer(buf.mapped, dtype=np.float32, count=4)
             self.header_views.append((f, f.view(np.uint32)))
+            raw = v.ffi.from_buffer(buf.mapped)
+            self.header_words.append((v.ffi.cast("float *", raw), v.ffi.cast("uint32_t *", raw)))
         self.lock = threading.Lock()  # the logic thread's too (LogicThread(lock=...)): slots change hands under it
         self.in_use: list[tuple[int, int]] = [(s, s) for s in range(sets)]  # per set: the slots its frame reads
         for s in range(sets):
@@ -130,7 +133,7 @@ class DeformGPU:
 
     def set_header(self, frame_set: int, alpha: float, prev: int, cur: int) -> None:
         """Set ``frame_set``'s frame mixes slots ``prev`` and ``cur`` with weight ``alpha`` (1: cur)."""
-        f, u = self.header_views[frame_set]
+        f, u = self.header_words[frame_set]
         f[0] = alpha
         u[1] = prev
         u[2] = cur

@@ -25,9 +25,16 @@ import numpy as np
 
 from rgraph.scene import instances as scene_instances
 from rgraph.scene import packing
+from rgraph.vk.loader import vk
 from rgraph.vk.runtime.logic import interpolation_alpha
 
 TIME_WORD = packing.FRAME_OFFSETS["time"] // 4  # Frame.time: (seconds, frame, near, fov_y)
+
+
+def float_words(buffer: Any) -> Any:
+    """A cffi ``float *`` over a HostBuffer's mapped memory (valid while it stays mapped)."""
+    ffi = vk().ffi
+    return ffi.cast("float *", ffi.from_buffer(buffer.mapped))
 
 
 class SceneFrames:
@@ -37,6 +44,7 @@ class SceneFrames:
         self.scene = scene
         self.frame_views = [np.frombuffer(buf.mapped, dtype=np.float32, count=packing.FRAME_BYTES // 4)
                             for buf in scene.frame_buffers]
+        self.frame_words = [float_words(buf) for buf in scene.frame_buffers]  # the same memory, for the loop
         self.camera_of: list[Any] = [None] * scene.sets  # per set: the CameraState its tables show
         # the logic thread's lock too (LogicThread(lock=...)): ring slots change hands under it
         self.lock = scene.deform.lock if scene.deform is not None else threading.Lock()
@@ -70,9 +78,9 @@ class SceneFrames:
             self._camera_tables(frame, frame_set, seconds)
             self.camera_of[frame_set] = cam
         else:
-            view = self.frame_views[frame_set]
-            view[TIME_WORD] = seconds
-            view[TIME_WORD + 1] = frame
+            words = self.frame_words[frame_set]  # a cffi float*: two small stores, no NumPy call
+            words[TIME_WORD] = seconds
+            words[TIME_WORD + 1] = frame
         if naive:
             sc.naive_buffers[frame_set].write(scene_instances.naive_commands(data, frame, sc.calls, sc.views, sc.ipd))
         if logic is None:

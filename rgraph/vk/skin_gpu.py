@@ -70,11 +70,11 @@ class SkinGPU:
         self.ring = self._buffer(device, self.bones_bytes, storage)
         self.ring.write(header.tobytes())
         self.frames = [self._buffer(device, SKIN_FRAME_BYTES, uniform) for _ in range(sets)]
-        self.frame_views = []  # per set: (float32, uint32) views of its SkinFrame
+        self.frame_words = []  # per set: (float *, uint32_t *) cffi pointers to its SkinFrame
         for buf in self.frames:
             buf.write(bytes(SKIN_FRAME_BYTES))
-            f = np.frombuffer(buf.mapped, dtype=np.float32, count=SKIN_FRAME_BYTES // 4)
-            self.frame_views.append((f, f.view(np.uint32)))
+            raw = v.ffi.from_buffer(buf.mapped)
+            self.frame_words.append((v.ffi.cast("float *", raw), v.ffi.cast("uint32_t *", raw)))
         self._slot_tick: list[int | None] = [None] * self.slots
         self.in_use: list[tuple[int, int]] = [(-1, -1)] * sets  # slots each set's frame reads
         self._states: dict[int, np.ndarray] = {}
@@ -158,7 +158,7 @@ class SkinGPU:
     def show_slots(self, frame_set: int, a: int, b: int, alpha: float) -> None:
         """Frame set ``frame_set`` mixes ring slots ``a`` -> ``b`` at ``alpha`` (the SkinFrame
         uniform, written in place: 12 bytes)."""
-        f, u = self.frame_views[frame_set]
+        f, u = self.frame_words[frame_set]
         f[0] = min(max(alpha, 0.0), 1.0)
         u[1] = self.header + a * self.bones
         u[2] = self.header + b * self.bones

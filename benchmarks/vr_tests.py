@@ -25,6 +25,7 @@ per-pass medians then come from a quarter of the frames; the mean includes the r
     python3 -m benchmarks.vr_tests [--size 1920x1080] [--frames 300] [--warmup 0.5]
         [--tests instanced,skinned,lighting,unique] [--views 1,2] [--modes gpu,naive] [--logic-hz 60]
         [--timestamps-every 4] [--json OUT.json]
+    python3 -m benchmarks.vr_tests --from-json gpu.json naive.json    # one table from two runs
     lavapipe smoke:  python3 -m benchmarks.vr_tests --size 160x90 --frames 3
 """
 
@@ -158,7 +159,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timestamps-every", dest="timestamps_every", type=int, default=4,
                         help="read one frame's timestamps in this many (default 4; 1: every frame)")
     parser.add_argument("--json", type=Path, help="write every figure as JSON")
+    parser.add_argument("--from-json", dest="from_json", type=Path, nargs="+",
+                        help="measure nothing: print the tables of these --json files' rows together")
     args = parser.parse_args(argv)
+    if args.from_json:
+        docs = [json.loads(p.read_text()) for p in args.from_json]
+        rows = [r for d in docs for r in d["rows"]]
+        print(f"device: {docs[0].get('device', '?')}, {'x'.join(map(str, docs[0]['size']))}, from "
+              + ", ".join(str(p) for p in args.from_json))
+        print(table(rows))
+        print(pass_ratios(rows))
+        return 0
     if args.warmup < 0.3:
         parser.error("--warmup must be at least 0.3 s")
     if args.frames < 2:

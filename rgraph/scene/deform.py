@@ -70,19 +70,23 @@ class Deformer:
     def write_positions(self, seconds: float, out: np.ndarray) -> None:
         """``positions(seconds)`` in float32 into ``out`` ((n, 3) float32, C-contiguous: e.g.
         mapped memory) without allocating (the per-frame path; within about one float32 ulp of
-        ``positions``): rest + c1 radial + c2 dent as three single-threaded array operations,
-        not a BLAS product, whose thread pool would wake on the render thread every frame.
-        One writer at a time (the render thread, or the logic thread with ``--logic-hz``)."""
+        ``positions``): rest + c1 radial + c2 dent as single-threaded array operations in a
+        scratch array, not a BLAS product (whose thread pool would wake on the render thread
+        every frame), then one copy into ``out``, which is only written, never read (mapped
+        memory may be write-combined: reads from it are uncached). One writer at a time (the
+        render thread, or the logic thread with ``--logic-hz``)."""
         if not out.flags.c_contiguous or out.dtype != np.float32 or out.size != self._basis32.shape[1]:
             raise ValueError("write_positions: out must be a C-contiguous (n, 3) float32 array")
         c = self._coefficients(seconds).astype(np.float32)
-        flat, basis = out.reshape(-1), self._basis32
+        basis = self._basis32
         if self._scratch is None:
-            self._scratch = np.empty(basis.shape[1], dtype=np.float32)
-        np.multiply(basis[1], c[1], out=flat)
-        flat += basis[0]  # c[0] is 1
-        np.multiply(basis[2], c[2], out=self._scratch)
-        flat += self._scratch
+            self._scratch = np.empty((2, basis.shape[1]), dtype=np.float32)
+        acc, term = self._scratch
+        np.multiply(basis[1], c[1], out=acc)
+        acc += basis[0]  # c[0] is 1
+        np.multiply(basis[2], c[2], out=term)
+        acc += term
+        out.reshape(-1)[:] = acc
 
     def at(self, seconds: float) -> MeshData:
         """The deformed mesh with its reference normals (float64; ``tangents_at`` for tangents)."""

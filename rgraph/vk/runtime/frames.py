@@ -44,7 +44,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     a frame into blocked, Vulkan calls and Python from them.
 
     The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
-    wait and reset, one query read into a preallocated buffer (copied into a numpy row; with
+    wait and reset, one query read into a preallocated buffer (copied out as bytes; with
     ``ex.timestamp_every`` = k > 1 only every k-th use of a frame set reads its timestamps, the
     per-pass medians then come from 1 / k of the frames), the timeline values, and one
     vkQueueSubmit2 per call of ``submit_calls``. The timestamp queries are reset by each pass

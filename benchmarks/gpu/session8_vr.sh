@@ -12,4 +12,6 @@ timeout 60 python3 -m benchmarks.vr_tests --size 1280x720 --frames 60 --warmup 0
 {
   echo "== vr_instanced naive 1920x1080 (no validation)"
   timeout 40 python3 -m rgraph run clustered --scene graphs/scenes/vr_instanced.yaml --naive-cpu --size 1920x1080 --frames 60 --no-check-data; echo "rc=$?"
+  echo "== vr_instanced draw.mode=cpu 1920x1080 (host-written Draws, one instanced draw; tells a naive loss apart)"
+  timeout 40 python3 -m rgraph run clustered --scene graphs/scenes/vr_instanced.yaml -p draw.mode=cpu --size 1920x1080 --frames 60 --no-check-data; echo "rc=$?"
 } > $OUT/naive_instanced.txt 2>&1; echo "naive instanced done"

@@ -14,7 +14,7 @@ Built once per run from ``plan["scene_source"]`` by the executor (``Executor._sc
   the camera moves, naive every frame: ``rgraph.vk.scene_naive`` copies naive mode's tables to
   device memory at the start of each frame), naive mode's per-object draw commands, and the
   deformable meshes' positions (deformed on the CPU every frame); their normals and tangents
-  are computed on the GPU (``rgraph.vk.scene_deform``: ``record_deform`` at the start of the
+  are computed on the GPU (``rgraph.vk.scene_deform``: ``record_frame`` at the start of the
   frame's first scene batch on the graphics queue), into the vertex buffers the draws bind.
 - skinning (bindings 7-9, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights (lined up with
   the TLSF-placed rigid vertex buffer), the ring of packed logic states and each set's

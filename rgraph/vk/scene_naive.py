@@ -35,7 +35,7 @@ class NaiveTables:
         v = vk()
         src = v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT
         self.draws_size, self.commands_size = draws_size, max(draw_count, 1) * COMMAND_BYTES
-        self.host_draws = [host_buffer(draws_size, v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | src) for _ in range(sets)]
+        self.host_draws = [host_buffer(draws_size, src) for _ in range(sets)]
         self.host_commands = [host_buffer(self.commands_size, src) for _ in range(sets)]
         self.draws = [device_buffer(draws_size, v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT) for _ in range(sets)]
         self.commands = [device_buffer(self.commands_size, v.VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT) for _ in range(sets)]

@@ -8,6 +8,7 @@ timeout 90 python3 -m benchmarks.vr_tests --size 1920x1080 --frames 60 --warmup 
 python3 -m benchmarks.vr_tests --from-json $OUT/vr_gpu.json $OUT/vr_naive.json > $OUT/vr_table.md 2>&1; echo "table rc=$?"
 timeout 100 python3 benchmarks/frame_cpu.py --passes real --size 1920x1080 --frames 2000 --rounds 1 > $OUT/frame_cpu_real.txt 2>&1; echo "frame_cpu rc=$?"
 timeout 100 python3 benchmarks/frame_cpu.py --passes real --size 1920x1080 --frames 2000 --rounds 1 --logic-hz 60 > $OUT/frame_cpu_logic60.txt 2>&1; echo "frame_cpu logic rc=$?"
+timeout 40 python3 -m benchmarks.vr_tests --size 1920x1080 --frames 60 --warmup 0.3 --logic-hz 60 --tests instanced,lighting --views 1 --modes gpu --timestamps-every 1 --json $OUT/vr_ts1.json > $OUT/vr_ts1.txt 2>&1; echo "vr timestamps every frame rc=$?"
 timeout 60 python3 -m benchmarks.vr_tests --size 1280x720 --frames 60 --warmup 0.3 --tests instanced,unique --modes gpu --json $OUT/vr_720p.json > $OUT/vr_720p.txt 2>&1; echo "vr 720p rc=$?"
 {
   echo "== vr_instanced naive 1920x1080 (no validation)"

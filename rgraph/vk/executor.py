@@ -98,6 +98,9 @@ class Executor:
         self.host_buffers: list[HostBuffer] = []
         self.barrier_batches: list[BarrierBatch] = []
         self.frames_done = 0
+        # frames_done at the first frame whose content is frame 0 (``Executable.warm_up`` moves it
+        # past warm-up frames of a plan that carries no state between frames)
+        self.frame_origin = 0
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread with logic_hz (run_frames starts it)
         self.timestamp_every = 1  # read one use in this many of a frame set's timestamps (rgraph.vk.runtime.frames)
         self.host_query_reset = True  # the frame loop resets the query pools (commands.record decides)

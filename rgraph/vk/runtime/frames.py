@@ -91,6 +91,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     timed = marks is not None
     mark = marks.append if marks is not None else None
     base = ex.frames_done
+    origin = getattr(ex, "frame_origin", 0)
     logic = ex.logic
     thread_t0 = time.thread_time()
     wall_t0 = perf()
@@ -141,10 +142,11 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if logic is not None and logic.error is not None:
                 raise ExecutionError(f"frame {frame}: the logic thread failed: {logic.error!r}")
             u0 = perf()
+            content = frame - origin  # the frame's content index (camera, animation, probe values)
             if update is not None:
-                update(frame, s)
+                update(content, s)
             for p in updaters:
-                p.update(frame, s)
+                p.update(content, s)
             update_s[local] = perf() - u0
             for slot, offset in slots_of[s]:
                 slot.value = frame + offset

@@ -21,8 +21,6 @@ from __future__ import annotations
 import threading
 from typing import Any
 
-import numpy as np
-
 from rgraph.scene import instances as scene_instances
 from rgraph.scene import packing
 from rgraph.vk.loader import vk
@@ -42,9 +40,7 @@ class SceneFrames:
 
     def __init__(self, scene: Any) -> None:
         self.scene = scene
-        self.frame_views = [np.frombuffer(buf.mapped, dtype=np.float32, count=packing.FRAME_BYTES // 4)
-                            for buf in scene.frame_buffers]
-        self.frame_words = [float_words(buf) for buf in scene.frame_buffers]  # the same memory, for the loop
+        self.frame_words = [float_words(buf) for buf in scene.frame_buffers]  # per set: its Frame uniform
         self.camera_of: list[Any] = [None] * scene.sets  # per set: the CameraState its tables show
         # the logic thread's lock too (LogicThread(lock=...)): ring slots change hands under it
         self.lock = scene.deform.lock if scene.deform is not None else threading.Lock()

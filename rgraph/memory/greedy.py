@@ -6,35 +6,64 @@ it in time and can hold it (aligned); when no gap fits it goes on top of them.
 
 from __future__ import annotations
 
+from bisect import insort
 from collections.abc import Iterator, Sequence
 
 from rgraph.memory.instance import Instance
 
 
-def best_fit(inst: Instance, order: Sequence[int]) -> list[int]:
-    """Offsets for every block, placing blocks in ``order``."""
-    offsets = [-1] * inst.n
-    placed: list[tuple[int, int] | None] = [None] * inst.n  # (offset, top) once placed
+def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None) -> list[int] | None:
+    """Offsets for every block, placing blocks in ``order``; None as soon as a block's top
+    reaches ``give_up_at`` (the peak could then only be at least that).
+
+    A block's placed neighbours are visited in offset order (the gap scan depends only on
+    the first of equal offsets and on the highest top so far): from the sorted list of every
+    placed block, skipping its non-neighbours, when it overlaps about half of them or more,
+    else by sorting its placed neighbours."""
+    n = inst.n
+    offsets = [-1] * n
+    placed: list[tuple[int, int] | None] = [None] * n  # (offset, top) once placed
     size, align, neighbors = inst.size, inst.align, inst.neighbors
     get = placed.__getitem__
+    every: list[tuple[int, int, int]] = []  # (offset, top, block) of the placed blocks, sorted
+    far = inst.non_neighbors
+    limit = give_up_at if give_up_at is not None else -1
     for i in order:
         need, a = size[i], align[i]
-        taken = sorted(filter(None, map(get, neighbors[i])))  # placed neighbours by (offset, top)
+        row = neighbors[i]
         best_off, best_gap = -1, -1
         cursor = 0
-        for lo, hi in taken:
-            if lo > cursor:
-                aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
-                if aligned + need <= lo:
-                    gap = lo - cursor
-                    if best_gap < 0 or gap < best_gap:
-                        best_off, best_gap = aligned, gap
-            if hi > cursor:
-                cursor = hi
+        if len(every) < 2 * len(row) + 16:
+            skip = far(i)
+            for lo, hi, j in every:
+                if j in skip:
+                    continue
+                if lo > cursor:
+                    aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
+                    if aligned + need <= lo:
+                        gap = lo - cursor
+                        if best_gap < 0 or gap < best_gap:
+                            best_off, best_gap = aligned, gap
+                if hi > cursor:
+                    cursor = hi
+        else:
+            for lo, hi in sorted(filter(None, map(get, row))):
+                if lo > cursor:
+                    aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
+                    if aligned + need <= lo:
+                        gap = lo - cursor
+                        if best_gap < 0 or gap < best_gap:
+                            best_off, best_gap = aligned, gap
+                if hi > cursor:
+                    cursor = hi
         if best_off < 0:
             best_off = cursor if cursor % a == 0 else cursor + a - cursor % a
+        top = best_off + need
+        if 0 <= limit <= top:
+            return None
         offsets[i] = best_off
-        placed[i] = (best_off, best_off + need)
+        placed[i] = (best_off, top)
+        insort(every, (best_off, top, i))
     return offsets
 
 

@@ -132,6 +132,14 @@ class Instance:
             totals.append(running)
         return totals
 
+    def non_neighbors(self, i: int) -> set[int]:
+        """The blocks, ``i`` included, that ``i`` may share bytes with (cached)."""
+        cache = self.__dict__.setdefault("_non_neighbors", {})
+        far = cache.get(i)
+        if far is None:
+            far = cache[i] = set(range(self.n)).difference(self.neighbors[i])
+        return far
+
     def lower_bound(self) -> int:
         return max(self.section_totals(), default=0)
 

@@ -24,7 +24,7 @@ from typing import NamedTuple
 
 from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
-from rgraph.ir.graph import Cell, cells
+from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
 PERSISTENT = ("persistent", "imported")
@@ -136,7 +136,7 @@ def access_syncs(p: PassSpec, resources: Mapping[str, ResourceSpec]) -> list[Syn
 def _pass_cells(p: PassSpec, syncs: list[Sync]) -> dict[Cell, tuple[Sync, bool]]:
     merged: dict[Cell, tuple[Sync, bool]] = {}
     for a, s in zip(p.accesses, syncs, strict=True):
-        for c in cells(a):
+        for c in a.cells:
             if c in merged:
                 prev, w = merged[c]
                 merged[c] = (merge(prev, s), w or a.write)

@@ -173,9 +173,7 @@ def synchronize(
         return _Cell("UNDEFINED" if res.is_image else None, None, None, [])
 
     # Frame 1 from scratch gives the end-of-frame state; frame 2 starts persistent cells there.
-    # Frame 1 is needed only for persistent cells and for the resources others alias.
     needed = {r for r, res in resources.items() if res.lifetime in PERSISTENT}
-    needed |= {p for preds in alias_sources.values() for p in preds}
     first = _Simulation(passes, per_pass_cells, timeline, resources)
     if needed:
         if not all(c[0] in needed for c in timeline):
@@ -194,20 +192,50 @@ def synchronize(
             )
         else:
             start[c] = fresh(c)
-    alias_init = _alias_initial_states(alias_sources, first)
-    for c, cell in start.items():
-        if c[0] in alias_init:
-            stages, access, queue, last, names, waits = alias_init[c[0]]
-            cell.write = (PREVIOUS_FRAME, stages, access) if stages or access else None
-            cell.queue = queue
-            cell.last_pass = last
-            cell.aliases = names
-            cell.alias_waits = waits
     sim = _Simulation(passes, per_pass_cells, timeline, resources)
     initial = {c: st.state() for c, st in start.items()}
-    sim.run(start)
+    sim.run(start, _AliasStarts(alias_sources, start, timeline, initial))
     final = sim.final_states()
     return SyncResult(sim.out, syncs, _by_resource(final), _by_resource(initial))
+
+
+class _AliasStarts:
+    """Transient cells whose memory an earlier resource used start from that resource's last
+    accesses (``_alias_state``). Every earlier occupant ends before the resource's first
+    pass, so its cells already hold their end-of-frame state when that pass comes: the
+    states are taken then, from the one simulation of the frame. (A transient's end state
+    does not depend on where it started: its first access to each cell writes it or reads
+    it, and either replaces what ``state()`` reports.)"""
+
+    def __init__(self, alias_sources: Mapping[str, Sequence[str]], start: dict[Cell, _Cell],
+                 timeline: Mapping[Cell, list], initial: dict[Cell, State]) -> None:
+        self.cells_of: dict[str, list[tuple[Cell, _Cell]]] = defaultdict(list)
+        for c, st in start.items():
+            self.cells_of[c[0]].append((c, st))
+        first_pass: dict[str, int] = {}
+        for c, uses in timeline.items():
+            i = uses[0].pass_pos
+            if first_pass.get(c[0], i) >= i:
+                first_pass[c[0]] = i
+        self.at: dict[int, list[str]] = defaultdict(list)  # pass -> resources that start there
+        for name, preds in alias_sources.items():
+            if preds and name in first_pass:
+                self.at[first_pass[name]].append(name)
+        self.sources = alias_sources
+        self.initial = initial
+
+    def apply(self, i: int) -> None:
+        """Start the aliased resources whose first pass is ``i``."""
+        for name in self.at.get(i, ()):
+            stages, access, queue, last, names, waits = _alias_state(
+                self.sources[name], [st for pred in self.sources[name] for _, st in self.cells_of[pred]], i)
+            for c, cell in self.cells_of[name]:
+                cell.write = (PREVIOUS_FRAME, stages, access) if stages or access else None
+                cell.queue = queue
+                cell.last_pass = last
+                cell.aliases = names
+                cell.alias_waits = waits
+                self.initial[c] = cell.state()
 
 
 def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
@@ -260,33 +288,26 @@ def _share_bytes(ranges: Mapping[str, tuple[int, int, int]], a: str, b: str) -> 
     return ha == hb and lo_a < hi_b and lo_b < hi_a
 
 
-def _alias_initial_states(alias_sources, first: _Simulation):
-    """Union of the last accesses of each aliased resource's predecessors."""
-    cells_of: dict[str, list[_Cell]] = defaultdict(list)
-    for c, st in first.cells.items():
-        cells_of[c[0]].append(st)
-    out = {}
-    for name, preds in alias_sources.items():
-        if not preds:
-            continue
-        stages: set[str] = set()
-        access: set[str] = set()
-        last: tuple[int, str | None] = (-1, None)
-        waits: set[tuple[str, int]] = set()
-        for pred in preds:
-            for st in cells_of[pred]:
-                s = st.state()
-                stages |= s.stages
-                access |= s.access
-                if st.last_pass is not None and st.last_pass > last[0]:
-                    last = (st.last_pass, st.queue)
-                if st.last_pass is not None and st.queue is not None:
-                    waits.add((st.queue, st.last_pass))
-        out[name] = (
-            frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
-            tuple(sorted(waits)),
-        )
-    return out
+def _alias_state(preds: Sequence[str], pred_cells: Sequence[_Cell], at: int):
+    """Union of the last accesses of an aliased resource's predecessors (their cells, each
+    last used before pass ``at``)."""
+    stages: set[str] = set()
+    access: set[str] = set()
+    last: tuple[int, str | None] = (-1, None)
+    waits: set[tuple[str, int]] = set()
+    for st in pred_cells:
+        assert st.last_pass is None or st.last_pass < at, "an earlier occupant outlives its successor's start"
+        s = st.state()
+        stages |= s.stages
+        access |= s.access
+        if st.last_pass is not None and st.last_pass > last[0]:
+            last = (st.last_pass, st.queue)
+        if st.last_pass is not None and st.queue is not None:
+            waits.add((st.queue, st.last_pass))
+    return (
+        frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
+        tuple(sorted(waits)),
+    )
 
 
 class _Simulation:
@@ -308,10 +329,13 @@ class _Simulation:
             for c, (s, w) in self.per_pass_cells[i].items():
                 step(c, cells_now[c], i, queue, s, w)
 
-    def run(self, start: dict[Cell, _Cell]) -> None:
+    def run(self, start: dict[Cell, _Cell], alias_starts: _AliasStarts | None = None) -> None:
         self.cells = cells_now = start
         step, out = self._step, self.out
+        starting = alias_starts.at if alias_starts is not None else {}
         for i, p in enumerate(self.passes):
+            if i in starting:
+                alias_starts.apply(i)
             # acquires grouped by their release pass too, so that each acquire's rectangles equal
             # its release's (the layer pairs ownership transfers by exact subresource range)
             groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = {}

@@ -6,7 +6,7 @@ it in time and can hold it (aligned); when no gap fits it goes on top of them.
 
 from __future__ import annotations
 
-from bisect import insort
+from bisect import bisect_left, insort
 from collections.abc import Iterator, Sequence
 
 from rgraph.memory.instance import Instance
@@ -17,15 +17,19 @@ def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None
     reaches ``give_up_at`` (the peak could then only be at least that).
 
     A block's placed neighbours are visited in offset order (the gap scan depends only on
-    the first of equal offsets and on the highest top so far): from the sorted list of every
-    placed block, skipping its non-neighbours, when it overlaps about half of them or more,
-    else by sorting its placed neighbours."""
+    the first of equal offsets and on the highest top so far). When it overlaps about half
+    of the placed blocks or more: the union of their byte ranges when all of them are its
+    neighbours (the same gaps), else the sorted list of every placed block, skipping its
+    non-neighbours; otherwise its placed neighbours, sorted."""
     n = inst.n
     offsets = [-1] * n
     placed: list[tuple[int, int] | None] = [None] * n  # (offset, top) once placed
     size, align, neighbors = inst.size, inst.align, inst.neighbors
     get = placed.__getitem__
     every: list[tuple[int, int, int]] = []  # (offset, top, block) of the placed blocks, sorted
+    placed_set: set[int] = set()
+    union_lo: list[int] = []  # the union of the placed blocks' byte ranges: disjoint, sorted
+    union_hi: list[int] = []
     far = inst.non_neighbors
     limit = give_up_at if give_up_at is not None else -1
     for i in order:
@@ -33,7 +37,17 @@ def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None
         row = neighbors[i]
         best_off, best_gap = -1, -1
         cursor = 0
-        if len(every) < 2 * len(row) + 16:
+        if len(every) < 2 * len(row) + 16 and far(i).isdisjoint(placed_set):
+            # every placed block is a neighbour: the gaps are those of their union
+            for lo, hi in zip(union_lo, union_hi):
+                if lo > cursor:
+                    aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
+                    if aligned + need <= lo:
+                        gap = lo - cursor
+                        if best_gap < 0 or gap < best_gap:
+                            best_off, best_gap = aligned, gap
+                cursor = hi
+        elif len(every) < 2 * len(row) + 16:
             skip = far(i)
             for lo, hi, j in every:
                 if j in skip:
@@ -64,7 +78,21 @@ def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None
         offsets[i] = best_off
         placed[i] = (best_off, top)
         insort(every, (best_off, top, i))
+        placed_set.add(i)
+        _merge(union_lo, union_hi, best_off, top)
     return offsets
+
+
+def _merge(los: list[int], his: list[int], lo: int, hi: int) -> None:
+    """Add ``[lo, hi)`` to the union ``los``/``his`` (sorted, disjoint, not touching)."""
+    k = bisect_left(his, lo)  # first interval ending at or after lo: touches or follows it
+    end = k
+    while end < len(los) and los[end] <= hi:
+        end += 1
+    if end > k:
+        lo, hi = min(lo, los[k]), max(hi, his[end - 1])
+    los[k:end] = [lo]
+    his[k:end] = [hi]
 
 
 def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:

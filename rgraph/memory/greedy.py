@@ -39,7 +39,7 @@ def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None
         cursor = 0
         if len(every) < 2 * len(row) + 16 and far(i).isdisjoint(placed_set):
             # every placed block is a neighbour: the gaps are those of their union
-            for lo, hi in zip(union_lo, union_hi):
+            for lo, hi in zip(union_lo, union_hi, strict=True):
                 if lo > cursor:
                     aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
                     if aligned + need <= lo:

@@ -127,12 +127,23 @@ class Device:
         v = vk()
         if self.handle is None:
             return
-        v.vkDeviceWaitIdle(self.handle)
+        wait_idle_for_teardown(self.handle)
         for sem in self.timelines:
             v.vkDestroySemaphore(self.handle, sem, None)
         self.timelines.clear()
         v.vkDestroyDevice(self.handle, None)
         self.handle = None
+
+
+def wait_idle_for_teardown(handle: Any) -> None:
+    """vkDeviceWaitIdle before destroying objects; a lost device is idle for that purpose
+    (objects of a lost device may still be destroyed), so the error that lost it, already
+    raised, is what the user sees rather than a second one from the teardown."""
+    v = vk()
+    try:
+        v.vkDeviceWaitIdle(handle)
+    except v.VkErrorDeviceLost:
+        pass
 
 
 def _family_for(families: list[Any], queue: str) -> int:

@@ -81,7 +81,7 @@ class DeviceLocal:
     def read(self, submit_once: SubmitOnce, buf: DeviceBuffer, src_stage: int, src_access: int) -> bytes:
         """The buffer's bytes, after the writes of (``src_stage``, ``src_access``) submitted earlier."""
         v = vk()
-        staging = HostBuffer.create(self.device, buf.size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT)
+        staging = HostBuffer.create(self.device, buf.size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback=True)
         try:
             def record(cb: Any) -> None:
                 barrier(cb, [buf.handle], src_stage, src_access, v.VK_PIPELINE_STAGE_2_COPY_BIT,

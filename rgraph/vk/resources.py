@@ -39,15 +39,17 @@ class Resource:
         return self.plan["kind"] == "image"
 
 
-def memory_type(device: Device, type_bits: int, want: int, avoid: int = 0) -> int:
-    """The first memory type allowed by ``type_bits`` with all ``want`` flags (prefers lacking ``avoid``)."""
+def memory_type(device: Device, type_bits: int, want: int, avoid: int = 0, prefer: int = 0) -> int:
+    """The first memory type allowed by ``type_bits`` with all ``want`` flags (prefers lacking
+    ``avoid``, then having all ``prefer`` flags)."""
     props = device.memory_properties
     candidates = [i for i in range(props.memoryTypeCount)
                   if type_bits & (1 << i) and props.memoryTypes[i].propertyFlags & want == want]
     if not candidates:
         raise ExecutionError(f"no memory type with flags {want:#x} among bits {type_bits:#x}")
-    preferred = [i for i in candidates if not props.memoryTypes[i].propertyFlags & avoid]
-    return (preferred or candidates)[0]
+    preferred = [i for i in candidates if not props.memoryTypes[i].propertyFlags & avoid] or candidates
+    flagged = [i for i in preferred if props.memoryTypes[i].propertyFlags & prefer == prefer]
+    return (flagged or preferred)[0]
 
 
 @dataclass
@@ -61,15 +63,19 @@ class HostBuffer:
     mapped: Any
 
     @classmethod
-    def create(cls, device: Device, size: int, usage: int, allocate_flags: int = 0) -> HostBuffer:
-        """``allocate_flags``: VkMemoryAllocateFlags (e.g. device address) for its memory."""
+    def create(cls, device: Device, size: int, usage: int, allocate_flags: int = 0,
+               readback: bool = False) -> HostBuffer:
+        """``allocate_flags``: VkMemoryAllocateFlags (e.g. device address) for its memory;
+        ``readback``: the host reads it, so prefer HOST_CACHED memory (reads of uncached,
+        write-combined memory run at a few hundred MB/s)."""
         v = vk()
         size = max(int(size), 4)
         info = v.VkBufferCreateInfo(size=size, usage=usage, sharingMode=v.VK_SHARING_MODE_EXCLUSIVE)
         handle = v.vkCreateBuffer(device.handle, info, None)
         req = v.vkGetBufferMemoryRequirements(device.handle, handle)
         want = v.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | v.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-        index = memory_type(device, req.memoryTypeBits, want)
+        prefer = v.VK_MEMORY_PROPERTY_HOST_CACHED_BIT if readback else 0
+        index = memory_type(device, req.memoryTypeBits, want, prefer=prefer)
         chain = {"pNext": v.VkMemoryAllocateFlagsInfo(flags=allocate_flags)} if allocate_flags else {}  # alive until the call returns
         memory = v.vkAllocateMemory(device.handle, v.VkMemoryAllocateInfo(
             allocationSize=req.size, memoryTypeIndex=index, **chain), None)

@@ -38,7 +38,7 @@ def read_back(ex: Any, frames: int | None = None) -> dict[tuple, bytes]:
                 regions, size = image_copy_regions(res, whole)
             else:
                 regions, size = None, int(res["size_bytes"] or res["bytes"])
-            buf = HostBuffer.create(ex.device, size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT)
+            buf = HostBuffer.create(ex.device, size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback=True)
             ex.host_buffers.append(buf)
             jobs.append((res, r, buf, regions, size))
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rgraph.vk.device import wait_idle_for_teardown
 from rgraph.vk.instance import ValidationMessage
 from rgraph.vk.loader import vk
 
@@ -16,7 +17,7 @@ def close(ex: Any) -> list[ValidationMessage]:
     dev = ex.device
     if dev is not None and dev.handle is not None:
         ex.log.context = "teardown"
-        v.vkDeviceWaitIdle(dev.handle)
+        wait_idle_for_teardown(dev.handle)
         for fences in ex.fences:
             for f in fences:
                 v.vkDestroyFence(dev.handle, f, None)

@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import NamedTuple
 
 from rgraph.compiler.read_layouts import unify_read_layouts
@@ -104,7 +105,7 @@ class _Cell:
         reads = self.reads
         if len(reads) == 1:
             return reads[0][1]
-        return EMPTY.union(*(s for _, s in reads))
+        return EMPTY.union(*[s for _, s in reads])
 
 
 class _Use(NamedTuple):
@@ -114,22 +115,22 @@ class _Use(NamedTuple):
     queue: str
 
 
+@lru_cache(maxsize=4096)
+def _sync(usage: str, kind: str, stages: tuple[str, ...] | None, image: bool, depth: bool, stencil: bool,
+          refit: bool) -> Sync:
+    """``sync_of`` by position (a positional cache key is cheaper to build than keywords)."""
+    return sync_of(usage, kind, explicit_stages=stages, is_image=image, depth_format=depth, stencil_format=stencil,
+                   refit=refit)
+
+
 def access_syncs(p: PassSpec, resources: Mapping[str, ResourceSpec]) -> list[Sync]:
     out = []
+    kind = p.kind
     for a in p.accesses:
         res = resources[a.resource]
         fmt = res.format
-        out.append(
-            sync_of(
-                a.usage,
-                p.kind,
-                explicit_stages=a.stages,
-                is_image=res.is_image,
-                depth_format=bool(fmt and fmt.has_depth),
-                stencil_format=bool(fmt and fmt.has_stencil),
-                refit=a.refit,
-            )
-        )
+        out.append(_sync(a.usage, kind, a.stages, res.kind == "image", bool(fmt and fmt.has_depth),
+                         bool(fmt and fmt.has_stencil), a.refit))
     return out
 
 
@@ -174,16 +175,16 @@ def synchronize(
 
     # Frame 1 from scratch gives the end-of-frame state; frame 2 starts persistent cells there.
     needed = {r for r, res in resources.items() if res.lifetime in PERSISTENT}
-    first = _Simulation(passes, per_pass_cells, timeline, resources)
+    first_cells: dict[Cell, _Cell] = {}
     if needed:
-        if not all(c[0] in needed for c in timeline):
-            first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
-        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})
+        first = _Simulation(passes, per_pass_cells, timeline, resources)
+        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})  # the other cells are skipped
+        first_cells = first.cells
     start: dict[Cell, _Cell] = {}
     for c in timeline:
         res = resources[c[0]]
         if res.lifetime in PERSISTENT:
-            st = first.cells[c]
+            st = first_cells[c]
             write = (PREVIOUS_FRAME, st.write[1], st.write[2]) if st.write else None
             reads = [(PREVIOUS_FRAME, stages) for _, stages in st.reads]
             start[c] = _Cell(
@@ -321,13 +322,16 @@ class _Simulation:
         self.image = {name: res.is_image for name, res in resources.items()}
 
     def run_states(self, start: dict[Cell, _Cell]) -> None:
-        """``run`` for the cells' end states only: the barriers it would derive are not kept."""
+        """``run`` for the end states of the cells in ``start`` only (others are skipped): the
+        barriers it would derive are not kept."""
         self.cells = cells_now = start
-        step = self._step
+        step, get = self._step, cells_now.get
         for i, p in enumerate(self.passes):
             queue = p.queue
             for c, (s, w) in self.per_pass_cells[i].items():
-                step(c, cells_now[c], i, queue, s, w)
+                cell = get(c)
+                if cell is not None:
+                    step(c, cell, i, queue, s, w)
 
     def run(self, start: dict[Cell, _Cell], alias_starts: _AliasStarts | None = None) -> None:
         self.cells = cells_now = start

@@ -7,7 +7,8 @@ it in time and can hold it (aligned); when no gap fits it goes on top of them.
 from __future__ import annotations
 
 from bisect import bisect_left, insort
-from collections.abc import Iterator, Sequence
+from collections.abc import Collection, Iterable, Iterator, Sequence
+from itertools import repeat
 
 from rgraph.memory.instance import Instance
 
@@ -23,31 +24,40 @@ def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None
     if 4 * inst.pair_count >= inst.n * inst.n:
         return _dense_best_fit(inst, order, give_up_at)
     offsets = [-1] * inst.n
-    placed: list[tuple[int, int] | None] = [None] * inst.n  # (offset, top) once placed
+    placed: list[tuple[int, int, int] | None] = [None] * inst.n  # (offset, top, block) once placed
     size, align, neighbors = inst.size, inst.align, inst.neighbors
     get = placed.__getitem__
     limit = give_up_at if give_up_at is not None else -1
     for i in order:
-        need, a = size[i], align[i]
-        best_off, best_gap = -1, -1
-        cursor = 0
-        for lo, hi in sorted(filter(None, map(get, neighbors[i]))):
-            if lo > cursor:
-                aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
-                if aligned + need <= lo:
-                    gap = lo - cursor
-                    if best_gap < 0 or gap < best_gap:
-                        best_off, best_gap = aligned, gap
-            if hi > cursor:
-                cursor = hi
-        if best_off < 0:
-            best_off = cursor if cursor % a == 0 else cursor + a - cursor % a
-        top = best_off + need
-        if 0 <= limit <= top:
+        need = size[i]
+        off = _fit(sorted(filter(None, map(get, neighbors[i]))), need, align[i])
+        if 0 <= limit <= off + need:
             return None
-        offsets[i] = best_off
-        placed[i] = (best_off, top)
+        offsets[i] = off
+        placed[i] = (off, off + need, i)
     return offsets
+
+
+def _fit(taken: Iterable[tuple[int, int, int]], need: int, a: int, skip: Collection[int] = frozenset()) -> int:
+    """The offset best fit gives a block of ``need`` bytes aligned to ``a`` among the
+    ``(start, end, block)`` byte ranges ``taken`` (ascending by start) of the blocks not in
+    ``skip``: the start of the smallest gap that holds it, else the top of them all."""
+    best_off, best_gap = -1, -1
+    cursor = 0
+    for lo, hi, j in taken:
+        if j in skip:
+            continue
+        if lo > cursor:
+            aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
+            if aligned + need <= lo:
+                gap = lo - cursor
+                if best_gap < 0 or gap < best_gap:
+                    best_off, best_gap = aligned, gap
+        if hi > cursor:
+            cursor = hi
+    if best_off < 0:
+        best_off = cursor if cursor % a == 0 else cursor + a - cursor % a
+    return best_off
 
 
 def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None) -> list[int] | None:
@@ -57,7 +67,7 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
     its non-neighbours; one with fewer neighbours sorts its placed ones."""
     n = inst.n
     offsets = [-1] * n
-    placed: list[tuple[int, int] | None] = [None] * n  # (offset, top) once placed
+    placed: list[tuple[int, int, int] | None] = [None] * n  # (offset, top, block) once placed
     size, align, neighbors = inst.size, inst.align, inst.neighbors
     get = placed.__getitem__
     every: list[tuple[int, int, int]] = []  # (offset, top, block) of the placed blocks, sorted
@@ -67,53 +77,21 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
     far = inst.non_neighbors
     limit = give_up_at if give_up_at is not None else -1
     for i in order:
-        need, a = size[i], align[i]
-        row = neighbors[i]
-        best_off, best_gap = -1, -1
-        cursor = 0
-        if len(every) < 2 * len(row) + 16 and far(i).isdisjoint(placed_set):
-            # every placed block is a neighbour: the gaps are those of their union
-            for lo, hi in zip(union_lo, union_hi, strict=True):
-                if lo > cursor:
-                    aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
-                    if aligned + need <= lo:
-                        gap = lo - cursor
-                        if best_gap < 0 or gap < best_gap:
-                            best_off, best_gap = aligned, gap
-                cursor = hi
-        elif len(every) < 2 * len(row) + 16:
-            skip = far(i)
-            for lo, hi, j in every:
-                if j in skip:
-                    continue
-                if lo > cursor:
-                    aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
-                    if aligned + need <= lo:
-                        gap = lo - cursor
-                        if best_gap < 0 or gap < best_gap:
-                            best_off, best_gap = aligned, gap
-                if hi > cursor:
-                    cursor = hi
+        need, row = size[i], neighbors[i]
+        if len(every) >= 2 * len(row) + 16:
+            off = _fit(sorted(filter(None, map(get, row))), need, align[i])
+        elif far(i).isdisjoint(placed_set):  # every placed block is a neighbour: their union's gaps
+            off = _fit(zip(union_lo, union_hi, repeat(-1)), need, align[i])
         else:
-            for lo, hi in sorted(filter(None, map(get, row))):
-                if lo > cursor:
-                    aligned = cursor if cursor % a == 0 else cursor + a - cursor % a
-                    if aligned + need <= lo:
-                        gap = lo - cursor
-                        if best_gap < 0 or gap < best_gap:
-                            best_off, best_gap = aligned, gap
-                if hi > cursor:
-                    cursor = hi
-        if best_off < 0:
-            best_off = cursor if cursor % a == 0 else cursor + a - cursor % a
-        top = best_off + need
+            off = _fit(every, need, align[i], far(i))
+        top = off + need
         if 0 <= limit <= top:
             return None
-        offsets[i] = best_off
-        placed[i] = (best_off, top)
-        insort(every, (best_off, top, i))
+        offsets[i] = off
+        placed[i] = entry = (off, top, i)
+        insort(every, entry)
         placed_set.add(i)
-        _merge(union_lo, union_hi, best_off, top)
+        _merge(union_lo, union_hi, off, top)
     return offsets
 
 

@@ -44,17 +44,19 @@ def register(sub: argparse._SubParsersAction) -> None:
                        help="every setting a Ray task in its own worker process (one GPU each on a GPU "
                             "cluster); ADDRESS of a running cluster, else RAY_ADDRESS or a new local one "
                             "(pip install 'rgraph[ray]')")
+    parser.add_argument("--per-worker", type=int, default=1, metavar="K",
+                        help="with --workers: settings one worker process renders on one device before a "
+                             "fresh process takes its place (default 1)")
     parser.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     parser.add_argument("-o", "--out", type=Path, required=True, help="output folder")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from rgraph.sweep import flip
     from rgraph.sweep.parallel import make_executor
     from rgraph.sweep.runner import SweepRequest, run_sweep
     from rgraph.sweep.settings import parse_assignments, parse_knob
-    from rgraph.sweep.writers import plot_metric, write_all
+    from rgraph.sweep.writers import write_sweep
     from rgraph.vk.errors import ExecutionError, VulkanUnavailable
 
     if args.frames < 1:
@@ -66,8 +68,11 @@ def run(args: argparse.Namespace) -> int:
         policy=args.policy, hdr=args.hdr, validate=args.validate)
     if args.workers is not None and args.workers < 1:
         raise RGraphError.in_file("<command line>", f"--workers must be at least 1, got {args.workers}")
+    if args.per_worker < 1:
+        raise RGraphError.in_file("<command line>", f"--per-worker must be at least 1, got {args.per_worker}")
     try:
-        executor = make_executor(args.workers, args.ray, use_ray=args.ray is not None)
+        executor = make_executor(args.workers, args.ray, use_ray=args.ray is not None,
+                                 tasks_per_worker=args.per_worker)
     except ImportError:
         print("rgraph: error: --ray needs Ray: pip install 'rgraph[ray]'", file=sys.stderr)
         return 2
@@ -79,13 +84,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if executor is not None:
             executor.close()
-    note = flip.missing_note()
-    if note and note not in result.notes:
-        result.notes.append(note)
-    chosen = plot_metric(result, args.metric)
-    if args.metric and chosen != args.metric:
-        result.notes.append(f"--metric {args.metric}: no values; plots show {chosen or 'nothing'}")
-    written = write_all(result, args.out, chosen)
+    written, _ = write_sweep(result, args.out, args.metric)
     for line in result.notes:
         print(f"rgraph: note: {line}", file=sys.stderr)
     messages = result.messages()

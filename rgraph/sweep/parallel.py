@@ -10,6 +10,7 @@ Ray is imported only by :class:`RayBackend`.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import multiprocessing.connection
 import os
@@ -75,6 +76,11 @@ class Executor:
     def description(self) -> str:
         return self.backend.description
 
+    @property
+    def timing_lock(self) -> str | None:
+        """The file its local workers lock around timed frames (None: they do not share one machine)."""
+        return getattr(self.backend, "timing_lock", None)
+
     def run(self, fn: Callable[[Any], Any], items: Iterable[tuple[Hashable, Any]]) -> Iterator[Outcome]:
         """``fn(arg)`` for every ``(key, arg)``, each in a fresh worker process; yields as
         tasks finish. ``items`` is read only when a slot is free (all at once without a slot
@@ -124,12 +130,6 @@ class Executor:
 
 
 # ------------------------------------------------------------------ local processes
-@dataclass(eq=False)
-class _Child:
-    process: Any
-    conn: Any
-
-
 def _child_main(conn: Any, fn: Callable[[Any], Any], arg: Any) -> None:
     result = call(fn, arg)
     try:
@@ -139,54 +139,132 @@ def _child_main(conn: Any, fn: Callable[[Any], Any], arg: Any) -> None:
     conn.close()
 
 
-class ProcessBackend:
-    """``workers`` spawned processes at a time; each runs one task and exits (no state, no
-    device, no driver instance outlives its task)."""
+def _serve(conn: Any, tasks: int) -> None:
+    """A long-lived worker: up to ``tasks`` ``(fn, arg)`` from ``conn``, each answered with
+    :func:`call`'s result, then exit (a spawned process exits through ``sys.exit``, so its
+    ``atexit`` handlers run: e.g. a device kept open across tasks is closed)."""
+    for _ in range(tasks):
+        try:
+            job = conn.recv()
+        except EOFError:
+            break
+        if job is None:
+            break
+        result = call(*job)
+        try:
+            conn.send(result)
+        except Exception as exc:  # noqa: BLE001 - e.g. an unpicklable result
+            conn.send(("error", f"result could not be sent back: {describe(exc)}"))
+    conn.close()
 
-    def __init__(self, workers: int) -> None:
+
+@dataclass(eq=False)
+class _Worker:
+    process: Any
+    conn: Any
+    done: int = 0
+    busy: bool = False
+
+
+class ProcessBackend:
+    """``workers`` spawned processes at a time. ``tasks_per_worker`` 1 (default): each runs one
+    task and exits (no state, no device, no driver instance outlives its task); K > 1: a
+    worker takes up to K tasks one after another (saving the process's start: imports, a
+    Vulkan instance and device, which a task may keep open for the next one), then exits
+    and a fresh one takes its place. A worker that dies loses only its current task."""
+
+    def __init__(self, workers: int, tasks_per_worker: int = 1) -> None:
         if workers < 1:
             raise ValueError(f"workers must be at least 1, got {workers}")
+        if tasks_per_worker < 1:
+            raise ValueError(f"tasks per worker must be at least 1, got {tasks_per_worker}")
         self.slots: int | None = workers
-        self.description = f"{workers} local worker process{'es' if workers > 1 else ''}"
+        self.tasks_per_worker = tasks_per_worker
+        self.description = (f"{workers} local worker process{'es' if workers > 1 else ''}"
+                            + (f" ({tasks_per_worker} settings each)" if tasks_per_worker > 1 else ""))
         self._ctx = multiprocessing.get_context("spawn")
+        self._idle: list[_Worker] = []
+        self.timing_lock: str | None = None  # workers lock it around timed frames (rgraph.sweep.remote)
+        if workers > 1:
+            import tempfile
 
-    def start(self, fn: Callable[[Any], Any], arg: Any) -> _Child:
-        recv, send = self._ctx.Pipe(duplex=False)
-        process = self._ctx.Process(target=_child_main, args=(send, fn, arg), daemon=True)
-        process.start()
-        send.close()
-        return _Child(process, recv)
+            handle, self.timing_lock = tempfile.mkstemp(prefix="rgraph-timing-", suffix=".lock")
+            os.close(handle)
+
+    def start(self, fn: Callable[[Any], Any], arg: Any) -> _Worker:
+        if self.tasks_per_worker == 1:
+            recv, send = self._ctx.Pipe(duplex=False)
+            process = self._ctx.Process(target=_child_main, args=(send, fn, arg), daemon=True)
+            process.start()
+            send.close()
+            return _Worker(process, recv, busy=True)
+        worker = None
+        while self._idle and worker is None:
+            worker = self._idle.pop()
+            if not worker.process.is_alive():  # died while idle
+                worker.process.join()
+                worker.conn.close()
+                worker = None
+        if worker is None:
+            mine, theirs = self._ctx.Pipe(duplex=True)
+            process = self._ctx.Process(target=_serve, args=(theirs, self.tasks_per_worker), daemon=True)
+            process.start()
+            theirs.close()
+            worker = _Worker(process, mine)
+        worker.busy = True
+        worker.conn.send((fn, arg))
+        return worker
 
     def wait(self, handles: list[Hashable]) -> list[tuple[Hashable, Status, Any]]:
-        children: list[_Child] = handles  # type: ignore[assignment]
+        workers: list[_Worker] = handles  # type: ignore[assignment]
         ready = set(multiprocessing.connection.wait(
-            [c.conn for c in children] + [c.process.sentinel for c in children]))
+            [w.conn for w in workers] + [w.process.sentinel for w in workers]))
         done = []
-        for c in children:
-            if c.conn not in ready and c.process.sentinel not in ready:
+        for w in workers:
+            if w.conn not in ready and w.process.sentinel not in ready:
                 continue
             status, value = "lost", None
             try:
-                if c.conn.poll():
-                    status, value = c.conn.recv()
+                if w.conn.poll():
+                    status, value = w.conn.recv()
             except (EOFError, OSError):
                 pass
-            c.process.join()
-            c.conn.close()
+            w.busy, w.done = False, w.done + 1
+            if status != "lost" and self.tasks_per_worker > 1 and w.done < self.tasks_per_worker:
+                self._idle.append(w)  # it takes the next task
+            else:
+                w.process.join()
+                w.conn.close()
             if status == "lost":
-                code = c.process.exitcode
+                code = w.process.exitcode
                 value = (f"worker process killed by signal {-code}" if code is not None and code < 0
                          else f"worker process exited with code {code} without a result")
-            done.append((c, status, value))
+            done.append((w, status, value))
         return done
 
     def cancel(self, handles: list[Hashable]) -> None:
-        for c in handles:
-            c.process.kill()  # type: ignore[attr-defined]
-            c.process.join()  # type: ignore[attr-defined]
+        for w in handles:
+            w.process.kill()  # type: ignore[attr-defined]
+            w.process.join()  # type: ignore[attr-defined]
 
     def close(self) -> None:
-        pass
+        """Let the idle workers exit."""
+        for w in self._idle:
+            try:
+                w.conn.send(None)
+            except OSError:
+                pass
+        for w in self._idle:
+            w.process.join(timeout=30)
+            if w.process.is_alive():
+                w.process.kill()
+                w.process.join()
+            w.conn.close()
+        self._idle = []
+        if self.timing_lock:
+            with contextlib.suppress(OSError):
+                os.remove(self.timing_lock)
+            self.timing_lock = None
 
 
 # ------------------------------------------------------------------ Ray
@@ -258,10 +336,12 @@ def assigned_gpu() -> int | None:
     return int(ids[0]) if ids else None
 
 
-def make_executor(workers: int | None = None, ray: str | None = None, *, use_ray: bool = False) -> Executor | None:
-    """The executor of ``--workers N`` / ``--ray [ADDRESS]``; None for the one-process path."""
+def make_executor(workers: int | None = None, ray: str | None = None, *, use_ray: bool = False,
+                  tasks_per_worker: int = 1) -> Executor | None:
+    """The executor of ``--workers N`` (``tasks_per_worker``: settings per worker process) /
+    ``--ray [ADDRESS]``; None for the one-process path."""
     if use_ray:
         return Executor(RayBackend(ray))
     if workers is not None:
-        return Executor(ProcessBackend(workers))
+        return Executor(ProcessBackend(workers, tasks_per_worker))
     return None

@@ -13,6 +13,7 @@ by name and file, and imports them first.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import importlib
 import importlib.util
@@ -40,6 +41,7 @@ class RenderJob:
     modules: tuple[tuple[str, str | None], ...]  # (name, file) of modules registering the graph's impls
     fault: str | None = None
     reference: Any = None  # the reference's Images once rendered: the worker compares with it
+    timing_lock: str | None = None  # file locked around the timed frames (local workers sharing a GPU)
 
 
 def implementation_modules(impls: set[str]) -> tuple[tuple[str, str | None], ...]:
@@ -64,19 +66,32 @@ def _graph_impls(request: Any) -> set[str]:
     return {p.model.impl for p in source.passes.values() if getattr(p.model, "impl", None)}
 
 
-def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
-         env: Mapping[str, str] | None = None) -> Iterator[tuple[Any, RenderJob]]:
-    """(params key, job) per distinct setting, in the given order (the reference first).
-    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
-    so its worker computes the metrics too."""
+def job_maker(request: Any, env: Mapping[str, str] | None = None,
+              timing_lock: str | None = None) -> Callable[[Setting, Any], RenderJob]:
+    """``make(setting, reference_images)``: the job of one setting of ``request`` (graph and
+    scene paths made absolute, the caller's ``sys.path`` and implementation modules;
+    ``timing_lock``: :func:`timed_alone`)."""
     env = os.environ if env is None else env
     fault = env.get(KILL_ENV) or None
     request = dataclasses.replace(request, graph=_absolute(request.graph), scene=_absolute(request.scene))
     sys_path = tuple(p for p in sys.path if p)
     modules = implementation_modules(_graph_impls(request))
+
+    def make(setting: Setting, reference: Any = None) -> RenderJob:
+        return RenderJob(request, setting, sys_path, modules, fault,
+                         None if setting.label == "reference" else reference, timing_lock)
+
+    return make
+
+
+def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
+         env: Mapping[str, str] | None = None, timing_lock: str | None = None) -> Iterator[tuple[Any, RenderJob]]:
+    """(params key, job) per distinct setting, in the given order (the reference first).
+    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
+    so its worker computes the metrics too."""
+    make = job_maker(request, env, timing_lock)
     for key, setting in settings.items():
-        images = reference() if reference is not None and setting.label != "reference" else None
-        yield key, RenderJob(request, setting, sys_path, modules, fault, images)
+        yield key, make(setting, reference() if reference is not None and setting.label != "reference" else None)
 
 
 def _absolute(path: str | None) -> str | None:
@@ -140,8 +155,54 @@ def _device_index(request: Any) -> int | None:
         instance.destroy()
 
 
+@contextlib.contextmanager
+def timed_alone(path: str | None) -> Iterator[None]:
+    """Hold the exclusive lock on file ``path`` (none: no lock): local workers take it around
+    their warm-up, timed frames and read-back, so no other worker's frames share the GPU while
+    one is timed; compiles, pipelines, uploads, PNG and metrics still overlap."""
+    if not path:
+        yield
+        return
+    import fcntl
+
+    with open(path, "a") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)
+
+
+_DEVICES: dict[tuple[bool, int | None], Any] = {}  # kept open for a worker's next setting
+
+
+def _open(validate: bool, device: int | None) -> Any:
+    """The worker's device (``rgraph.open_device``), opened once and closed at exit."""
+    import atexit
+
+    from rgraph.api import open_device
+
+    key = (validate, device)
+    if key not in _DEVICES:
+        gpu = _DEVICES[key] = open_device(validate=validate, device=device, verbose=False)
+        atexit.register(gpu.close)
+    return _DEVICES[key]
+
+
+def _drop(validate: bool, device: int | None) -> None:
+    import atexit
+
+    gpu = _DEVICES.pop((validate, device), None)
+    if gpu is not None:
+        atexit.unregister(gpu.close)
+        gpu.close()
+
+
 def render_job(job: RenderJob) -> Any:
-    """Compile and render one setting (in a worker process): a runner ``_Rendering``."""
+    """Compile and render one setting (in a worker process): a runner ``_Rendering``. The
+    device stays open for the worker's next setting (``--workers`` with several settings per
+    worker), as the one-process sweep renders every setting on one device; a failed setting
+    closes it."""
     from rgraph.sweep.runner import _compile_all, _render
 
     _prepare(job)
@@ -150,11 +211,13 @@ def render_job(job: RenderJob) -> Any:
     index = _device_index(request)
     if index != request.device:
         request = dataclasses.replace(request, device=index)
-    from rgraph.api import open_device
-
-    with open_device(validate=request.validate, device=request.device, verbose=False) as gpu:
+    gpu = _open(request.validate, request.device)
+    try:
         (plan,) = _compile_all(request, [job.setting], gpu).values()
-        rendering = _render(request, plan, gpu)
+        rendering = _render(request, plan, gpu, timed_alone(job.timing_lock))
+    except BaseException:
+        _drop(request.validate, request.device)
+        raise
     if job.reference is not None:
         from rgraph.sweep.compare import compare
 

@@ -8,6 +8,7 @@ as it comes, in any order, and orders the rows as the settings.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -127,14 +128,18 @@ def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: boo
     return labels
 
 
-def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
-              executor: Executor | None = None) -> SweepResult:
-    """Render every setting of ``request``; write images and error maps under ``out_dir``.
+@dataclass
+class Prepared:
+    """A sweep ready to render: its distinct settings (params key -> first setting with
+    those params, the reference first) and the collector that takes their renderings."""
 
-    ``executor`` (``rgraph.sweep.parallel``): every distinct setting in its own worker
-    process, compiled and rendered there; a setting that fails twice is reported in
-    ``SweepResult.failures`` and its row left empty. Without one, every setting renders here,
-    one after the other, and the first failure raises."""
+    request: SweepRequest
+    distinct: dict[tuple, Setting]
+    collector: Any  # rgraph.sweep.collect.Collector
+
+
+def prepare(request: SweepRequest, out_dir: Path) -> Prepared:
+    """Expand ``request``'s settings (bad knobs fail here, before anything renders)."""
     from rgraph.sweep.collect import Collector
 
     source = load_graph(resolve_graph(request.graph))
@@ -143,8 +148,21 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
     distinct: dict[tuple, Setting] = {}
     for s in settings:
         distinct.setdefault(params_key(resolved_params[s.label]), s)
-    collector = Collector(request, settings, resolved_params, out_dir)
-    with _progress_bar(progress, len(distinct)) as bar:
+    return Prepared(request, distinct, Collector(request, settings, resolved_params, out_dir))
+
+
+def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
+              executor: Executor | None = None) -> SweepResult:
+    """Render every setting of ``request``; write images and error maps under ``out_dir``.
+
+    ``executor`` (``rgraph.sweep.parallel``): every distinct setting in its own worker
+    process, compiled and rendered there; a setting that fails twice is reported in
+    ``SweepResult.failures`` and its row left empty. Without one, every setting renders here,
+    one after the other, and the first failure raises. Several sweeps through one pool of
+    workers: :func:`rgraph.sweep.pool.run_groups`."""
+    sweep = prepare(request, out_dir)
+    distinct, collector = sweep.distinct, sweep.collector
+    with progress_bar(progress, len(distinct)) as bar:
         if executor is None:
             from rgraph.api import open_device
 
@@ -156,7 +174,8 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
         else:
             from rgraph.sweep.remote import jobs, render_job
 
-            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images)):
+            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images,
+                                                         timing_lock=executor.timing_lock)):
                 collector.add(outcome.key, outcome.value, outcome.error)
                 bar.finished(distinct[outcome.key].label + ("" if outcome.ok else " (failed)"))
     return collector.result()
@@ -177,8 +196,13 @@ def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> di
     return plans
 
 
-def _render(request: SweepRequest, plan: dict, gpu: Any) -> _Rendering:
-    result = gpu.load(plan).run_and_check(request.frames, check_data=False, read_outputs=True,
+def _render(request: SweepRequest, plan: dict, gpu: Any, timing: Any = None) -> _Rendering:
+    """Load ``plan`` on ``gpu``, warm up, time ``request.frames`` frames and read back; ``timing``:
+    a context manager held around the warm-up, the timed frames and the read-back (the lock
+    that keeps other local workers' frames off the GPU meanwhile: :mod:`rgraph.sweep.remote`)."""
+    executable = gpu.load(plan)
+    with timing or contextlib.nullcontext():
+        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True,
                                           warmup_s=request.warmup_s)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
@@ -197,7 +221,7 @@ def _render(request: SweepRequest, plan: dict, gpu: Any) -> _Rendering:
                       None if ldr is None else image_io.png_bytes(ldr))
 
 
-class _progress_bar:
+class progress_bar:
     """A rich progress bar on stderr (or nothing): ``step`` names the next rendering here,
     ``finished`` counts one that a worker finished."""
 
@@ -206,7 +230,7 @@ class _progress_bar:
         self.bar: Any = None
         self.task: Any = None
 
-    def __enter__(self) -> _progress_bar:
+    def __enter__(self) -> progress_bar:
         if self.enabled:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn

@@ -164,3 +164,17 @@ def write_all(result: SweepResult, out_dir: Path, metric: str | None = None) -> 
     (out_dir / "sweep.md").write_text(markdown(result, plots, chosen) + "\n")
     return {"csv": out_dir / "sweep.csv", "md": out_dir / "sweep.md",
             **{f"plot:{k}": out_dir / v for k, v in plots.items()}}
+
+
+def write_sweep(result: SweepResult, out_dir: Path, wanted: str | None = None) -> tuple[dict[str, Path], str | None]:
+    """What ``rgraph sweep`` writes for ``result``: its notes completed (FLIP missing, an
+    empty ``--metric``), then :func:`write_all`. Returns (what was written, metric plotted)."""
+    from rgraph.sweep import flip
+
+    note = flip.missing_note()
+    if note and note not in result.notes:
+        result.notes.append(note)
+    chosen = plot_metric(result, wanted)
+    if wanted and chosen != wanted:
+        result.notes.append(f"--metric {wanted}: no values; plots show {chosen or 'nothing'}")
+    return write_all(result, out_dir, chosen), chosen

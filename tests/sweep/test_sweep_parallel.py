@@ -102,3 +102,69 @@ def test_items_are_read_when_a_slot_frees():
 
     assert [o.key for o in Executor(backend).run(str, items())] == ["a", "b", "c"]
     assert seen == [("a", []), ("b", ["a"]), ("c", ["a", "b"])]
+
+
+def _pid_or_die(arg):
+    if arg == "die":
+        os._exit(5)
+    return os.getpid()
+
+
+def test_process_backend_k_tasks_per_worker_then_a_fresh_one():
+    """One worker, 3 tasks each: tasks 0-2 share a process, 3-5 the next; neither is the caller."""
+    backend = ProcessBackend(1, tasks_per_worker=3)
+    with Executor(backend) as executor:
+        pids = [o.value for o in executor.run(_pid, [(i, i) for i in range(6)])]
+    assert pids[0] == pids[1] == pids[2] != pids[3] == pids[4] == pids[5] and os.getpid() not in pids
+    assert backend.timing_lock is None  # one worker: nothing to share the GPU with
+
+
+def test_a_worker_that_dies_loses_only_its_task_and_the_lock_goes():
+    backend = ProcessBackend(2, tasks_per_worker=4)
+    lock = backend.timing_lock
+    assert lock and os.path.isfile(lock)  # two workers time their frames under it
+    with Executor(backend, retries=0) as executor:
+        got = {o.key: o for o in executor.run(_pid_or_die, [("a", "a"), ("die", "die"), ("b", "b"), ("c", "c")])}
+    assert got["die"].error == "attempt 1: worker process exited with code 5 without a result"
+    assert all(got[k].ok for k in "abc") and os.getpid() not in {got[k].value for k in "abc"}
+    assert not os.path.exists(lock) and backend.timing_lock is None
+
+
+def test_bad_tasks_per_worker():
+    import pytest
+
+    with pytest.raises(ValueError, match="tasks per worker must be at least 1"):
+        ProcessBackend(2, tasks_per_worker=0)
+
+
+def _time_under_lock(path):
+    import time
+
+    from rgraph.sweep.remote import timed_alone
+
+    with timed_alone(path):
+        return time.time()
+
+
+def test_workers_wait_for_the_timing_lock(tmp_path):
+    """While one holder has the lock, no worker enters its timed section."""
+    import fcntl
+    import threading
+    import time
+
+    backend = ProcessBackend(2)
+    released: list[float] = []
+    with open(backend.timing_lock, "a") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+
+        def release():
+            time.sleep(1.5)
+            released.append(time.time())
+            fcntl.flock(held, fcntl.LOCK_UN)
+
+        thread = threading.Thread(target=release)
+        thread.start()
+        with Executor(backend) as executor:
+            entered = [o.value for o in executor.run(_time_under_lock, [(i, backend.timing_lock) for i in range(2)])]
+        thread.join()
+    assert len(entered) == 2 and min(entered) >= released[0]

@@ -121,3 +121,16 @@ def test_workers_started_after_the_reference_compare_with_it(one_process, tmp_pa
     out = tmp_path / "w1"
     assert sweep([*ARGS, "--workers", "1", "-o", str(out)]) == 0, capsys.readouterr().err
     assert differences(one_process, out) == []
+
+
+def test_several_settings_per_worker_give_the_one_process_sweep(one_process, tmp_path, capsys):
+    out = tmp_path / "k"
+    assert sweep([*ARGS, "--workers", "2", "--per-worker", "4", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "in 2 local worker processes (4 settings each)" in err and "0 validation message(s)" in err
+    assert differences(one_process, out) == []
+
+
+def test_bad_per_worker_is_a_located_error(tmp_path, capsys):
+    assert sweep([*ARGS, "--workers", "2", "--per-worker", "0", "-o", str(tmp_path / "x")]) == 2
+    assert "<command line>:1:1: error: --per-worker must be at least 1, got 0" in capsys.readouterr().err

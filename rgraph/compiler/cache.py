@@ -131,7 +131,8 @@ class PlanCache:
                   size: tuple[int, int]) -> Frontend:
         """``frontend``, with the loaded graph and scene kept while their files are unchanged:
         a changed param or size only specializes again."""
-        key = (str(Path(resolve_graph(str(graph))).resolve()), None if scene_path is None else str(scene_path))
+        key = (str(Path(resolve_graph(str(graph))).resolve()),
+               None if scene_path is None else str(Path(scene_path).resolve()))
         loaded = self._loaded.get(key)
         if loaded is None or not self._unchanged(loaded[0]):
             front = frontend(graph, scene_path, params, size)

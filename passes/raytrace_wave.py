@@ -2,13 +2,14 @@
 
 - ``rt_wave_shade`` (raytrace, every pixel): tree level 0. The first surface from the visibility
   buffer, its opaque part (Phong + shadow rays) or the sky; a surface that reflects or refracts
-  takes a slot of the pixel list (``ray_list``, ``ray_args`` = (resolve groups, 1, 1, count)),
+  takes a slot of the pixel list (``ray_list``, ``ray_args`` = (0, 1, 1, count)),
   stores its own radiance in accumulator ``slot`` (``wave_color``: 3 x uint64 fixed point) and
   appends its children to ``rays_1`` (count in ``rays_1_args``);
 - ``rt_wave`` (raytrace, ``trace_rays_indirect`` over ``rays_k``): tree level k, one closest-hit
   trace per ray, its radiance added to the owner's accumulator (64-bit integer atomics: the same
   sum in any order), children to ``rays_{k+1}`` when the pass writes it, else walked in-thread;
-- ``rt_wave_resolve`` (compute, indirect over the pixel list): the listed pixels' colours.
+- ``rt_wave_resolve`` (compute, over the accumulators' capacity; the count read from
+  ``ray_args``): the listed pixels' colours.
 
 Nothing is dropped: children that do not fit the next list, pixels past the accumulators'
 capacity and everything below the last list are walked in-thread by the stand-alone's stack walk.
@@ -153,20 +154,47 @@ class Wave(WaveImpl):
         rec.trace_rays_indirect(self.pipeline, rec.buffer_address(args))
 
 
+@register("rt_wave_listed")
+class WaveListed(WaveImpl):
+    """Level 0 of the pixels rt_classify listed (benchmarks/graphs/rt_hybrid_async.yaml): list
+    slot = accumulator slot; the other pixels are shaded by rt_hybrid_shade on another queue."""
+
+    raygen = "rt/hybrid_wave_listed.rgen"
+
+    def __init__(self, setup: Any) -> None:
+        extent = setup.extent_of("visibility")
+        if capacity(setup, "wave_color", ACCUM) < extent[0] * extent[1]:
+            raise ValueError(f"pass {setup.name!r}: wave_color must hold a slot per pixel ({ACCUM} bytes each)")
+        more, defines = wave_bindings(setup, 1)
+        super().__init__(setup, [*GBUFFER, Binding(9, "storage_image", "ray_list"), *more], defines, True)
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        self._bind(rec, frame_set)
+        rec.push(self.pipeline, self.push)
+        args, _size = self.setup.buffer("ray_args", frame_set)
+        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(args))
+
+
 @register("rt_wave_resolve")
 class WaveResolve(PassImpl):
     def __init__(self, setup: Any) -> None:
         super().__init__(setup)
         self.pipeline = None
-        if not wavefront(setup):
+        classified = any(p.get("impl") == "rt_classify" for p in setup.plan["passes"])  # count in word 0
+        if not (wavefront(setup) or classified):
             return
         self.sets = setup.descriptors([
             Binding(0, "storage_image", "color"), Binding(1, "storage_image", "ray_list"),
             Binding(2, "storage_buffer", "ray_args"), Binding(3, "storage_buffer", "wave_color")])
         extent = setup.extent_of("color")
         pixels = min(extent[0] * extent[1], capacity(setup, "wave_color", ACCUM))
+        defines: dict[str, object] = {"PIXEL_CAPACITY": f"{pixels}u"}
+        groups = -(-pixels // 64)
+        self.groups = (min(groups, 65535), -(-groups // 65535))  # maxComputeWorkGroupCount >= 65535
+        if classified:
+            defines["COUNT_AT_0"] = 1
         self.pipeline = setup.compute_pipeline("rt/wave_resolve.comp", [self.sets.layout], push_constant_bytes=4,
-                                               defines={"PIXEL_CAPACITY": f"{pixels}u"})
+                                               defines=defines)
         self.push = struct.pack("<I", extent[0])
 
     def record(self, rec: Any, frame_set: int) -> None:
@@ -174,5 +202,4 @@ class WaveResolve(PassImpl):
             return
         rec.bind(self.pipeline, [self.sets[frame_set]])
         rec.push(self.pipeline, self.push)
-        args, _size = self.setup.buffer("ray_args", frame_set)
-        rec.dispatch_indirect(args, 0)
+        rec.dispatch(*self.groups)

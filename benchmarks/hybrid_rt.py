@@ -47,6 +47,7 @@ RASTER_GRAPH = "rt_hybrid_raster"
 WARMUP_S = 0.3  # seconds of frames of every plan before timing (GPU clocks ramp up); rgraph.api.WARMUP_S
 CHUNK = 5       # frames per timed run; the plans alternate run by run
 WAVE_LEVELS = 3  # the wavefront ray lists of graphs/rt_hybrid.yaml (rays_1 .. rays_3)
+ASYNC_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_async.yaml"  # --async: matte pixels on the async queue
 
 
 def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: int, params: dict[str, str],
@@ -126,10 +127,11 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
-            hybrid_params: dict[str, str] | None = None) -> dict[str, Any]:
+            hybrid_params: dict[str, str] | None = None, async_shade: bool = False) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
-    side by side on ``gpu``."""
+    side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
+    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns)."""
     from rgraph.compiler.pipeline import compile_graph
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
@@ -138,6 +140,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs", *levels))}
     if raster:
         graphs["raster"] = (RASTER_GRAPH, ("visibility",))
+    if async_shade:
+        graphs["async"] = (str(ASYNC_GRAPH), ("ray_args",))
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera,
                                  params={**params, **(hybrid_params or {})} if name == "hybrid" else params,
                                  extra_outputs=list(extra), memory=gpu.memory_requirements())
@@ -157,6 +161,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
         header = np.frombuffer(out["vis_jobs"].tobytes()[:8], dtype=np.uint32)
         row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
+    if async_shade:
+        row.update(_hybrid_columns(runs["async"]["timings"], T, runs["async"]["outputs"], alone["outputs"], "async_"))
     if raster:
         raster_out = runs["raster"]["outputs"]
         row.update(_hybrid_columns(runs["raster"]["timings"], T, raster_out, alone["outputs"], "raster_"))
@@ -214,9 +220,12 @@ def _levels(row: dict[str, Any]) -> str:
 
 def table(rows: list[dict[str, Any]]) -> str:
     raster = any("raster_t_ms" in r for r in rows)
+    extra = any("async_t_ms" in r for r in rows)
     head = ("| scene | camera | T (ms) | t_a (ms) | t_a/T | t_b (ms) | t (ms) | t/T | PSNR (dB) | SSIM | FLIP "
             "| traced | rays per level | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
-            + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else ""))
+            + (" async t (ms) | async t/T | async PSNR (dB) |" if extra else "")
+            + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else "")
+            + ("---:|---:|---:|" if extra else ""))
     lines = [head]
     for r in rows:
         line = (f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
@@ -226,6 +235,9 @@ def table(rows: list[dict[str, Any]]) -> str:
         if raster:
             line += (f" {r['raster_t_b_ms']:.3f} | {r['raster_t_ms']:.3f} | {r['raster_t_over_T']:.2f} "
                      f"| {_fmt(r['raster_psnr_db'], '.1f')} |") if "raster_t_ms" in r else " - | - | - | - |"
+        if extra:
+            line += (f" {r['async_t_ms']:.3f} | {r['async_t_over_T']:.2f} | {_fmt(r['async_psnr_db'], '.1f')} |"
+                     if "async_t_ms" in r else " - | - | - |")
         lines.append(line)
     return "\n".join(lines)
 
@@ -253,6 +265,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--cameras", default="0,1,2,3,4")
     parser.add_argument("--max-depth", type=int, default=4)
+    parser.add_argument("--async", dest="async_shade", action="store_true",
+                        help="also time benchmarks/graphs/rt_hybrid_async.yaml (matte pixels shaded on the async queue)")
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                         help="a param of graphs/rt_hybrid.yaml for the hybrid (repeatable), e.g. rt.wave_subgroup=1")
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
@@ -276,7 +290,8 @@ def main(argv: list[str] | None = None) -> int:
             for scene in scenes:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
-                                        chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params))
+                                        chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
+                                        async_shade=args.async_shade))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

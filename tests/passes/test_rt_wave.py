@@ -10,6 +10,7 @@ lists (levels 4 and 5 are walked in-thread by the last list's rays):
 - full lists and full accumulators (tiny capacities) fall back to in-thread walks: same image;
 - ``rt.wavefront: 0`` (the path of devices without 64-bit atomics): same image, empty lists;
 - ``rt.wave_subgroup: 1`` (subgroup appends where the device has them): same lists and image;
+- benchmarks/graphs/rt_hybrid_async.yaml (matte pixels on the async queue): same lists and image;
 - the fixed-point accumulation is order-independent: two runs are bit-identical.
 Ray tracing passes run without the validation layer (docs/raytracing.md: the 1.3.239 layer
 crashes on ray tracing pipelines); the run's message log must still be empty.
@@ -40,7 +41,7 @@ def _run(graph: str, **params: str) -> dict:
     from rgraph.vk.executor import execute_plan
 
     plan = compile_graph(graph, scene_path=SCENE, size=(SIZE, SIZE), params={"rt.max_depth": str(DEPTH), **params},
-                         extra_outputs=["ray_args", *LISTS] if graph == "rt_hybrid" else [])
+                         extra_outputs=["ray_args", *LISTS] if graph != "rt_standalone" else [])
     try:
         result = execute_plan(plan, frames=1, read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
@@ -106,4 +107,17 @@ def test_subgroup_appends_give_the_same_lists_and_image(alone):
     operations (a GPU), else (lavapipe) per-ray atomics; either way the same trees and image."""
     out = _run("rt_hybrid", **{"rt.wave_subgroup": "1"})
     assert [int(_args(out, name)[0]) for name in LISTS] == [int(_args(_run("rt_hybrid"), name)[0]) for name in LISTS]
+    assert np.abs(_rgb(out) - alone).max() < 2e-3 and psnr(alone, _rgb(out)) > 70
+
+
+@pytest.mark.vulkan
+def test_the_async_variant_traces_the_same_trees(alone):
+    """benchmarks/graphs/rt_hybrid_async.yaml: classify + level 0 of the listed pixels on the
+    graphics queue, the matte pixels' shading on the compute queue, the same waves and resolve."""
+    from locations import ROOT
+
+    out = _run(str(ROOT / "benchmarks" / "graphs" / "rt_hybrid_async.yaml"))
+    hybrid = _run("rt_hybrid")
+    assert [int(_args(out, name)[0]) for name in LISTS] == [int(_args(hybrid, name)[0]) for name in LISTS]
+    assert _args(out, "ray_args")[0] > 0  # classify's list: (count, 1, 1)
     assert np.abs(_rgb(out) - alone).max() < 2e-3 and psnr(alone, _rgb(out)) > 70

@@ -26,8 +26,8 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.passkit import Binding
 
 from .raytrace_hybrid import prim_bits
-from .raytrace_wave import MAX_WAVE_RESETS, list_args
 from .raytrace_standalone import pack_tables
+from .raytrace_wave import MAX_WAVE_RESETS, list_args
 from .rt_model import camera_basis
 
 TILE = 32  # pixels per side of a tile job (shaders/rt/visraster.glsl)

@@ -29,6 +29,7 @@ from rgraph.vk.errors import VulkanUnavailable
 builtin_passes()
 from rgraph.passes.rt_model import build_tables, sky_cubemap  # noqa: E402
 from rgraph.passes.rt_ref import render  # noqa: E402
+
 from rgraph.scene.build import load_scene_data  # noqa: E402
 
 SCENE = TESTS / "data" / "rt" / "wave_tir.yaml"

@@ -38,7 +38,7 @@ class SweepRequest:
     policy: str | None = None
     hdr: str | None = None  # an intermediate image read back for HDR metrics
     validate: bool = False
-    warmup_s: float | None = None  # None: the device's default (api.Gpu.default_warmup_s)
+    warmup_s: float | None = None  # None: the device's default (api.Gpu.default_warmup_s); see warmup_frames
 
 
 @dataclass
@@ -196,14 +196,36 @@ def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> di
     return plans
 
 
+#: Untimed warm-up frames per second of ``--warmup`` (``warmup_frames``).
+WARMUP_FPS = 200
+
+
+def warmup_frames(request: SweepRequest, gpu: Any) -> int:
+    """Untimed frames before a setting's timed ones: ``--warmup`` seconds (default the
+    device's ``default_warmup_s``: 0.3 s on a GPU, none on a CPU device) times
+    :data:`WARMUP_FPS`, the same count for every setting. Not a wall-time warm-up: animated
+    scenes (``surgery``'s) move by frame index, so a wall-time warm-up would run a different
+    number of frames per setting and each image would show another moment of the animation
+    (errors against the reference that no knob caused, and outputs that differ run to run)."""
+    seconds = gpu.default_warmup_s if request.warmup_s is None else request.warmup_s
+    return max(1, round(seconds * WARMUP_FPS)) if seconds > 0 else 0
+
+
 def _render(request: SweepRequest, plan: dict, gpu: Any, timing: Any = None) -> _Rendering:
-    """Load ``plan`` on ``gpu``, warm up, time ``request.frames`` frames and read back; ``timing``:
-    a context manager held around the warm-up, the timed frames and the read-back (the lock
-    that keeps other local workers' frames off the GPU meanwhile: :mod:`rgraph.sweep.remote`)."""
+    """Load ``plan`` on ``gpu``, run :func:`warmup_frames` untimed frames, time
+    ``request.frames`` frames and read back; ``timing``: a context manager held around the
+    warm-up, the timed frames and the read-back (the lock that keeps other local workers'
+    frames off the GPU meanwhile: :mod:`rgraph.sweep.remote`)."""
     executable = gpu.load(plan)
+    warm = warmup_frames(request, gpu)
     with timing or contextlib.nullcontext():
-        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True,
-                                          warmup_s=request.warmup_s)
+        if warm:
+            try:
+                executable.run(warm)
+            except BaseException:
+                executable.close()
+                raise
+        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True, warmup_s=0.0)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None

@@ -109,6 +109,7 @@ class _Rendering:
     params_read: dict[str, list[str]] = field(default_factory=dict)  # pass -> params its impl looked up
     png: bytes | None = None  # the display image as PNG (encoded where it rendered: a worker, in parallel)
     compared: tuple[dict[str, float | None], list[str]] | None = None  # metrics, when a worker had the reference
+    error_maps: dict[str, dict[str, bytes]] = field(default_factory=dict)  # slug -> drawn maps (a worker's)
 
 
 def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: bool) -> list[str]:
@@ -174,7 +175,7 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
         else:
             from rgraph.sweep.remote import jobs, render_job
 
-            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images,
+            for outcome in executor.run(render_job, jobs(request, distinct, collector,
                                                          timing_lock=executor.timing_lock)):
                 collector.add(outcome.key, outcome.value, outcome.error)
                 bar.finished(distinct[outcome.key].label + ("" if outcome.ok else " (failed)"))

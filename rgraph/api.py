@@ -194,15 +194,35 @@ class Executable:
         log = self.gpu.instance.log.messages
         first = len(log)
         timings = self.executor.run_frames(frames, marks)
-        return RunSummary(timings, log[first:], self.executor.frames_done)
+        return RunSummary(timings, log[first:], self.content_frames)
 
-    def warm_up(self, seconds: float) -> int:
+    @property
+    def content_frames(self) -> int:
+        """Frames whose content has been rendered (frames run, less warm-up frames that do not count)."""
+        return self.executor.frames_done - self.executor.frame_origin
+
+    def warm_up(self, seconds: float, frames: int | None = None) -> int:
         """Run untimed frames for about ``seconds`` of wall time (at least one frame when
         ``seconds`` > 0) so that a GPU that idles at low clocks is at its working clocks when
-        timing starts; the frames count (the data check knows them). Returns the frames run."""
+        timing starts; ``frames``: exactly that many instead, whatever the wall time (sweeps:
+        the same count for every setting). Returns the frames run. When the plan carries no
+        state between frames (``rgraph.plan.state.carries_state``) the next frame's content is
+        frame 0 again (camera, animation, probe values), so images do not depend on how many
+        warm-up frames the wall time allowed; otherwise the warm-up frames count (the data
+        check knows them)."""
         from rgraph.vk.runtime.frames import run_for
 
-        return run_for(self.executor.run_frames, seconds) if seconds > 0 else 0
+        if (seconds <= 0) if frames is None else frames <= 0:
+            return 0
+        from rgraph.plan.state import carries_state
+
+        if frames is None:
+            frames = run_for(self.executor.run_frames, seconds)
+        else:
+            self.executor.run_frames(frames)
+        if not carries_state(self.plan):
+            self.executor.frame_origin = self.executor.frames_done
+        return frames
 
     def read_back(self) -> dict[tuple, bytes]:
         """Raw bytes per (resource, mip, layer) of outputs, persistent and imported resources."""
@@ -236,7 +256,7 @@ class Executable:
                 data = self.read_back()
                 result.outputs = decode_outputs(self.plan, data)
                 if check_data:
-                    verdict = check_outputs(self.plan, data, self.executor.frames_done)
+                    verdict = check_outputs(self.plan, data, self.content_frames)
                     result.data_ok, result.mismatches, result.unchecked = (verdict.ok, verdict.mismatches,
                                                                            verdict.unchecked)
                 if out_png is not None:

@@ -204,10 +204,11 @@ WARMUP_FPS = 200
 def warmup_frames(request: SweepRequest, gpu: Any) -> int:
     """Untimed frames before a setting's timed ones: ``--warmup`` seconds (default the
     device's ``default_warmup_s``: 0.3 s on a GPU, none on a CPU device) times
-    :data:`WARMUP_FPS`, the same count for every setting. Not a wall-time warm-up: animated
-    scenes (``surgery``'s) move by frame index, so a wall-time warm-up would run a different
-    number of frames per setting and each image would show another moment of the animation
-    (errors against the reference that no knob caused, and outputs that differ run to run)."""
+    :data:`WARMUP_FPS`, the same count for every setting. Plans that carry no state between
+    frames then start their content at frame 0 again (``Executable.warm_up``); for a plan
+    that does, a wall-time warm-up would run a different number of frames per setting and each
+    image would show another moment (errors that no knob caused, outputs that differ run to
+    run); a count keeps them the same."""
     seconds = gpu.default_warmup_s if request.warmup_s is None else request.warmup_s
     return max(1, round(seconds * WARMUP_FPS)) if seconds > 0 else 0
 
@@ -220,12 +221,11 @@ def _render(request: SweepRequest, plan: dict, gpu: Any, timing: Any = None) -> 
     executable = gpu.load(plan)
     warm = warmup_frames(request, gpu)
     with timing or contextlib.nullcontext():
-        if warm:
-            try:
-                executable.run(warm)
-            except BaseException:
-                executable.close()
-                raise
+        try:
+            executable.warm_up(0.0, frames=warm)
+        except BaseException:
+            executable.close()
+            raise
         result = executable.run_and_check(request.frames, check_data=False, read_outputs=True, warmup_s=0.0)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)

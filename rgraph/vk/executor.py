@@ -98,6 +98,9 @@ class Executor:
         self.host_buffers: list[HostBuffer] = []
         self.barrier_batches: list[BarrierBatch] = []
         self.frames_done = 0
+        # frames_done at the first frame whose content is frame 0 (``Executable.warm_up`` moves it
+        # past warm-up frames of a plan that carries no state between frames)
+        self.frame_origin = 0
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread with logic_hz (run_frames starts it)
         try:
             if self.instance.validate:

@@ -9,6 +9,8 @@ import pytest
 from locations import ROOT
 
 import rgraph
+from rgraph.api import plan_of
+from rgraph.plan.state import carries_state
 
 pytestmark = pytest.mark.vulkan
 
@@ -112,3 +114,26 @@ def test_warm_up_runs_untimed_frames_that_count(tmp_path):
         result = exe.run_and_check(2, check_data=True, warmup_s=0.02)
         assert result.timings["frames"] == 2 and result.data_ok
         assert [str(m) for m in result.messages] == []
+
+
+def _outputs_after(gpu, plan, warm_s: float, frames: int) -> dict:
+    exe = gpu.load(plan)
+    try:
+        exe.warm_up(warm_s)
+        exe.run(frames)
+        return exe.read_back()
+    finally:
+        exe.close()
+
+
+def test_warm_up_does_not_change_the_image():
+    """A plan with no state between frames renders after a warm-up exactly what it renders
+    cold: the warm-up frames do not advance the content frame (the GPU's image would otherwise
+    depend on how many frames the warm-up's wall time allowed: H200 sweeps, session 8)."""
+    with rgraph.open_device(validate=True, verbose=False) as gpu:
+        plan = rgraph.compile("surgery", size=(32, 32), device=gpu)  # the neck deforms frame by frame
+        assert not carries_state(plan_of(plan))
+        cold2, cold3 = _outputs_after(gpu, plan, 0, 2), _outputs_after(gpu, plan, 0, 3)
+        assert cold2 != cold3  # the content depends on the frame: the comparison below has teeth
+        assert _outputs_after(gpu, plan, 0.05, 2) == cold2
+        assert [str(m) for m in gpu.messages] == []

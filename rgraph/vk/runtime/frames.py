@@ -79,6 +79,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     timed = marks is not None
     mark = marks.append if marks is not None else None
     base = ex.frames_done
+    origin = getattr(ex, "frame_origin", 0)
     logic = ex.logic
     update_s = np.zeros(frames)
     thread_t0 = time.thread_time()
@@ -127,10 +128,11 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if logic is not None and logic.error is not None:
                 raise ExecutionError(f"frame {frame}: the logic thread failed: {logic.error!r}")
             u0 = perf()
+            content = frame - origin  # the frame's content index (camera, animation, probe values)
             if scene is not None:
-                scene.update(frame, s)
+                scene.update(content, s)
             for p in updaters:
-                p.update(frame, s)
+                p.update(content, s)
             update_s[local] = perf() - u0
             for slot, offset in ex.value_slots[s]:
                 slot.value = frame + offset

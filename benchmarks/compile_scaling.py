@@ -3,7 +3,8 @@
     .venv/bin/python benchmarks/compile_scaling.py [--sizes 250,1000,4000,16000] [--policy aliased]
         [--chain 10000] [--side-effects 5000] [--phases]
 
-Prints one row per size and the growth exponent fitted on log(time) vs log(passes), then
+Prints one row per size and the growth exponent fitted on log(time) vs log(passes) (of the
+wall medians and of the minimum CPU times: on a shared machine the second is steadier), then
 two structured graphs: a chain (pass i reads buffer b_i and writes b_{i+1}: every buffer
 reuses the memory of the one before) and one with N side-effect buffers (each written by
 its own pass, all kept as outputs). Target (issue 19): 1,000 random passes in at most
@@ -128,6 +129,34 @@ def cache_hit_us(passes: int, repeats: int = 200) -> float:
     return statistics.median(times) * 1e6
 
 
+def incremental_ms(repeats: int = 20) -> tuple[float, float]:
+    """Median ms of a surgery "recompile" through ``PlanCache`` after a value-only param
+    changed (a new ``hbao.strength`` each time: the incremental path), and of a full compile."""
+    from rgraph.compiler.cache import PlanCache
+    from rgraph.compiler.pipeline import compile_graph_plan
+
+    cache = PlanCache()
+    cache.plan("surgery", size=(64, 64))
+    times, full = [], []
+    for k in range(repeats):
+        start = time.perf_counter()
+        cache.plan("surgery", params={"hbao.strength": f"{1 + k / 100}"}, size=(64, 64))
+        times.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        compile_graph_plan("surgery", params={"hbao.strength": f"{1 + k / 100}"}, size=(64, 64))
+        full.append(time.perf_counter() - start)
+    assert cache.reused == repeats
+    return statistics.median(times) * 1e3, statistics.median(full) * 1e3
+
+
+def exponent(points: list[tuple[int, float]]) -> float:
+    """Least-squares slope of log(time) over log(passes)."""
+    xs = [math.log(n) for n, _ in points]
+    ys = [math.log(t) for _, t in points]
+    mx, my = statistics.fmean(xs), statistics.fmean(ys)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys, strict=True)) / sum((x - mx) ** 2 for x in xs)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--sizes", default="250,1000,4000,16000")
@@ -142,15 +171,13 @@ def main() -> None:
     for n in sizes:
         repeats = max(3, min(15, 16000 // n))
         median, cpu, executed, barriers, spec = measure(n, args.policy, repeats)
-        rows.append((n, median))
+        rows.append((n, median, cpu))
         print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f} {cpu * 1e3:>11.1f}")
         if args.phases:
             print(phases_line(spec, args.policy, repeats))
-    xs = [math.log(n) for n, _ in rows]
-    ys = [math.log(t) for _, t in rows]
-    mx, my = statistics.fmean(xs), statistics.fmean(ys)
-    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys, strict=True)) / sum((x - mx) ** 2 for x in xs)
-    print(f"growth exponent: {slope:.2f}  (policy {args.policy})")
+    if len(rows) > 1:
+        print(f"growth exponent: {exponent([(n, t) for n, t, _ in rows]):.2f} (wall medians), "
+              f"{exponent([(n, c) for n, _, c in rows]):.2f} (min cpu)  (policy {args.policy})")
     for label, count, text in (("chain", args.chain, chain_yaml), ("side-effect buffers", args.side_effects,
                                                                       side_effects_yaml)):
         if count:
@@ -159,6 +186,9 @@ def main() -> None:
             if args.phases:
                 print(phases_line(spec, args.policy, 3))
     print(f"unchanged 1,000-pass graph through PlanCache: median {cache_hit_us(1000):.1f} us")
+    reuse, full = incremental_ms()
+    print(f"surgery with a changed value-only param through PlanCache: median {reuse:.1f} ms "
+          f"(full load + compile: {full:.1f} ms)")
 
 
 if __name__ == "__main__":

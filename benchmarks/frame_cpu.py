@@ -29,7 +29,8 @@ rounds alternate the two plans; each reports wall ms per frame over ``--busy-fra
 pipelined frames and the GPU span (first pass start to last pass end, median).
 
     python benchmarks/frame_cpu.py [--frames 2000] [--busy-frames 300] [--size 64x64]
-        [--policy P] [--passes probe|real] [--logic-hz HZ] [--compare-sync 1920x1080 [--rounds 3]]
+        [--policy P] [--passes probe|real] [--logic-hz HZ] [--timestamps-every K]
+        [--compare-sync 1920x1080 [--rounds 3]]
 """
 
 from __future__ import annotations
@@ -57,12 +58,13 @@ def probe_only(plan: dict) -> dict:
 
 
 def frame_cpu_us(gpu: rgraph.Gpu, plan: dict, frames: int, one_call_per_queue: bool = True,
-                 logic_hz: float | None = None) -> dict[str, Any]:
+                 logic_hz: float | None = None, timestamps_every: int = 1) -> dict[str, Any]:
     """Per frame (microseconds, frame start to next frame start): blocked in the fence wait,
     each Vulkan call, and Python (the rest); ``calls``: vkQueueSubmit2 calls per frame;
     ``render_thread``/``logic``: the run's timings of them (thread CPU time per frame)."""
     marks: list[float] = []
     with gpu.load(plan, one_call_per_queue=one_call_per_queue, logic_hz=logic_hz) as exe:
+        exe.executor.timestamp_every = timestamps_every
         timings = exe.run(frames, marks=marks).timings
         calls = len(exe.executor.submit_calls[0])
     parts = frame_parts(marks, calls)
@@ -150,7 +152,8 @@ def compare_sync(gpu: rgraph.Gpu, size: tuple[int, int], frames: int, policy: st
 
 def _summary(values: list[float]) -> str:
     deciles = statistics.quantiles(values, n=10)
-    return f"median {statistics.median(values):.1f} us, p10 {deciles[0]:.1f} us, p90 {deciles[-1]:.1f} us"
+    return (f"median {statistics.median(values):.1f} us, p10 {deciles[0]:.1f} us, p90 {deciles[-1]:.1f} us, "
+            f"mean {statistics.fmean(values):.1f} us")
 
 
 def main() -> None:
@@ -163,6 +166,8 @@ def main() -> None:
                         help="probe: every pass by the probe (the runtime's own cost); real: the graph's passes")
     parser.add_argument("--logic-hz", type=float, default=None,
                         help="scene logic on its own thread at this rate (rgraph run --logic-hz)")
+    parser.add_argument("--timestamps-every", dest="timestamps_every", type=int, default=1,
+                        help="the frame loop reads one frame's timestamps in this many (default 1: every frame)")
     parser.add_argument("--compare-sync", metavar="WxH", help="compare normal and --sync naive plans at this size")
     parser.add_argument("--rounds", type=int, default=3,
                         help="rounds of the CPU measurement and of --compare-sync (default 3)")
@@ -180,10 +185,11 @@ def measure(gpu: rgraph.Gpu, args: argparse.Namespace) -> None:
     plan, device, is_gpu = compile_for_device(gpu, (w, h), args.policy)
     if args.passes == "probe":
         plan = probe_only(plan)
-    parts = frame_cpu_us(gpu, plan, args.frames, logic_hz=args.logic_hz)
+    parts = frame_cpu_us(gpu, plan, args.frames, logic_hz=args.logic_hz, timestamps_every=args.timestamps_every)
     passes = len(plan["passes"])
     print(f"device: {device}")
     logic = f", logic thread at {args.logic_hz:g} Hz" if args.logic_hz else ""
+    logic += f", timestamps read every {args.timestamps_every} frames" if args.timestamps_every > 1 else ""
     print(f"surgery {w}x{h} ({args.passes} passes{logic}): {passes} passes, "
           f"{sum(len(p['barriers']) for p in plan['passes'])} barriers")
     print(f"frame wall time, main thread ({len(parts['frame'])} frames): {_summary(parts['frame'])}")
@@ -212,7 +218,7 @@ def measure(gpu: rgraph.Gpu, args: argparse.Namespace) -> None:
         for mode in ("per run", "per queue") if r % 2 == 0 else ("per queue", "per run"):
             if r or mode == "per run":
                 rounds[mode].append(frame_cpu_us(gpu, plan, args.frames, one_call_per_queue=mode == "per queue",
-                                                 logic_hz=args.logic_hz))
+                                                 logic_hz=args.logic_hz, timestamps_every=args.timestamps_every))
     for mode, measured in rounds.items():
         python = [statistics.median(m["python"]) for m in measured]
         runtime = [statistics.median(m["runtime"]) for m in measured]

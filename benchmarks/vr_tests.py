@@ -12,11 +12,20 @@ clocks; its first frames run ~3x slow):
 
 - FPS = 1 / wall time per frame over ``--frames`` pipelined frames;
 - GPU busy = the median timestamp span of a frame (first pass start to last pass end) / wall;
-- render-thread CPU = the median per frame of the frame loop's time minus its fence wait
-  (``benchmarks.frame_cpu.frame_parts``: Python and Vulkan calls, the host updates included).
+- render-thread CPU = per frame, the frame loop's time minus its fence wait
+  (``benchmarks.frame_cpu.frame_parts``: Python and Vulkan calls, the host updates, the
+  timestamp reads included): the mean over the timed frames (what the thread spends per frame,
+  periodic work such as a logic tick's or a timestamp read's included) and the median; the
+  medians of its Python and Vulkan-call parts;
+- per pass, the GPU ms of stereo over mono (what doubles with the second eye, what more).
+
+The render thread reads one frame's timestamps in ``--timestamps-every`` (default 4; the
+per-pass medians then come from a quarter of the frames; the mean includes the reads).
 
     python3 -m benchmarks.vr_tests [--size 1920x1080] [--frames 300] [--warmup 0.5]
-        [--tests instanced,skinned,lighting,unique] [--views 1,2] [--modes gpu,naive] [--json OUT.json]
+        [--tests instanced,skinned,lighting,unique] [--views 1,2] [--modes gpu,naive] [--logic-hz 60]
+        [--timestamps-every 4] [--json OUT.json]
+    python3 -m benchmarks.vr_tests --from-json gpu.json naive.json    # one table from two runs
     lavapipe smoke:  python3 -m benchmarks.vr_tests --size 160x90 --frames 3
 """
 
@@ -58,7 +67,7 @@ def load_kwargs(gpu: Any, logic_hz: float | None) -> dict[str, Any]:
 
 
 def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, frames: int, warmup: float,
-            logic_hz: float | None) -> dict[str, Any]:
+            logic_hz: float | None, timestamps_every: int = 1) -> dict[str, Any]:
     from benchmarks.frame_cpu import frame_parts
     from rgraph.compiler.pipeline import compile_graph
 
@@ -67,6 +76,7 @@ def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, f
                          memory=gpu.memory_requirements())
     marks: list[float] = []
     with gpu.load(plan, **load_kwargs(gpu, logic_hz)) as exe:
+        exe.executor.timestamp_every = timestamps_every
         exe.warm_up(warmup)
         warmed = exe.run(3).frames  # frames run before timing (warm-up included)
         t0 = time.perf_counter()
@@ -76,11 +86,18 @@ def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, f
         draws = exe.executor.scene_gpu.draw_count
     parts = frame_parts(marks, calls, skip=0)
     span = timings["total_ms"]
-    cpu_us = statistics.median(parts["runtime"]) if parts["runtime"] else None
+    runtime = parts["runtime"]
+
+    def median(key: str) -> float | None:
+        return statistics.median(parts[key]) if parts[key] else None
+
     return {"test": test, "views": views, "mode": mode, "draws": draws, "warmup_frames": warmed,
             "wall_ms": wall_ms, "fps": 1000.0 / wall_ms, "gpu_span_ms": span,
-            "gpu_busy": (span / wall_ms) if span is not None else None, "render_cpu_us": cpu_us,
-            "passes_ms": timings["passes"]}
+            "gpu_busy": (span / wall_ms) if span is not None else None,
+            "render_cpu_us": statistics.fmean(runtime) if runtime else None,
+            "render_cpu_median_us": median("runtime"), "python_median_us": median("python"),
+            "vulkan_median_us": median("vulkan"), "submit_median_us": median("submit"),
+            "timestamps_every": timestamps_every, "logic": timings.get("logic"), "passes_ms": timings["passes"]}
 
 
 def _f(v: float | None, fmt: str) -> str:
@@ -89,8 +106,8 @@ def _f(v: float | None, fmt: str) -> str:
 
 def table(rows: list[dict[str, Any]]) -> str:
     """Markdown: a line per test and view count, gpu and naive side by side."""
-    head = ("| test | views | draws | FPS (gpu) | GPU busy (gpu) | render CPU us (gpu) | GPU ms (gpu) | "
-            "FPS (naive) | GPU busy (naive) | render CPU us (naive) | stereo / mono frame (gpu) | study (Ultra) |")
+    head = ("| test | views | draws | FPS (gpu) | GPU busy (gpu) | render CPU us mean (gpu) | GPU ms (gpu) | "
+            "FPS (naive) | GPU busy (naive) | render CPU us mean (naive) | stereo / mono frame (gpu) | study (Ultra) |")
     lines = [head, "|" + "---|" * 12]
     by = {(r["test"], r["views"], r["mode"]): r for r in rows}
     for (test, views, mode), r in by.items():
@@ -108,6 +125,23 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def pass_ratios(rows: list[dict[str, Any]]) -> str:
+    """Markdown: per test (gpu mode), each pass's GPU ms mono, stereo and stereo / mono."""
+    by = {(r["test"], r["views"]): r for r in rows if r["mode"] == "gpu"}
+    lines = ["| test | pass | mono ms | stereo ms | stereo / mono |", "|---|---|---:|---:|---:|"]
+    for (test, views), mono in by.items():
+        stereo = by.get((test, 2))
+        if views != 1 or stereo is None:
+            continue
+        for name, a in mono["passes_ms"].items():
+            b = stereo["passes_ms"].get(name)
+            ratio = (b / a) if a and b is not None else None
+            lines.append(f"| {test} | {name} | {_f(a, '.3f')} | {_f(b, '.3f')} | {_f(ratio, '.2f')} |")
+        ratio = stereo["wall_ms"] / mono["wall_ms"]
+        lines.append(f"| {test} | frame (wall) | {mono['wall_ms']:.3f} | {stereo['wall_ms']:.3f} | {ratio:.2f} |")
+    return "\n".join(lines) if len(lines) > 2 else ""
+
+
 def _pct(v: float | None) -> float | None:
     return None if v is None else 100.0 * v
 
@@ -122,8 +156,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--modes", default="gpu,naive", help="draw.mode values (gpu, naive, cpu)")
     parser.add_argument("--logic-hz", dest="logic_hz", type=float, default=None,
                         help="run scene logic on its own thread at this rate (needs rgraph run --logic-hz)")
+    parser.add_argument("--timestamps-every", dest="timestamps_every", type=int, default=4,
+                        help="read one frame's timestamps in this many (default 4; 1: every frame)")
     parser.add_argument("--json", type=Path, help="write every figure as JSON")
+    parser.add_argument("--from-json", dest="from_json", type=Path, nargs="+",
+                        help="measure nothing: print the tables of these --json files' rows together")
     args = parser.parse_args(argv)
+    if args.from_json:
+        docs = [json.loads(p.read_text()) for p in args.from_json]
+        rows = [r for d in docs for r in d["rows"]]
+        print(f"device: {docs[0].get('device', '?')}, {'x'.join(map(str, docs[0]['size']))}, from "
+              + ", ".join(str(p) for p in args.from_json))
+        print(table(rows))
+        print(pass_ratios(rows))
+        return 0
     if args.warmup < 0.3:
         parser.error("--warmup must be at least 0.3 s")
     if args.frames < 2:
@@ -144,13 +190,21 @@ def main(argv: list[str] | None = None) -> int:
         for test in tests:
             for views in (int(v) for v in args.views.split(",")):
                 for mode in (m.strip() for m in args.modes.split(",")):
-                    r = measure(gpu, test, (w, h), views, mode, args.frames, args.warmup, args.logic_hz)
+                    r = measure(gpu, test, (w, h), views, mode, args.frames, args.warmup, args.logic_hz,
+                                args.timestamps_every)
                     rows.append(r)
                     print(f"{test} views={views} {mode}: {r['fps']:.1f} FPS, GPU busy {_f(_pct(r['gpu_busy']), '.1f')}%, "
-                          f"render CPU {_f(r['render_cpu_us'], '.1f')} us/frame, GPU {_f(r['gpu_span_ms'], '.3f')} ms",
-                          flush=True)
-    print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up")
+                          f"render CPU {_f(r['render_cpu_us'], '.1f')} us/frame mean, "
+                          f"{_f(r['render_cpu_median_us'], '.1f')} median (Python {_f(r['python_median_us'], '.1f')}, "
+                          f"Vulkan calls {_f(r['vulkan_median_us'], '.1f')}, of it submits "
+                          f"{_f(r['submit_median_us'], '.1f')}), GPU {_f(r['gpu_span_ms'], '.3f')} ms", flush=True)
+    print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up, "
+          f"timestamps read every {args.timestamps_every} frames, logic thread "
+          + (f"at {args.logic_hz:g} Hz" if args.logic_hz else "off"))
     print(table(rows))
+    ratios = pass_ratios(rows)
+    if ratios:
+        print(ratios)
     if args.json:
         args.json.write_text(json.dumps({"size": [w, h], "device": device, "rows": rows}, indent=1) + "\n")
     return 0

@@ -39,12 +39,17 @@ class _BuildOnce:
         self.buffers = [setup.host_buffer(12 * len(groups), flags) for _ in range(setup.sets)]
         for buf in self.buffers:
             buf.write(self._args(True))
+        self._building = [True] * setup.sets  # per set: its buffer holds the real counts
 
     def _args(self, build: bool) -> bytes:
         return b"".join(struct.pack("<3I", *(g if build else (0, 0, 0))) for g in self.groups)
 
     def update(self, frame: int, frame_set: int) -> None:
-        self.buffers[frame_set].write(self._args(not self.static or frame == 0))
+        """Set ``frame_set``'s arguments for ``frame``, written only when they change."""
+        build = not self.static or frame == 0
+        if build != self._building[frame_set]:
+            self.buffers[frame_set].write(self._args(build))
+            self._building[frame_set] = build
 
     def dispatch(self, rec, frame_set: int, index: int) -> None:
         rec.dispatch_indirect(self.buffers[frame_set].handle, 12 * index)

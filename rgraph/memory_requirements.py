@@ -166,9 +166,9 @@ class ProfileMemoryRequirements:
             raise self._error(
                 f"device profile {self.name!r}: requirements of {key} depend on usage; cannot predict offline"
             )
-        for s in entry["samples"]:
-            if list(s[0:6]) == [*ext, int(mips), int(layers), int(samples)]:
-                return int(s[6]), int(s[7]), int(s[8])
+        measured = self._measured(key).get((*ext, int(mips), int(layers), int(samples)))
+        if measured is not None:
+            return measured
         rule = entry.get("rule")
         if rule is None:
             raise self._error(
@@ -188,6 +188,16 @@ class ProfileMemoryRequirements:
         else:
             size = predict_image(rule, entry["block_bytes"], entry["block_extent"], ext, mips, layers, samples)
         return size, int(entry["alignment"]), int(entry["memory_type_bits"])
+
+    def _measured(self, key: str) -> dict[tuple[int, ...], Requirements]:
+        """A format's measured samples by (w, h, d, mips, layers, samples); the first wins."""
+        index = self.__dict__.setdefault("_sample_index", {})
+        found = index.get(key)
+        if found is None:
+            found = index[key] = {}
+            for s in self.profile["formats"][key]["samples"]:
+                found.setdefault(tuple(int(v) for v in s[0:6]), (int(s[6]), int(s[7]), int(s[8])))
+        return found
 
     def _accel_section(self) -> dict[str, Any]:
         section = self.profile.get("accel")

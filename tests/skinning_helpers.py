@@ -79,8 +79,13 @@ def reference_pose(mesh, frame: int, alpha: float | None) -> tuple[np.ndarray, n
     """(instances, V, 3) posed object-space positions and unit normals of frame ``frame`` from
     the half-float states, float64 (``alpha``: override the frame's interpolation factor)."""
     tick, frame_alpha = logic_tick(frame / 60.0, LOGIC_HZ)
-    a, b = (unpack_bones(mesh.animator.state(k, LOGIC_HZ)) for k in (tick - 1, tick))
-    pose = interpolate(a, b, frame_alpha if alpha is None else alpha)  # joint transforms
+    return reference_pose_of_ticks(mesh, tick - 1, tick, frame_alpha if alpha is None else alpha, LOGIC_HZ)
+
+
+def reference_pose_of_ticks(mesh, previous: int, current: int, alpha: float, hz: float) -> tuple[np.ndarray, np.ndarray]:
+    """``reference_pose`` between logic states ``previous`` and ``current`` (at ``hz``) at ``alpha``."""
+    a, b = (unpack_bones(mesh.animator.state(k, hz)) for k in (previous, current))
+    pose = interpolate(a, b, alpha)  # joint transforms
     rig, out_p, out_n = mesh.animator.rig, [], []
     for c in range(mesh.instances):
         joints = [ref.similarity(pose.q[:, j, c], pose.t[:, j, c], pose.s[j, c]) for j in range(rig.skeleton.bones)]

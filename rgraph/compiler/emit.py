@@ -14,12 +14,17 @@ from typing import TYPE_CHECKING, Any
 from rgraph.compiler import sync as csync
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
+from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
 if TYPE_CHECKING:
     from rgraph.compiler.phases import Compilation
 
 SIGNAL_STAGES = ("ALL_COMMANDS",)
+
+# The plan values built per access, barrier, pass and resource (rgraph.plan.builders).
+_Access, _Barrier, _Pass, _Resource = (builder(c) for c in (pm.Access, pm.Barrier, pm.PlanPass, pm.PlanResource))
+_Wait, _Signal, _Culled = (builder(c) for c in (pm.Wait, pm.Signal, pm.Culled))
 
 
 @lru_cache(maxsize=4096)
@@ -44,7 +49,7 @@ def _subresource(res: ResourceSpec, mips, layers) -> pm.Subresource | None:
 
 def _barrier(b: csync.Barrier, resources: Mapping[str, ResourceSpec]) -> pm.Barrier:
     key = b.key
-    return pm.Barrier(b.resource, _subresource(resources[b.resource], b.mips, b.layers), plan_state(key.src),
+    return _Barrier(b.resource, _subresource(resources[b.resource], b.mips, b.layers), plan_state(key.src),
                       plan_state(key.dst), key.aliases)
 
 
@@ -85,18 +90,17 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
     for i, p in enumerate(passes):
         ps = sync.passes[i]
         accesses = tuple([
-            pm.Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
+            _Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
                       _names(s.stages), _names(s.access), s.layout, a.write)
             for a, s in zip(p.accesses, sync.access_sync[i], strict=True)
         ])
-        out.append(pm.PlanPass(
-            name=p.name, index=i, device=0, queue=p.queue, kind=p.kind, impl=p.impl, params=_frozen(p.params),
-            accesses=accesses,
-            barriers=tuple([_barrier(b, resources) for b in ps.barriers]) if ps.barriers else (),
-            releases=tuple([_barrier(b, resources) for b in ps.releases]) if ps.releases else (),
-            waits=tuple([pm.Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits])
+        out.append(_Pass(
+            p.name, i, 0, p.queue, p.kind, p.impl, _frozen(p.params), accesses,
+            tuple([_barrier(b, resources) for b in ps.barriers]) if ps.barriers else (),
+            tuple([_barrier(b, resources) for b in ps.releases]) if ps.releases else (),
+            tuple([_Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits])
             if ps.waits else (),
-            signals=(pm.Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
+            (_Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
         ))
     return tuple(out)
 
@@ -111,7 +115,7 @@ def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
         heap, offset = placement.offsets[name]
         lifetime = "output" if (name in outputs and res.lifetime == "transient") else res.lifetime
         image = res.is_image
-        out.append(pm.PlanResource(
+        out.append(_Resource(
             name=name, kind=res.kind, format=res.format.vk_name if res.format else None, bytes=mem.bytes,
             size_bytes=None if image else res.bytes, alignment=mem.alignment, memory_type_bits=mem.memory_type_bits,
             memory_class=mem.memory_class, usages=mem.usages, lifetime=lifetime, first=mem.first, last=mem.last,
@@ -154,7 +158,7 @@ def emit(c: Compilation) -> pm.Plan:
 def _culled(name: str, reason: str, p: PassSpec, c: Compilation, used: Mapping[str, Any]) -> pm.Culled:
     """A culled pass with the resources only culled passes used (not in ``used``), and their bytes."""
     only = tuple(sorted({a.resource for a in p.accesses if a.resource not in used}))
-    return pm.Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
+    return _Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
 
 
 def _signal_values(passes: Sequence[PassSpec], sync: csync.SyncResult) -> dict[int, int]:

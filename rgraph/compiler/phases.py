@@ -11,9 +11,9 @@ networkx: ``Compilation.graph`` is the dependency DAG of the scheduled passes
 async-early`` orders passes with ``networkx.lexicographical_topological_sort`` on it
 (``rgraph.ir.schedule``). The default path does without it: dependencies are found in
 program order, so every edge points forward and declaration order already *is* the
-lexicographic topological order keyed by declaration index; culling is a backwards walk
-over read-after-write edges that ``rgraph.ir.graph.raw_ancestors`` does on the edge dict
-it already has. Building a DiGraph for either costs more than the phase itself
+lexicographic topological order keyed by declaration index; culling is one backwards
+walk over the cells still waiting for their producer (``rgraph.ir.cull._alive``; it
+builds no edges). Building a DiGraph for either costs more than the phase itself
 (benchmarks/compile_scaling.py).
 """
 

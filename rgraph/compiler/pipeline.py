@@ -67,7 +67,12 @@ def frontend(
     size: tuple[int, int] = DEFAULT_SIZE,
 ) -> Frontend:
     source = load_graph(resolve_graph(str(graph)))
-    scene = load_scene_for(source, scene_path)
+    return specialized(source, load_scene_for(source, scene_path), params, size)
+
+
+def specialized(source: GraphSource, scene: Scene | None, params: Mapping[str, str] | None,
+                size: tuple[int, int]) -> Frontend:
+    """``frontend`` once the graph and its scene are loaded (``PlanCache`` keeps those)."""
     features = scene.features if scene else ALL_PRESENT
     resolved = resolve_params(source, params or {})
     spec = specialize(source, features=features, params=resolved, size=size, scene_name=scene.name if scene else None,

@@ -19,7 +19,6 @@ from __future__ import annotations
 from bisect import bisect_left, bisect_right
 from collections.abc import Collection, Sequence
 
-from rgraph.ir.graph import cells
 from rgraph.spec.specialize import PassSpec
 
 
@@ -30,7 +29,7 @@ def direct_waits(passes: Sequence[PassSpec]) -> list[dict[str, int]]:
     for i, p in enumerate(passes):
         waits: dict[str, int] = {}
         for a in p.accesses:
-            for c in cells(a):
+            for c in a.cells:
                 prev = last.get(c)
                 if prev is not None and prev[0] != p.queue and prev[1] != i:
                     waits[prev[0]] = max(waits.get(prev[0], -1), prev[1])
@@ -55,7 +54,7 @@ def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str
                 continue
             s = span.setdefault(a.resource, [i, i])
             s[1] = i
-            for c in cells(a):
+            for c in a.cells:
                 if c not in seen:
                     seen.add(c)
                     firsts.setdefault(a.resource, set()).add((i, p.queue))

@@ -20,11 +20,12 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import NamedTuple
 
 from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
-from rgraph.ir.graph import Cell, cells
+from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
 PERSISTENT = ("persistent", "imported")
@@ -104,7 +105,7 @@ class _Cell:
         reads = self.reads
         if len(reads) == 1:
             return reads[0][1]
-        return EMPTY.union(*(s for _, s in reads))
+        return EMPTY.union(*[s for _, s in reads])
 
 
 class _Use(NamedTuple):
@@ -114,29 +115,29 @@ class _Use(NamedTuple):
     queue: str
 
 
+@lru_cache(maxsize=4096)
+def _sync(usage: str, kind: str, stages: tuple[str, ...] | None, image: bool, depth: bool, stencil: bool,
+          refit: bool) -> Sync:
+    """``sync_of`` by position (a positional cache key is cheaper to build than keywords)."""
+    return sync_of(usage, kind, explicit_stages=stages, is_image=image, depth_format=depth, stencil_format=stencil,
+                   refit=refit)
+
+
 def access_syncs(p: PassSpec, resources: Mapping[str, ResourceSpec]) -> list[Sync]:
     out = []
+    kind = p.kind
     for a in p.accesses:
         res = resources[a.resource]
         fmt = res.format
-        out.append(
-            sync_of(
-                a.usage,
-                p.kind,
-                explicit_stages=a.stages,
-                is_image=res.is_image,
-                depth_format=bool(fmt and fmt.has_depth),
-                stencil_format=bool(fmt and fmt.has_stencil),
-                refit=a.refit,
-            )
-        )
+        out.append(_sync(a.usage, kind, a.stages, res.kind == "image", bool(fmt and fmt.has_depth),
+                         bool(fmt and fmt.has_stencil), a.refit))
     return out
 
 
 def _pass_cells(p: PassSpec, syncs: list[Sync]) -> dict[Cell, tuple[Sync, bool]]:
     merged: dict[Cell, tuple[Sync, bool]] = {}
     for a, s in zip(p.accesses, syncs, strict=True):
-        for c in cells(a):
+        for c in a.cells:
             if c in merged:
                 prev, w = merged[c]
                 merged[c] = (merge(prev, s), w or a.write)
@@ -173,19 +174,17 @@ def synchronize(
         return _Cell("UNDEFINED" if res.is_image else None, None, None, [])
 
     # Frame 1 from scratch gives the end-of-frame state; frame 2 starts persistent cells there.
-    # Frame 1 is needed only for persistent cells and for the resources others alias.
     needed = {r for r, res in resources.items() if res.lifetime in PERSISTENT}
-    needed |= {p for preds in alias_sources.values() for p in preds}
-    first = _Simulation(passes, per_pass_cells, timeline, resources)
+    first_cells: dict[Cell, _Cell] = {}
     if needed:
-        if not all(c[0] in needed for c in timeline):
-            first.per_pass_cells = [{c: v for c, v in pc.items() if c[0] in needed} for pc in per_pass_cells]
-        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})
+        first = _Simulation(passes, per_pass_cells, timeline, resources)
+        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})  # the other cells are skipped
+        first_cells = first.cells
     start: dict[Cell, _Cell] = {}
     for c in timeline:
         res = resources[c[0]]
         if res.lifetime in PERSISTENT:
-            st = first.cells[c]
+            st = first_cells[c]
             write = (PREVIOUS_FRAME, st.write[1], st.write[2]) if st.write else None
             reads = [(PREVIOUS_FRAME, stages) for _, stages in st.reads]
             start[c] = _Cell(
@@ -194,20 +193,50 @@ def synchronize(
             )
         else:
             start[c] = fresh(c)
-    alias_init = _alias_initial_states(alias_sources, first)
-    for c, cell in start.items():
-        if c[0] in alias_init:
-            stages, access, queue, last, names, waits = alias_init[c[0]]
-            cell.write = (PREVIOUS_FRAME, stages, access) if stages or access else None
-            cell.queue = queue
-            cell.last_pass = last
-            cell.aliases = names
-            cell.alias_waits = waits
     sim = _Simulation(passes, per_pass_cells, timeline, resources)
     initial = {c: st.state() for c, st in start.items()}
-    sim.run(start)
+    sim.run(start, _AliasStarts(alias_sources, start, timeline, initial))
     final = sim.final_states()
     return SyncResult(sim.out, syncs, _by_resource(final), _by_resource(initial))
+
+
+class _AliasStarts:
+    """Transient cells whose memory an earlier resource used start from that resource's last
+    accesses (``_alias_state``). Every earlier occupant ends before the resource's first
+    pass, so its cells already hold their end-of-frame state when that pass comes: the
+    states are taken then, from the one simulation of the frame. (A transient's end state
+    does not depend on where it started: its first access to each cell writes it or reads
+    it, and either replaces what ``state()`` reports.)"""
+
+    def __init__(self, alias_sources: Mapping[str, Sequence[str]], start: dict[Cell, _Cell],
+                 timeline: Mapping[Cell, list], initial: dict[Cell, State]) -> None:
+        self.cells_of: dict[str, list[tuple[Cell, _Cell]]] = defaultdict(list)
+        for c, st in start.items():
+            self.cells_of[c[0]].append((c, st))
+        first_pass: dict[str, int] = {}
+        for c, uses in timeline.items():
+            i = uses[0].pass_pos
+            if first_pass.get(c[0], i) >= i:
+                first_pass[c[0]] = i
+        self.at: dict[int, list[str]] = defaultdict(list)  # pass -> resources that start there
+        for name, preds in alias_sources.items():
+            if preds and name in first_pass:
+                self.at[first_pass[name]].append(name)
+        self.sources = alias_sources
+        self.initial = initial
+
+    def apply(self, i: int) -> None:
+        """Start the aliased resources whose first pass is ``i``."""
+        for name in self.at.get(i, ()):
+            stages, access, queue, last, names, waits = _alias_state(
+                self.sources[name], [st for pred in self.sources[name] for _, st in self.cells_of[pred]], i)
+            for c, cell in self.cells_of[name]:
+                cell.write = (PREVIOUS_FRAME, stages, access) if stages or access else None
+                cell.queue = queue
+                cell.last_pass = last
+                cell.aliases = names
+                cell.alias_waits = waits
+                self.initial[c] = cell.state()
 
 
 def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
@@ -260,33 +289,26 @@ def _share_bytes(ranges: Mapping[str, tuple[int, int, int]], a: str, b: str) -> 
     return ha == hb and lo_a < hi_b and lo_b < hi_a
 
 
-def _alias_initial_states(alias_sources, first: _Simulation):
-    """Union of the last accesses of each aliased resource's predecessors."""
-    cells_of: dict[str, list[_Cell]] = defaultdict(list)
-    for c, st in first.cells.items():
-        cells_of[c[0]].append(st)
-    out = {}
-    for name, preds in alias_sources.items():
-        if not preds:
-            continue
-        stages: set[str] = set()
-        access: set[str] = set()
-        last: tuple[int, str | None] = (-1, None)
-        waits: set[tuple[str, int]] = set()
-        for pred in preds:
-            for st in cells_of[pred]:
-                s = st.state()
-                stages |= s.stages
-                access |= s.access
-                if st.last_pass is not None and st.last_pass > last[0]:
-                    last = (st.last_pass, st.queue)
-                if st.last_pass is not None and st.queue is not None:
-                    waits.add((st.queue, st.last_pass))
-        out[name] = (
-            frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
-            tuple(sorted(waits)),
-        )
-    return out
+def _alias_state(preds: Sequence[str], pred_cells: Sequence[_Cell], at: int):
+    """Union of the last accesses of an aliased resource's predecessors (their cells, each
+    last used before pass ``at``)."""
+    stages: set[str] = set()
+    access: set[str] = set()
+    last: tuple[int, str | None] = (-1, None)
+    waits: set[tuple[str, int]] = set()
+    for st in pred_cells:
+        assert st.last_pass is None or st.last_pass < at, "an earlier occupant outlives its successor's start"
+        s = st.state()
+        stages |= s.stages
+        access |= s.access
+        if st.last_pass is not None and st.last_pass > last[0]:
+            last = (st.last_pass, st.queue)
+        if st.last_pass is not None and st.queue is not None:
+            waits.add((st.queue, st.last_pass))
+    return (
+        frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
+        tuple(sorted(waits)),
+    )
 
 
 class _Simulation:
@@ -300,18 +322,24 @@ class _Simulation:
         self.image = {name: res.is_image for name, res in resources.items()}
 
     def run_states(self, start: dict[Cell, _Cell]) -> None:
-        """``run`` for the cells' end states only: the barriers it would derive are not kept."""
+        """``run`` for the end states of the cells in ``start`` only (others are skipped): the
+        barriers it would derive are not kept."""
         self.cells = cells_now = start
-        step = self._step
+        step, get = self._step, cells_now.get
         for i, p in enumerate(self.passes):
             queue = p.queue
             for c, (s, w) in self.per_pass_cells[i].items():
-                step(c, cells_now[c], i, queue, s, w)
+                cell = get(c)
+                if cell is not None:
+                    step(c, cell, i, queue, s, w)
 
-    def run(self, start: dict[Cell, _Cell]) -> None:
+    def run(self, start: dict[Cell, _Cell], alias_starts: _AliasStarts | None = None) -> None:
         self.cells = cells_now = start
         step, out = self._step, self.out
+        starting = alias_starts.at if alias_starts is not None else {}
         for i, p in enumerate(self.passes):
+            if i in starting:
+                alias_starts.apply(i)
             # acquires grouped by their release pass too, so that each acquire's rectangles equal
             # its release's (the layer pairs ownership transfers by exact subresource range)
             groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = {}

@@ -15,7 +15,7 @@ from functools import cached_property
 
 import networkx as nx
 
-from rgraph.ir.graph import build_graph, cells, dependencies, last_writers, raw_ancestors, reads
+from rgraph.ir.graph import Cell, build_graph, last_writers, reads
 from rgraph.spec.specialize import PassSpec, Spec
 
 
@@ -49,12 +49,42 @@ def cull(spec: Spec) -> Culling:
     culled = [Culled(name, reason) for name, reason in spec.removed]
     kept, dropped, cascade = _drop_unproduced_reads(spec, removed_reason)
     culled += cascade
-    alive = raw_ancestors(dependencies(kept), _roots(spec, kept))
+    alive = _alive(spec, kept)
     final = [p for p in kept if p.name in alive]
     culled += [Culled(p.name, "reaches no output") for p in kept if p.name not in alive]
     order = {p.name: p.order for p in spec.passes}
     culled.sort(key=lambda c: order[c.pass_name])
     return Culling(final, culled, dropped)
+
+
+def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
+    """``raw_ancestors(dependencies(kept), _roots(spec, kept))`` as one backwards walk:
+    ``wanted`` holds the cells that live passes read and whose producer is not met yet,
+    ``claimed`` the cells of kept resources that a later pass writes last."""
+    keep = {n for n, r in spec.resources.items() if r.lifetime in ("persistent", "imported", "output")}
+    keep.update(spec.outputs)
+    wanted: set[Cell] = set()
+    claimed: set[Cell] = set()
+    alive: set[str] = set()
+    for p in reversed(kept):
+        live = p.side_effects
+        for access in p.accesses:
+            if access.write:
+                cs = access.cells
+                if not live and (not wanted.isdisjoint(cs) or (access.resource in keep and not claimed.issuperset(cs))):
+                    live = True
+                if access.resource in keep:
+                    claimed.update(cs)
+        if not live:
+            continue
+        alive.add(p.name)
+        for access in p.accesses:
+            if access.write:
+                wanted.difference_update(access.cells)
+        for access in p.accesses:
+            if reads(access):
+                wanted.update(access.cells)
+    return alive
 
 
 def _roots(spec: Spec, kept: list[PassSpec]) -> set[str]:
@@ -81,8 +111,8 @@ def _drop_unproduced_reads(
         for access in p.accesses:
             persistent = spec.resources[access.resource].lifetime in ("persistent", "imported")
             needs_input = reads(access) and not access.write and not persistent
-            if not removed and needs_input and not all(producer.get(c) for c in cells(access)):
-                culprit = next((lost[c] for c in cells(access) if c in lost), None)
+            if not removed and needs_input and not all(producer.get(c) for c in access.cells):
+                culprit = next((lost[c] for c in access.cells if c in lost), None)
                 if access.optional:
                     why = "optional read with no producer"
                     if culprit:
@@ -98,7 +128,7 @@ def _drop_unproduced_reads(
             removed = True
         for access in p.accesses:
             if access.write:
-                for c in cells(access):
+                for c in access.cells:
                     if removed:
                         lost[c] = p.name
                     else:

@@ -19,14 +19,8 @@ Cell = tuple[str, int, int]
 
 
 def cells(access: AccessSpec) -> tuple[Cell, ...]:
-    """The (resource, mip, layer) cells an access touches, mip-major; buffers have the one
-    cell (0, 0)."""
-    mips, layers, name = access.mips, access.layers, access.resource
-    if mips is None or layers is None:
-        return ((name, 0, 0),)
-    if mips[1] - mips[0] == 1 and layers[1] - layers[0] == 1:
-        return ((name, mips[0], layers[0]),)
-    return tuple((name, mip, layer) for mip in range(*mips) for layer in range(*layers))
+    """The (resource, mip, layer) cells an access touches (``AccessSpec.cells``)."""
+    return access.cells
 
 
 def reads(access: AccessSpec) -> bool:
@@ -55,7 +49,7 @@ def dependencies(passes: Iterable[PassSpec]) -> Edges:
     for p in passes:
         for access in p.accesses:
             is_read = reads(access)
-            for cell in cells(access):
+            for cell in access.cells:
                 writer = last_writer.get(cell)
                 if is_read and writer is not None:
                     add(writer, p.name, "RAW", access.resource)
@@ -65,7 +59,7 @@ def dependencies(passes: Iterable[PassSpec]) -> Edges:
                     if writer is not None:
                         add(writer, p.name, "WAW", access.resource)
         for access in p.accesses:
-            for cell in cells(access):
+            for cell in access.cells:
                 if access.write:
                     last_writer[cell] = p.name
                     readers[cell] = []
@@ -107,6 +101,6 @@ def last_writers(passes: Iterable[PassSpec], resources: set[str]) -> set[str]:
     for p in passes:
         for access in p.accesses:
             if access.write and access.resource in resources:
-                for cell in cells(access):
+                for cell in access.cells:
                     final[cell] = p.name
     return set(final.values())

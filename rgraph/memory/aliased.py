@@ -77,7 +77,9 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
     lb = inst.lower_bound()
     best: ClassResult | None = None
     for name, order in orderings(inst):
-        offsets = best_fit(inst, order)
+        offsets = best_fit(inst, order, None if best is None else best.peak)  # None: not lower
+        if offsets is None:
+            continue
         peak = inst.peak(offsets)
         if best is None or peak < best.peak:
             best = ClassResult(offsets, peak, lb, f"greedy:{name}")

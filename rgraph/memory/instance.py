@@ -132,6 +132,19 @@ class Instance:
             totals.append(running)
         return totals
 
+    @cached_property
+    def pair_count(self) -> int:
+        """Ordered pairs of blocks that may not share bytes (the neighbour lists' total)."""
+        return sum(map(len, self.neighbors))
+
+    def non_neighbors(self, i: int) -> set[int]:
+        """The blocks, ``i`` included, that ``i`` may share bytes with (cached)."""
+        cache = self.__dict__.setdefault("_non_neighbors", {})
+        far = cache.get(i)
+        if far is None:
+            far = cache[i] = set(range(self.n)).difference(self.neighbors[i])
+        return far
+
     def lower_bound(self) -> int:
         return max(self.section_totals(), default=0)
 

@@ -35,6 +35,7 @@ class Deformer:
     _basis: np.ndarray = field(init=False, repr=False)
     _basis32: np.ndarray = field(init=False, repr=False)
     topology: SmoothingTopology = field(init=False, repr=False)
+    _scratch: np.ndarray | None = field(init=False, default=None, repr=False)
 
     def __post_init__(self) -> None:
         p = self.rest.positions
@@ -68,11 +69,23 @@ class Deformer:
 
     def write_positions(self, seconds: float, out: np.ndarray) -> None:
         """``positions(seconds)`` in float32 into ``out`` ((n, 3) float32, C-contiguous: e.g.
-        mapped memory), one matrix-vector product without allocating (the per-frame path;
-        within about one float32 ulp of ``positions``)."""
+        mapped memory) without allocating (the per-frame path; within about one float32 ulp of
+        ``positions``): rest + c1 radial + c2 dent as single-threaded array operations on
+        scratch arrays, not a BLAS product (whose thread pool would wake on the render thread
+        every frame); the last one writes ``out``, which is only written, never read (mapped
+        memory may be write-combined: reads from it are uncached). One writer at a time (the
+        render thread, or the logic thread with ``--logic-hz``)."""
         if not out.flags.c_contiguous or out.dtype != np.float32 or out.size != self._basis32.shape[1]:
             raise ValueError("write_positions: out must be a C-contiguous (n, 3) float32 array")
-        np.dot(self._coefficients(seconds).astype(np.float32), self._basis32, out=out.reshape(-1))
+        c = self._coefficients(seconds)
+        basis = self._basis32  # rows: rest, radial, dent (flat, contiguous: fast NumPy loops)
+        if self._scratch is None:
+            self._scratch = np.empty((2, basis.shape[1]), dtype=np.float32)
+        acc, term = self._scratch
+        np.multiply(basis[1], np.float32(c[1]), out=acc)
+        np.add(acc, basis[0], out=acc)  # c[0] is 1
+        np.multiply(basis[2], np.float32(c[2]), out=term)
+        np.add(acc, term, out=out.reshape(-1))  # out is only written
 
     def at(self, seconds: float) -> MeshData:
         """The deformed mesh with its reference normals (float64; ``tangents_at`` for tangents)."""

@@ -11,6 +11,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 from rgraph import formats
@@ -77,6 +78,17 @@ class AccessSpec:
     optional: bool
     loc: Location
     refit: bool = False  # accel_build of a persistent accel refitted each frame (reads it too)
+
+    @cached_property
+    def cells(self) -> tuple[tuple[str, int, int], ...]:
+        """The (resource, mip, layer) cells the access touches, mip-major; a buffer has the
+        one cell (0, 0). Computed once: every compiler phase walks them."""
+        mips, layers, name = self.mips, self.layers, self.resource
+        if mips is None or layers is None:
+            return ((name, 0, 0),)
+        if mips[1] - mips[0] == 1 and layers[1] - layers[0] == 1:
+            return ((name, mips[0], layers[0]),)
+        return tuple((name, mip, layer) for mip in range(*mips) for layer in range(*layers))
 
 
 @dataclass(frozen=True)

@@ -102,6 +102,8 @@ class Executor:
         # past warm-up frames of a plan that carries no state between frames)
         self.frame_origin = 0
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread with logic_hz (run_frames starts it)
+        self.timestamp_every = 1  # read one use in this many of a frame set's timestamps (rgraph.vk.runtime.frames)
+        self.host_query_reset = True  # the frame loop resets the query pools (commands.record decides)
         try:
             if self.instance.validate:
                 refuse_layer_for_ray_tracing(plan)

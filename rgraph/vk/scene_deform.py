@@ -5,7 +5,8 @@ vertex, float32), and per frame-in-flight set a 16-byte *header* (``alpha``, the
 the current state's slot). Without a logic thread, set s's frame writes its positions into slot
 s (header: alpha 1, slots s, s). With one (``rgraph.vk.runtime.logic``) the logic thread writes
 each tick's positions into a free slot (``write_slot``: not the published pair, not a pair a
-frame in flight reads; all under ``lock``) and the render thread writes only the header.
+frame in flight reads; all under ``lock``) and the render thread writes only the header
+(``rgraph.vk.scene_frame``: it marks the slots it takes in ``in_use`` under the same lock).
 Device-local, per set: the vertex buffer (position, normal: ``packing.VERTEX_BYTES``) the
 scene's draws bind and a tangent buffer (vec4: xyz, w the bitangent's sign), both written by
 ``shaders/scene/deform_normals.comp``. Shared and uploaded once: the smoothing topology
@@ -96,10 +97,13 @@ class DeformGPU:
         # numpy views of the mapped memory: the ring (SLOTS, total, 3); per set (alpha, slots)
         self.slots = np.frombuffer(self.ring.mapped, dtype=np.float32, count=self.ring_bytes // 4).reshape(
             SLOTS, self.total, 3)
-        self.header_views = []
+        self.header_views = []  # NumPy views (reading); header_words: cffi pointers (the per-frame writes)
+        self.header_words = []
         for buf in self.headers:
             f = np.frombuffer(buf.mapped, dtype=np.float32, count=4)
             self.header_views.append((f, f.view(np.uint32)))
+            raw = v.ffi.from_buffer(buf.mapped)
+            self.header_words.append((v.ffi.cast("float *", raw), v.ffi.cast("uint32_t *", raw)))
         self.lock = threading.Lock()  # the logic thread's too (LogicThread(lock=...)): slots change hands under it
         self.in_use: list[tuple[int, int]] = [(s, s) for s in range(sets)]  # per set: the slots its frame reads
         for s in range(sets):
@@ -119,25 +123,17 @@ class DeformGPU:
 
     def write_slot(self, seconds: float, published: Any) -> int:
         """The logic thread's tick: the positions at ``seconds`` into a slot that no frame set
-        reads (``in_use``) and ``published()`` (the slots a frame may still take) does not
-        name; its index. Slots in use and published: at most 6 of ``SLOTS``."""
+        reads (``in_use``) and ``published()`` (the slots of the states a frame may still take)
+        does not name; its index. Slots in use and published: at most 6 of ``SLOTS``."""
         with self.lock:
-            busy = {*(st.value for st in published()), *(x for pair in self.in_use for x in pair)}
+            busy = {*published(), *(x for pair in self.in_use for x in pair)}
             slot = next(k for k in range(SLOTS) if k not in busy)
         self.write_positions(slot, seconds)
         return slot
 
-    def take(self, frame_set: int, states: Any) -> tuple[Any, Any]:
-        """``states()`` (the logic's (prev, cur), values = slots), marked in use by
-        ``frame_set`` in one step (its previous pair is free: its fence was waited)."""
-        with self.lock:
-            prev, cur = states()
-            self.in_use[frame_set] = (prev.value, cur.value)
-        return prev, cur
-
     def set_header(self, frame_set: int, alpha: float, prev: int, cur: int) -> None:
         """Set ``frame_set``'s frame mixes slots ``prev`` and ``cur`` with weight ``alpha`` (1: cur)."""
-        f, u = self.header_views[frame_set]
+        f, u = self.header_words[frame_set]
         f[0] = alpha
         u[1] = prev
         u[2] = cur

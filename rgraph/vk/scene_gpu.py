@@ -11,9 +11,10 @@ Built once per run from ``plan["scene_source"]`` by the executor (``Executor._sc
 - per frame-in-flight set, host-visible and written in ``update(frame, frame_set)``: the Frame
   uniform, the Views uniform (binding 5, ``views=2``), the Draws (draw modes cpu and naive) and
   Decals storage buffers (camera-relative, float64 on the CPU; cpu mode rewrites them only when
-  the camera moves, naive every frame), naive mode's per-object draw commands, and the
+  the camera moves, naive every frame: ``rgraph.vk.scene_naive`` copies naive mode's tables to
+  device memory at the start of each frame), naive mode's per-object draw commands, and the
   deformable meshes' positions (deformed on the CPU every frame); their normals and tangents
-  are computed on the GPU (``rgraph.vk.scene_deform``: ``record_deform`` at the start of the
+  are computed on the GPU (``rgraph.vk.scene_deform``: ``record_frame`` at the start of the
   frame's first scene batch on the graphics queue), into the vertex buffers the draws bind.
 - skinning (bindings 7-9, ``rgraph.vk.skin_gpu.SkinGPU``): joints and weights (lined up with
   the TLSF-placed rigid vertex buffer), the ring of packed logic states and each set's
@@ -38,7 +39,6 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
 from rgraph.vk.resources import HostBuffer
-from rgraph.vk.runtime.logic import interpolation_alpha
 from rgraph.vk.scene_modes import draw_mode, view_count
 from rgraph.vk.skin_gpu import BINDING_BONES, BINDING_SKIN_FRAME, BINDING_SKIN_VERTICES, SkinGPU
 
@@ -82,7 +82,6 @@ class SceneGPU:
         self.set_layout = None
         self._sets: list[Any] = []
         self._submit_once = submit_once
-        self._camera_written: list[bytes | None] = [None] * sets  # per set: the camera its Draws/Decals are for
         self.logic: Any = None  # rgraph.vk.runtime.logic.LogicThread (attach_logic)
         self.ticks_taken: list[tuple[int, int] | None] = [None] * sets  # per set: the logic ticks its frame mixes
         self.alpha_range = [1.0, 0.0]
@@ -203,12 +202,19 @@ class SceneGPU:
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]
         draws_size = len(instances) if gpu else len(packing.draws_bytes(data, 0))
-        self.draw_buffers = [] if gpu else [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
+        self.naive = None  # rgraph.vk.scene_naive.NaiveTables (draw.mode=naive)
+        if self.mode == "naive":
+            from rgraph.vk.scene_naive import NaiveTables
+
+            self.naive = NaiveTables(self.sets, draws_size, data.draw_count, device_buffer=self._device_buffer,
+                                     host_buffer=self._host_buffer)
+            self.draw_buffers = self.naive.host_draws
+        else:
+            self.draw_buffers = [] if gpu else [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
         views_size = scene_instances.views_size(self.views)
         self.view_buffers = [self._host_buffer(views_size, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                              for _ in range(self.sets)]
-        self.naive_buffers = ([self._host_buffer(data.draw_count * 20, v.VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)
-                               for _ in range(self.sets)] if self.mode == "naive" else [])
+        self.naive_buffers = self.naive.host_commands if self.naive is not None else []
         decals_size = max(len(data.decals), 1) * packing.DECAL_BYTES
         self.decal_buffers = [self._host_buffer(decals_size, storage) for _ in range(self.sets)]
         if deform_base:
@@ -220,6 +226,9 @@ class SceneGPU:
                                     host_buffer=self._host_buffer, upload=lambda ups: self._upload(submit_once, ups))
         self._make_descriptors(materials_size=len(materials), lights_size=len(scene_lights), draws_size=draws_size,
                                decals_size=decals_size, views_size=views_size, meshes_size=len(meshes))
+        from rgraph.vk.scene_frame import SceneFrames
+
+        self.frames = SceneFrames(self)
         for s in range(self.sets):
             self.update(0, s)
 
@@ -246,8 +255,7 @@ class SceneGPU:
             descriptorPool=self._pool, descriptorSetCount=self.sets, pSetLayouts=[self.set_layout] * self.sets)))
         for s in range(self.sets):
             sources = [(BINDING_FRAME, ubo, self.frame_buffers[s].handle, packing.FRAME_BYTES),
-                       (BINDING_DRAWS, ssbo, (self.instance_buffer if self.mode == "gpu" else self.draw_buffers[s]).handle,
-                        draws_size),
+                       (BINDING_DRAWS, ssbo, self._draws_of(s).handle, draws_size),
                        (BINDING_MATERIALS, ssbo, self.materials_buffer.handle, materials_size),
                        (BINDING_SCENE_LIGHTS, ssbo, self.scene_lights_buffer.handle, lights_size),
                        (BINDING_DECALS, ssbo, self.decal_buffers[s].handle, decals_size),
@@ -261,71 +269,48 @@ class SceneGPU:
                       for (b, t, _h, _size), info in zip(sources, infos, strict=True)]
             v.vkUpdateDescriptorSets(dev, len(writes), writes, 0, None)
 
+    def _draws_of(self, frame_set: int) -> Any:
+        """The buffer binding 1 reads: the persistent instances (gpu), the device copy of the
+        host-written Draws (naive), the host-written Draws (cpu)."""
+        if self.mode == "gpu":
+            return self.instance_buffer
+        return self.naive.draws[frame_set] if self.naive is not None else self.draw_buffers[frame_set]
+
     # ----------------------------------------------------------------- per frame
     def update(self, frame: int, frame_set: int) -> None:
-        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished).
-        ``draw.mode=gpu`` writes no per-object data (the instances are persistent);
-        ``naive`` culls every object on the CPU and writes one draw command per object."""
-        data = self.data
-        logic = self.logic
-        if logic is None:
-            seconds = data.seconds(frame)
-        else:  # between the logic thread's last two states
-            prev, cur = logic.latest() if self.deform is None else self.deform.take(frame_set, logic.latest)
-            alpha = interpolation_alpha(logic.clock(), cur.wall, logic.hz)
-            seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
-            self.alpha_range[0] = min(self.alpha_range[0], alpha)
-            self.alpha_range[1] = max(self.alpha_range[1], alpha)
-        self.frame_buffers[frame_set].write(packing.frame_bytes(data, frame, seconds))
-        camera = data.camera(frame).position.tobytes()
-        # camera-relative tables change with the camera only; naive mode (the engines' way) writes
-        # every object's matrix every frame
-        if self._camera_written[frame_set] != camera or self.mode == "naive":
-            if self.mode != "gpu":
-                self.draw_buffers[frame_set].write(packing.draws_bytes(data, frame))
-            if data.decals:
-                self.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
-            self._camera_written[frame_set] = camera
-        if self.views > 1:
-            self.view_buffers[frame_set].write(scene_instances.cached_views_bytes(data, frame, self.views, self.ipd))
-        if self.mode == "naive":
-            self.naive_buffers[frame_set].write(scene_instances.naive_commands(data, frame, self.calls, self.views,
-                                                                               self.ipd))
-        if logic is None:
-            if self.skin is not None:
-                self.skin.update(seconds, frame_set)
-            if self.deform is not None:
-                self.deform.write(seconds, frame_set)
-            return
-        if self.skin is not None:  # the logic thread packed these states (logic_step)
-            self.skin.show(frame_set, prev.tick, cur.tick, alpha)
-        if self.deform is not None:
-            self.deform.set_header(frame_set, alpha, prev.value, cur.value)  # the logic wrote the slots
-        self.ticks_taken[frame_set] = (prev.tick, cur.tick)
+        """Write set ``frame_set``'s host memory for ``frame`` (its previous use has finished):
+        ``rgraph.vk.scene_frame.SceneFrames.update``. ``draw.mode=gpu`` writes no per-object
+        data (the instances are persistent); ``naive`` culls every object on the CPU and
+        writes one draw command per object."""
+        self.frames.update(frame, frame_set)
 
     def attach_logic(self, logic: Any) -> None:
-        """Take scene time and deformable positions from ``logic`` (a started-on-demand
+        """Take scene time, deformable positions and bones from ``logic`` (a started-on-demand
         ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step`` and whose lock is
-        ``deform.lock``)."""
+        ``lock``)."""
         self.logic = logic
         if self.skin is not None:
             self.skin.logic_hz = float(logic.hz)  # skinning's logic ticks are this thread's
         self.ticks_taken = [None] * self.sets
         self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
 
-    def logic_step(self, seconds: float) -> Any:
-        """One logic tick at scene time ``seconds`` (the logic thread): the deformable positions
-        written into a free ring slot; the slot (None: no deformable meshes)."""
-        if self.skin is not None and self.skin.active:  # packed here, copied by the render thread
-            self.skin.state(round(seconds * self.logic.hz))
-        if self.deform is None:
-            return None
-        return self.deform.write_slot(seconds, self.logic.published)
+    @property
+    def lock(self) -> Any:
+        """The lock the logic thread publishes states under (ring slots change hands under it)."""
+        return self.frames.lock
 
-    def record_deform(self, cb: Any, frame_set: int) -> None:
-        """The deformable vertices' compute pass and its barriers (nothing without deformable meshes)."""
+    def logic_step(self, seconds: float) -> Any:
+        """One logic tick at scene time ``seconds`` (the logic thread): (deformable slot, bones
+        slot) of the ring slots it wrote (``SceneFrames.logic_step``)."""
+        return self.frames.logic_step(seconds)
+
+    def record_frame(self, cb: Any, frame_set: int) -> None:
+        """The scene's per-frame GPU work before the frame's draws, with its barriers: the
+        deformable vertices' compute pass, draw.mode=naive's table copies (nothing otherwise)."""
         if self.deform is not None:
             self.deform.record(cb, frame_set)
+        if self.naive is not None:
+            self.naive.record(cb, frame_set)
 
     def refresh_instances(self) -> None:
         """After instances moved (``SceneMesh.positions`` changed in ``self.data``): drop the
@@ -334,7 +319,7 @@ class SceneGPU:
         idle (frames in flight read the table), so it suits rare changes."""
         for cache in ("_instance_arrays", "_packed_draw_table", "_frame_cache", "_views_cache"):
             self.data.__dict__.pop(cache, None)
-        self._camera_written = [None] * self.sets  # the Draws are written again at the next update
+        self.frames.forget_camera()  # the camera-relative tables are written again at the next update
         if self.mode == "gpu":
             vk().vkDeviceWaitIdle(self.device.handle)
             self._upload(self._submit_once, [(self.instance_buffer, scene_instances.instance_bytes(self.data))])
@@ -362,6 +347,9 @@ class SceneGPU:
         if any(call.deformable for call in calls) and not self.deform.recorded[frame_set]:
             raise ExecutionError("deformable meshes drawn before their compute pass was recorded (the draw is not "
                                  "on the graphics queue after the frame's first scene batch)")
+        if self.naive is not None and not self.naive.recorded[frame_set]:
+            raise ExecutionError("draw.mode=naive: scene drawn before the frame's table copies were recorded (the draw "
+                                 "is not on the graphics queue after the frame's first scene batch)")
         if args is not None and self.mode == "gpu" and share is None:
             rec.bind_vertex_buffers([self.vertex_buffer.handle])
             bound = self.vertex_buffer.handle
@@ -373,8 +361,9 @@ class SceneGPU:
                 rec.bind_vertex_buffers([want])
                 bound = want
             if self.mode == "naive" and not call.deformable:
+                commands = self.naive.commands[frame_set].handle
                 for d in range(call.first_instance, call.first_instance + call.instances):
-                    rec.draw_indexed_indirect(self.naive_buffers[frame_set].handle, 20 * d)
+                    rec.draw_indexed_indirect(commands, 20 * d)
                 continue
             rec.draw_indexed(call.index_count, call.instances, call.first_index, call.vertex_offset,
                              call.first_instance)

@@ -7,15 +7,17 @@
   (``Draw.info.y``) a ``uvec4`` whose x is the first entry of that mesh's rest joint positions
   (``head``, float32 bits in xyz), then those heads. A slot: the packed joint transforms of
   every skinned instance (rgraph.scene.skinning: 16 bytes per bone, bone-major per mesh). Each
-  logic state is packed and written once, into a slot no frame in flight reads; the study's
-  "two bone textures" are the two slots a frame set names.
+  logic state is packed and written once, into a slot no frame in flight reads (``SLOTS``:
+  two per frame set, the logic's published pair and the one being written); the study's
+  "two bone textures" are the two slots a frame set names. With a logic thread the thread
+  writes its states there itself (``write_slot``); the render thread only names the slots.
 - binding 9 ``SkinFrame`` (per frame set, std140): ``(alpha, previous slot's first entry,
   current slot's first entry, 0)``; the vertex shader interpolates previous -> current.
 
 Logic time: frame ``f`` shows ``interpolate(state k - 1, state k, alpha)`` with
 ``(k, alpha) = logic_tick(f / 60 s, logic_hz)`` (rgraph.scene.animation); the logic rate is
-``plan["logic_hz"]`` (default 60). A logic thread can publish states through
-:meth:`SkinGPU.show` instead.
+``plan["logic_hz"]`` (default 60). A logic thread (``rgraph.vk.scene_frame``) writes states
+with :meth:`SkinGPU.write_slot` and frames name them with :meth:`SkinGPU.show_slots` instead.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from rgraph.vk.resources import HostBuffer
 BINDING_SKIN_VERTICES, BINDING_BONES, BINDING_SKIN_FRAME = range(7, 10)  # after scene.glsl's Views (5), Meshes (6)
 SKIN_VERTEX_BYTES = 8
 SKIN_FRAME_BYTES = 16
+SLOTS = 8  # >= 2 sets x 2 slots in flight + the published pair + the one being written
 
 
 class SkinGPU:
@@ -47,7 +50,7 @@ class SkinGPU:
         self.data, self.sets, self.logic_hz = data, sets, float(logic_hz)
         self.meshes = list(rigid_bases)
         self.bones = data.bone_count
-        self.slots = 2 * sets  # every other set holds at most two, this one needs two
+        self.slots = max(SLOTS, 2 * sets + 3)
         self._buffers: list[HostBuffer] = []
         storage, uniform = v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
         active = self.bones > 0
@@ -66,11 +69,15 @@ class SkinGPU:
         self.bones_bytes = max((self.header + self.slots * self.bones) * BONE_BYTES, 16)
         self.ring = self._buffer(device, self.bones_bytes, storage)
         self.ring.write(header.tobytes())
+        self._ring_bytes = np.frombuffer(self.ring.mapped, dtype=np.uint8, count=self.bones_bytes)
         self.frames = [self._buffer(device, SKIN_FRAME_BYTES, uniform) for _ in range(sets)]
+        self.frame_words = []  # per set: (float *, uint32_t *) cffi pointers to its SkinFrame
         for buf in self.frames:
             buf.write(bytes(SKIN_FRAME_BYTES))
+            raw = v.ffi.from_buffer(buf.mapped)
+            self.frame_words.append((v.ffi.cast("float *", raw), v.ffi.cast("uint32_t *", raw)))
         self._slot_tick: list[int | None] = [None] * self.slots
-        self._held: list[tuple[int, int]] = [(-1, -1)] * sets  # slots each set's frame reads
+        self.in_use: list[tuple[int, int]] = [(-1, -1)] * sets  # slots each set's frame reads
         self._states: dict[int, np.ndarray] = {}
 
     @staticmethod
@@ -115,27 +122,50 @@ class SkinGPU:
             self._states[tick] = got
         return got
 
+    def _write(self, slot: int, tick: int) -> None:
+        """State ``tick`` into ring slot ``slot``: one NumPy copy, which releases the GIL while
+        it runs (4 MiB for 1,024 x 256 bones: the render thread is not held up meanwhile)."""
+        start = (self.header + slot * self.bones) * BONE_BYTES
+        packed = np.ascontiguousarray(self.state(tick)).reshape(-1).view(np.uint8)
+        np.copyto(self._ring_bytes[start:start + self.bones * BONE_BYTES], packed)
+        self._slot_tick[slot] = tick
+
     def _slot_of(self, tick: int, frame_set: int, keep: int) -> int:
         if tick in self._slot_tick:
             return self._slot_tick.index(tick)
-        busy = {s for k, held in enumerate(self._held) if k != frame_set for s in held} | {keep}
+        busy = {s for k, held in enumerate(self.in_use) if k != frame_set for s in held} | {keep}
         slot = next(s for s in range(self.slots) if s not in busy)
-        start = (self.header + slot * self.bones) * BONE_BYTES
-        self.ring.mapped[start:start + self.bones * BONE_BYTES] = memoryview(np.ascontiguousarray(self.state(tick))).cast("B")
-        self._slot_tick[slot] = tick
+        self._write(slot, tick)
+        return slot
+
+    def write_slot(self, tick: int, lock: Any, published: Any) -> int:
+        """The logic thread's tick: state ``tick`` packed and written into a slot that no
+        frame set reads (``in_use``) and ``published()`` (the slots of the states a frame may
+        still take) does not name, chosen under ``lock``; its index."""
+        with lock:
+            busy = {*published(), *(x for pair in self.in_use for x in pair)}
+            slot = next(s for s in range(self.slots) if s not in busy)
+        self._slot_tick[slot] = None  # the state being written is no state yet
+        self._write(slot, tick)
         return slot
 
     def show(self, frame_set: int, previous: int, current: int, alpha: float) -> None:
         """Frame set ``frame_set`` (its last frame finished) draws logic states ``previous`` ->
-        ``current`` at ``alpha`` in [0, 1]."""
+        ``current`` at ``alpha`` in [0, 1] (written into slots here when they are not yet)."""
         if not self.active:
             return
         a = self._slot_of(previous, frame_set, -1)
         b = self._slot_of(current, frame_set, a)
-        self._held[frame_set] = (a, b)
-        alpha = min(max(float(alpha), 0.0), 1.0)
-        first = np.array([self.header + a * self.bones, self.header + b * self.bones, 0], dtype=np.uint32)
-        self.frames[frame_set].write(np.float32(alpha).tobytes() + first.tobytes())
+        self.in_use[frame_set] = (a, b)
+        self.show_slots(frame_set, a, b, alpha)
+
+    def show_slots(self, frame_set: int, a: int, b: int, alpha: float) -> None:
+        """Frame set ``frame_set`` mixes ring slots ``a`` -> ``b`` at ``alpha`` (the SkinFrame
+        uniform, written in place: 12 bytes)."""
+        f, u = self.frame_words[frame_set]
+        f[0] = min(max(alpha, 0.0), 1.0)
+        u[1] = self.header + a * self.bones
+        u[2] = self.header + b * self.bones
 
     def update(self, seconds: float, frame_set: int) -> None:
         """The frame at render time ``seconds``: states k - 1 -> k at alpha (module docstring)."""

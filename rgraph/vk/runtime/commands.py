@@ -1,7 +1,10 @@
 """Command buffers: one per batch of the lowered recording and frame-in-flight set, recorded once.
 
-Per pass: a debug label, a start timestamp, (the first scene pass on the graphics queue: the
-scene's deformable vertices, ``SceneGPU.record_deform``), the pass's lowered barrier calls, its commands
+Per pass: a debug label, the reset of its two timestamp queries (on graphics and compute
+queue families; a pass on a transfer-only family leaves ``ex.host_query_reset`` set and the
+frame loop resets the set's pool from the host), a start timestamp, (the first scene pass on
+the graphics queue: the scene's per-frame GPU work, ``SceneGPU.record_frame``: deformable
+vertices, naive mode's table copies), the pass's lowered barrier calls, its commands
 (``ImplPass.record``), its lowered releases, an end timestamp. Nothing here decides a
 barrier (``rgraph.vk.lower``); ``rgraph.vk.record`` builds the structs.
 """
@@ -24,6 +27,7 @@ def record(ex: Any) -> None:
     plan_passes = ex.plan["passes"]
     ex.command_buffers = []
     deform_batch = scene_batch(ex)
+    ex.host_query_reset = False
     for s in range(FRAMES_IN_FLIGHT):
         per_batch = []
         for bi, batch in enumerate(recording.batches):
@@ -37,14 +41,18 @@ def record(ex: Any) -> None:
             v.vkBeginCommandBuffer(cb, v.VkCommandBufferBeginInfo())
             ctx = RecordContext(dev, cb)
             timestamps = dev.timestamp_valid_bits.get(batch.queue, 0) > 0
+            in_command_buffer = bool(dev.capabilities.get(batch.queue, frozenset()) & {"graphics", "compute"})
+            ex.host_query_reset |= timestamps and not in_command_buffer
             for i in batch.passes:
                 lowered = recording.passes[i]
                 ex.log.context = f"recording pass {lowered.name}"
                 label_begin(dev, cb, f"pass {lowered.name}")
                 if timestamps:
+                    if in_command_buffer:  # query commands of one queue run in submission order
+                        v.vkCmdResetQueryPool(cb, ex.query_pools[s], 2 * i, 2)
                     v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, ex.query_pools[s], 2 * i)
                 if bi == deform_batch and i == batch.passes[0]:  # counted in this pass's GPU time
-                    ex.scene_gpu.record_deform(cb, s)
+                    ex.scene_gpu.record_frame(cb, s)
                 for barriers in barrier_batches(ex.resources, s, lowered.before):
                     ex.barrier_batches.append(barriers)
                     v.vkCmdPipelineBarrier2(cb, barriers.dependency)
@@ -61,7 +69,7 @@ def record(ex: Any) -> None:
 
 def scene_batch(ex: Any) -> int | None:
     """The first batch (submit order) on the graphics VkQueue with a pass that uses the scene:
-    the scene's per-frame compute work (``SceneGPU.record_deform``) goes at its start."""
+    the scene's per-frame compute work (``SceneGPU.record_frame``) goes at its start."""
     if ex.scene_gpu is None:
         return None
     graphics = ex.device.queues["graphics"]

@@ -44,8 +44,12 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     a frame into blocked, Vulkan calls and Python from them.
 
     The loop calls the binding's raw cffi functions with prebuilt arrays: per frame one fence
-    wait and reset, one query read into a preallocated buffer (copied into a numpy row), the
-    timeline values, and one vkQueueSubmit2 per call of ``submit_calls``.
+    wait and reset, one query read into a preallocated buffer (copied out as bytes; with
+    ``ex.timestamp_every`` = k > 1 only every k-th use of a frame set reads its timestamps, the
+    per-pass medians then come from 1 / k of the frames), the timeline values, and one
+    vkQueueSubmit2 per call of ``submit_calls``. The timestamp queries are reset by each pass
+    in its command buffer (``rgraph.vk.runtime.commands``), from the host only where a pass
+    runs on a transfer-only queue family.
 
     With a logic thread (``ex.logic``: ``rgraph run --logic-hz``) it runs while the frames do
     (started here, stopped when they end or fail); an error there stops the loop. The timings
@@ -64,16 +68,24 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     fence_arrays = ex.fence_arrays
     pools = ex.query_pools
     timestamps = n > 0 and all(dev.timestamp_valid_bits.get(p["queue"], 0) > 0 for p in ex.plan["passes"])
+    host_reset = timestamps and getattr(ex, "host_query_reset", True)
+    every = max(1, int(getattr(ex, "timestamp_every", 1)))  # read one frame's timestamps in this many
     query_buffer = ffi.new("uint64_t[]", max(2 * n, 1))
-    query_view = np.frombuffer(ffi.buffer(query_buffer), dtype=np.uint64)
-    rows = np.zeros((frames, 2 * n), dtype=np.uint64)
-    collected = 0
+    query_bytes = ffi.buffer(query_buffer)
+    query_size = 16 * n
+    read_rows: list[bytes] = []  # each read frame's timestamps (bytes: a copy in one C call)
     query_flags = v.VK_QUERY_RESULT_64_BIT
-    cpu_s = np.zeros(frames)
+    cpu_s = [0.0] * frames  # plain lists: no NumPy call in the loop
+    update_s = [0.0] * frames
     submitted = [False] * FRAMES_IN_FLIGHT
     scene, updaters = ex.scene_gpu, ex.updaters
+    update = scene.update if scene is not None else None
     wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
     get_queries, reset_queries = lib.vkGetQueryPoolResults, lib.vkResetQueryPool
+    # per set: (queue, infos count, infos, fence, context) of each vkQueueSubmit2; semaphore values
+    calls_of = [[(c.queue, c.count, c.infos, c.fence, c.context) for c in ex.submit_calls[k]]
+                for k in range(FRAMES_IN_FLIGHT)]
+    slots_of = ex.value_slots
     timeout = 10**11
     perf = time.perf_counter
     timed = marks is not None
@@ -81,7 +93,6 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     base = ex.frames_done
     origin = getattr(ex, "frame_origin", 0)
     logic = ex.logic
-    update_s = np.zeros(frames)
     thread_t0 = time.thread_time()
     wall_t0 = perf()
     try:
@@ -97,31 +108,34 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if timed:
                 mark(t0)
             log.context = f"frame {frame}"  # also a hook: tests/vk/test_soak.py samples RSS on it
-            fenced = fence_counts[s] > 0
+            count = fence_counts[s]
             if timed:
                 mark(perf())
-            if fenced:
-                check_result(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
+            if count:
+                result = wait_fences(handle, count, fence_arrays[s], 1, timeout)
+                if result:
+                    check_result(result, "vkWaitForFences")
             if timed:
                 mark(perf())
                 mark(perf())
-            if fenced and submitted[s] and timestamps:
-                read = get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0
+            if count and submitted[s] and timestamps and (frame // FRAMES_IN_FLIGHT) % every == 0:
+                read = get_queries(handle, pools[s], 0, 2 * n, query_size, query_buffer, 8, query_flags) == 0
                 if timed:
                     mark(perf())
                 if read:
-                    rows[collected] = query_view
-                    collected += 1
+                    read_rows.append(query_bytes[:])
             elif timed:
                 mark(perf())
             if timed:
                 mark(perf())
-            if fenced:
-                check_result(reset_fences(handle, fence_counts[s], fence_arrays[s]), "vkResetFences")
+            if count:
+                result = reset_fences(handle, count, fence_arrays[s])
+                if result:
+                    check_result(result, "vkResetFences")
             if timed:
                 mark(perf())
                 mark(perf())
-            if fenced and timestamps:
+            if count and host_reset:  # otherwise each pass resets its queries on the GPU
                 reset_queries(handle, pools[s], 0, 2 * n)
             if timed:
                 mark(perf())
@@ -129,19 +143,21 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
                 raise ExecutionError(f"frame {frame}: the logic thread failed: {logic.error!r}")
             u0 = perf()
             content = frame - origin  # the frame's content index (camera, animation, probe values)
-            if scene is not None:
-                scene.update(content, s)
+            if update is not None:
+                update(content, s)
             for p in updaters:
                 p.update(content, s)
             update_s[local] = perf() - u0
-            for slot, offset in ex.value_slots[s]:
+            for slot, offset in slots_of[s]:
                 slot.value = frame + offset
-            for call in ex.submit_calls[s]:
+            for queue, infos_count, infos, fence, context in calls_of[s]:
                 if validate:
-                    log.context = f"frame {frame} {call.context}"
+                    log.context = f"frame {frame} {context}"
                 if timed:
                     mark(perf())
-                check_result(submit2(call.queue, call.count, call.infos, call.fence), "vkQueueSubmit2")
+                result = submit2(queue, infos_count, infos, fence)
+                if result:
+                    check_result(result, "vkQueueSubmit2")
                 if timed:
                     mark(perf())
             submitted[s] = True
@@ -157,10 +173,11 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     for s in range(FRAMES_IN_FLIGHT):
         if submitted[s] and fence_counts[s]:
             check_result(wait_fences(handle, fence_counts[s], fence_arrays[s], 1, timeout), "vkWaitForFences")
-            if timestamps and get_queries(handle, pools[s], 0, 2 * n, 16 * n, query_buffer, 8, query_flags) == 0:
-                rows[collected] = query_view
-                collected += 1
-    out = timings(ex, rows[:collected], frames, cpu_s)
+            if timestamps and get_queries(handle, pools[s], 0, 2 * n, query_size, query_buffer, 8, query_flags) == 0:
+                read_rows.append(query_bytes[:])
+    rows = np.frombuffer(b"".join(read_rows), dtype=np.uint64).reshape(len(read_rows), 2 * n) if read_rows and n \
+        else np.zeros((0, 2 * n), dtype=np.uint64)
+    out = timings(ex, rows, frames, np.asarray(cpu_s))
     out["render_thread"] = render
     if logic is not None:
         out["logic"] = {**logic.stats(), "alpha_range": list(scene.alpha_range) if scene is not None else None}

@@ -69,7 +69,7 @@ def attach_logic(ex: Any, hz: float) -> None:
 
     try:
         scene = ex.scene_gpu
-        lock = scene.deform.lock if scene is not None and scene.deform is not None else None
+        lock = scene.lock if scene is not None else None
         ex.logic = LogicThread(scene.logic_step if scene is not None else (lambda _s: None), hz, lock=lock)
     except ValueError as exc:
         raise ExecutionError(str(exc)) from None

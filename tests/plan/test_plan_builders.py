@@ -1,0 +1,36 @@
+"""``rgraph.plan.builders.builder``: the fast constructors build objects equal to the
+dataclasses' own, with the same defaults, keywords and immutability."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from rgraph.plan import model as pm
+from rgraph.plan.builders import builder
+
+
+def test_builders_equal_the_dataclass_constructors() -> None:
+    sub = pm.Subresource((0, 1), (0, 2))
+    st = pm.State(("COMPUTE_SHADER",), ("SHADER_STORAGE_WRITE",), "GENERAL", "compute")
+    cases = [
+        (pm.Access, ("img", sub, "storage_write", ("A",), ("B",), "GENERAL", True), {}),
+        (pm.Barrier, ("img", sub, st, st), {}),
+        (pm.Barrier, ("img", None, st, st), {"aliases": ("old",)}),
+        (pm.Wait, ("compute", 3, ("ALL_COMMANDS",)), {}),
+        (pm.Signal, ("graphics", 1, ("ALL_COMMANDS",)), {"device": 1}),
+        (pm.Culled, ("p", "reaches no output", ("r",), 256), {}),
+    ]
+    for cls, args, kwargs in cases:
+        made = builder(cls)(*args, **kwargs)
+        assert type(made) is cls
+        assert made == cls(*args, **kwargs)
+        assert hash(made) == hash(cls(*args, **kwargs))
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(made, dataclasses.fields(cls)[0].name, "x")
+
+
+def test_builder_refuses_classes_it_cannot_build() -> None:
+    with pytest.raises(TypeError):
+        builder(pm.Plan)  # no slots, default_factory fields

@@ -201,20 +201,25 @@ class Executable:
         """Frames whose content has been rendered (frames run, less warm-up frames that do not count)."""
         return self.executor.frames_done - self.executor.frame_origin
 
-    def warm_up(self, seconds: float) -> int:
+    def warm_up(self, seconds: float, frames: int | None = None) -> int:
         """Run untimed frames for about ``seconds`` of wall time (at least one frame when
         ``seconds`` > 0) so that a GPU that idles at low clocks is at its working clocks when
-        timing starts. Returns the frames run. When the plan carries no state between frames
-        (``rgraph.plan.state.carries_state``) the next frame's content is frame 0 again
-        (camera, animation, probe values), so images do not depend on how many warm-up frames
-        the wall time allowed; otherwise the warm-up frames count (the data check knows them)."""
+        timing starts; ``frames``: exactly that many instead, whatever the wall time (sweeps:
+        the same count for every setting). Returns the frames run. When the plan carries no
+        state between frames (``rgraph.plan.state.carries_state``) the next frame's content is
+        frame 0 again (camera, animation, probe values), so images do not depend on how many
+        warm-up frames the wall time allowed; otherwise the warm-up frames count (the data
+        check knows them)."""
         from rgraph.vk.runtime.frames import run_for
 
-        if seconds <= 0:
+        if (seconds <= 0) if frames is None else frames <= 0:
             return 0
         from rgraph.plan.state import carries_state
 
-        frames = run_for(self.executor.run_frames, seconds)
+        if frames is None:
+            frames = run_for(self.executor.run_frames, seconds)
+        else:
+            self.executor.run_frames(frames)
         if not carries_state(self.plan):
             self.executor.frame_origin = self.executor.frames_done
         return frames

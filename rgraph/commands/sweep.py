@@ -28,7 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     parser.add_argument("--grid", action="store_true", help="every combination of the knobs' values")
     parser.add_argument("--frames", type=int, default=8, help="frames per setting; times are medians (default 8)")
     parser.add_argument("--warmup", type=warmup_seconds, default=None, metavar="SECONDS",
-                        help="untimed frames before each setting's timed ones (default: 0.3 s on a GPU, none on a CPU device)")
+                        help="untimed frames before each setting's timed ones: SECONDS x 200 frames, the same count for "
+                             "every setting (animated scenes move by frame) (default: 0.3 s = 60 frames on a GPU, "
+                             "none on a CPU device)")
     parser.add_argument("--device", type=int, default=None, help="physical device index")
     parser.add_argument("--policy", help="memory placement policy (see rgraph compile)")
     parser.add_argument("--hdr", metavar="RESOURCE",

@@ -51,6 +51,10 @@ class Collector:
         else:
             self.pending.append(key)
 
+    def extreme_slugs(self, key: tuple) -> tuple[str, ...]:
+        """Slugs of the settings of params ``key`` whose error maps are kept."""
+        return tuple(s.slug for s in self.settings if self.keys[s.label] == key and s.label in self.extremes)
+
     def reference_images(self) -> Images | None:
         """The reference's images once it rendered (kept to the end), else None."""
         reference = self.renderings.get(self.reference_key)
@@ -84,7 +88,8 @@ class Collector:
         image_io.save_png(self.out_dir / f"images/{s.slug}.png", rendering.png or test)
         ref = reference.images.ldr if reference is not None else None
         if s.label in self.extremes and ref is not None and ref.shape == test.shape:
-            self.error_maps[s.label] = plots.write_error_maps(self.out_dir, s.slug, ref, test)
+            self.error_maps[s.label] = plots.write_error_maps(self.out_dir, s.slug, ref, test,
+                                                              rendering.error_maps.get(s.slug))
 
     def result(self) -> SweepResult:
         """The sweep's result once every distinct setting was added."""

@@ -85,10 +85,15 @@ def pareto_plot(path: Path, *, knob: str, labels: list[str], ms: list[float | No
     return True
 
 
-def write_error_maps(out_dir: Path, slug: str, reference: np.ndarray, test: np.ndarray) -> list[str]:
-    """Per-pixel error maps of display images: |difference| heatmap, and FLIP (magma, its
-    own [0, 1] scale) when flip-evaluator is installed. Returns paths relative to ``out_dir``."""
-    written = []
+def error_map_pngs(slug: str, reference: np.ndarray, test: np.ndarray) -> dict[str, bytes]:
+    """Per-pixel error maps of display images as PNG bytes by path (relative to the output
+    folder): the |difference| heatmap, and FLIP (magma, its own [0, 1] scale) when
+    flip-evaluator is installed. Pure: a worker process draws them (``--workers``)."""
+    import io
+
+    from rgraph.sweep.images import png_bytes
+
+    maps: dict[str, bytes] = {}
     diff = metrics.abs_difference(reference, test)
     plt = _pyplot()
     h, w = diff.shape
@@ -99,15 +104,22 @@ def write_error_maps(out_dir: Path, slug: str, reference: np.ndarray, test: np.n
         ax.set_title(f"{slug}: max {diff.max():.4g}, mean {diff.mean():.4g}", fontsize=9)
         ax.set_axis_off()
         fig.tight_layout()
-        rel = f"errors/{slug}_absdiff.png"
-        (out_dir / rel).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(out_dir / rel)
-        written.append(rel)
+        buffer = io.BytesIO()
+        fig.savefig(buffer, format="png")
+        maps[f"errors/{slug}_absdiff.png"] = buffer.getvalue()
     finally:
         plt.close(fig)
     out = flip.flip_ldr(reference, test, magma=True)
     if out is not None:
-        rel = f"errors/{slug}_flip.png"
-        save_png(out_dir / rel, out[0])
-        written.append(rel)
-    return written
+        maps[f"errors/{slug}_flip.png"] = png_bytes(out[0])
+    return maps
+
+
+def write_error_maps(out_dir: Path, slug: str, reference: np.ndarray, test: np.ndarray,
+                     drawn: dict[str, bytes] | None = None) -> list[str]:
+    """Write :func:`error_map_pngs` (``drawn``: already drawn, e.g. by a worker) under
+    ``out_dir``. Returns their paths relative to ``out_dir``."""
+    maps = error_map_pngs(slug, reference, test) if drawn is None else drawn
+    for rel, data in maps.items():
+        save_png(out_dir / rel, data)
+    return list(maps)

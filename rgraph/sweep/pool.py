@@ -41,7 +41,7 @@ def _items(groups: list[Group], sweeps: dict[str, Prepared], timing_lock: str | 
     """(group name, params key) and job of every distinct setting: all references first, then
     the first group (in the given order) whose reference rendered and that has settings left,
     else the first with settings left. Read lazily by the executor, one item per free worker."""
-    from rgraph.sweep.remote import job_maker
+    from rgraph.sweep.remote import collector_job, job_maker
 
     makers = {g.name: job_maker(g.request, timing_lock=timing_lock) for g in groups}
     left: dict[str, deque[tuple]] = {}
@@ -49,14 +49,14 @@ def _items(groups: list[Group], sweeps: dict[str, Prepared], timing_lock: str | 
         sweep = sweeps[g.name]
         reference = sweep.collector.reference_key
         left[g.name] = deque(k for k in sweep.distinct if k != reference)
-        yield (g.name, reference), makers[g.name](sweep.distinct[reference], None)
+        yield (g.name, reference), makers[g.name](sweep.distinct[reference])
     while any(left.values()):
         waiting = [g.name for g in groups if left[g.name]]
         ready = [n for n in waiting if sweeps[n].collector.reference_images() is not None]
         name = (ready or waiting)[0]
         key = left[name].popleft()
         sweep = sweeps[name]
-        yield (name, key), makers[name](sweep.distinct[key], sweep.collector.reference_images())
+        yield (name, key), collector_job(makers[name], sweep.collector, key, sweep.distinct[key])
 
 
 def run_groups(groups: list[Group], executor: Executor, *, done: Done | None = None,

@@ -42,6 +42,7 @@ class RenderJob:
     fault: str | None = None
     reference: Any = None  # the reference's Images once rendered: the worker compares with it
     timing_lock: str | None = None  # file locked around the timed frames (local workers sharing a GPU)
+    error_maps: tuple[str, ...] = ()  # slugs whose error maps the worker draws (with the reference)
 
 
 def implementation_modules(impls: set[str]) -> tuple[tuple[str, str | None], ...]:
@@ -77,21 +78,31 @@ def job_maker(request: Any, env: Mapping[str, str] | None = None,
     sys_path = tuple(p for p in sys.path if p)
     modules = implementation_modules(_graph_impls(request))
 
-    def make(setting: Setting, reference: Any = None) -> RenderJob:
-        return RenderJob(request, setting, sys_path, modules, fault,
-                         None if setting.label == "reference" else reference, timing_lock)
+    def make(setting: Setting, reference: Any = None, error_maps: tuple[str, ...] = ()) -> RenderJob:
+        reference = None if setting.label == "reference" else reference
+        return RenderJob(request, setting, sys_path, modules, fault, reference, timing_lock,
+                         error_maps if reference is not None else ())
 
     return make
 
 
-def jobs(request: Any, settings: Mapping[Any, Setting], reference: Callable[[], Any] | None = None,
+def jobs(request: Any, settings: Mapping[Any, Setting], collector: Any = None,
          env: Mapping[str, str] | None = None, timing_lock: str | None = None) -> Iterator[tuple[Any, RenderJob]]:
     """(params key, job) per distinct setting, in the given order (the reference first).
-    Read lazily: a job made once ``reference()`` gives the reference's images carries them,
-    so its worker computes the metrics too."""
+    Read lazily: a job made once ``collector`` (:class:`rgraph.sweep.collect.Collector`) has
+    the reference's images carries them, so its worker computes the metrics and draws the
+    setting's error maps too."""
     make = job_maker(request, env, timing_lock)
     for key, setting in settings.items():
-        yield key, make(setting, reference() if reference is not None and setting.label != "reference" else None)
+        yield key, collector_job(make, collector, key, setting)
+
+
+def collector_job(make: Callable[..., RenderJob], collector: Any, key: Any, setting: Setting) -> RenderJob:
+    """``make``'s job for ``setting`` with what ``collector`` has: the reference's images
+    (once rendered) and the slugs of the settings of ``key`` whose error maps are kept."""
+    if collector is None:
+        return make(setting)
+    return make(setting, collector.reference_images(), collector.extreme_slugs(key))
 
 
 def _absolute(path: str | None) -> str | None:
@@ -222,4 +233,9 @@ def render_job(job: RenderJob) -> Any:
         from rgraph.sweep.compare import compare
 
         rendering.compared = compare(job.reference, rendering.images)
+        ref, test = job.reference.ldr, rendering.images.ldr
+        if job.error_maps and ref is not None and test is not None and ref.shape == test.shape:
+            from rgraph.sweep.plots import error_map_pngs
+
+            rendering.error_maps = {slug: error_map_pngs(slug, ref, test) for slug in job.error_maps}
     return rendering

@@ -38,7 +38,7 @@ class SweepRequest:
     policy: str | None = None
     hdr: str | None = None  # an intermediate image read back for HDR metrics
     validate: bool = False
-    warmup_s: float | None = None  # None: the device's default (api.Gpu.default_warmup_s)
+    warmup_s: float | None = None  # None: the device's default (api.Gpu.default_warmup_s); see warmup_frames
 
 
 @dataclass
@@ -109,6 +109,7 @@ class _Rendering:
     params_read: dict[str, list[str]] = field(default_factory=dict)  # pass -> params its impl looked up
     png: bytes | None = None  # the display image as PNG (encoded where it rendered: a worker, in parallel)
     compared: tuple[dict[str, float | None], list[str]] | None = None  # metrics, when a worker had the reference
+    error_maps: dict[str, dict[str, bytes]] = field(default_factory=dict)  # slug -> drawn maps (a worker's)
 
 
 def extreme_labels(settings: Sequence[Setting], knobs: Sequence[Knob], grid: bool) -> list[str]:
@@ -174,7 +175,7 @@ def run_sweep(request: SweepRequest, out_dir: Path, *, progress: bool = True,
         else:
             from rgraph.sweep.remote import jobs, render_job
 
-            for outcome in executor.run(render_job, jobs(request, distinct, collector.reference_images,
+            for outcome in executor.run(render_job, jobs(request, distinct, collector,
                                                          timing_lock=executor.timing_lock)):
                 collector.add(outcome.key, outcome.value, outcome.error)
                 bar.finished(distinct[outcome.key].label + ("" if outcome.ok else " (failed)"))
@@ -196,14 +197,36 @@ def _compile_all(request: SweepRequest, settings: list[Setting], gpu: Any) -> di
     return plans
 
 
+#: Untimed warm-up frames per second of ``--warmup`` (``warmup_frames``).
+WARMUP_FPS = 200
+
+
+def warmup_frames(request: SweepRequest, gpu: Any) -> int:
+    """Untimed frames before a setting's timed ones: ``--warmup`` seconds (default the
+    device's ``default_warmup_s``: 0.3 s on a GPU, none on a CPU device) times
+    :data:`WARMUP_FPS`, the same count for every setting. Plans that carry no state between
+    frames then start their content at frame 0 again (``Executable.warm_up``); for a plan
+    that does, a wall-time warm-up would run a different number of frames per setting and each
+    image would show another moment (errors that no knob caused, outputs that differ run to
+    run); a count keeps them the same."""
+    seconds = gpu.default_warmup_s if request.warmup_s is None else request.warmup_s
+    return max(1, round(seconds * WARMUP_FPS)) if seconds > 0 else 0
+
+
 def _render(request: SweepRequest, plan: dict, gpu: Any, timing: Any = None) -> _Rendering:
-    """Load ``plan`` on ``gpu``, warm up, time ``request.frames`` frames and read back; ``timing``:
-    a context manager held around the warm-up, the timed frames and the read-back (the lock
-    that keeps other local workers' frames off the GPU meanwhile: :mod:`rgraph.sweep.remote`)."""
+    """Load ``plan`` on ``gpu``, run :func:`warmup_frames` untimed frames, time
+    ``request.frames`` frames and read back; ``timing``: a context manager held around the
+    warm-up, the timed frames and the read-back (the lock that keeps other local workers'
+    frames off the GPU meanwhile: :mod:`rgraph.sweep.remote`)."""
     executable = gpu.load(plan)
+    warm = warmup_frames(request, gpu)
     with timing or contextlib.nullcontext():
-        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True,
-                                          warmup_s=request.warmup_s)
+        try:
+            executable.warm_up(0.0, frames=warm)
+        except BaseException:
+            executable.close()
+            raise
+        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True, warmup_s=0.0)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None

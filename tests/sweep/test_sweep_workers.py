@@ -108,8 +108,9 @@ def test_ray_missing_is_one_line(tmp_path, monkeypatch, capsys):
 
 def test_workers_started_after_the_reference_compare_with_it(one_process, tmp_path, monkeypatch, capsys):
     """With one worker the reference renders first, so every later job carries its images
-    and its worker computes the metrics: the parent compares only the reference with itself."""
-    from rgraph.sweep import collect
+    and its worker computes the metrics and draws the error maps: the parent compares only the
+    reference with itself and draws no error map (the worker's are the same bytes)."""
+    from rgraph.sweep import collect, plots
 
     real = collect.compare
 
@@ -117,7 +118,11 @@ def test_workers_started_after_the_reference_compare_with_it(one_process, tmp_pa
         assert reference is test, "a worker that had the reference should have compared"
         return real(reference, test)
 
+    def parent_draws(*args):
+        raise AssertionError("a worker that had the reference should have drawn the error maps")
+
     monkeypatch.setattr(collect, "compare", parent_compare)
+    monkeypatch.setattr(plots, "error_map_pngs", parent_draws)
     out = tmp_path / "w1"
     assert sweep([*ARGS, "--workers", "1", "-o", str(out)]) == 0, capsys.readouterr().err
     assert differences(one_process, out) == []

@@ -32,7 +32,7 @@ def unpack_text(text: str, folder: Path) -> list[Path]:
     """The files of :func:`pack_text`'s ``text`` written under ``folder``."""
     pieces = HEADER.split(text)  # ["", name, body, name, body, ...]
     written: list[Path] = []
-    for name, body in zip(pieces[1::2], pieces[2::2]):
+    for name, body in zip(pieces[1::2], pieces[2::2], strict=True):
         if ".." in Path(name).parts or Path(name).is_absolute():
             raise SystemExit(f"sweep_bundle: refusing path {name!r}")
         target = folder / name
@@ -58,7 +58,7 @@ def tile_plots(folder: Path, out: Path, columns: int = 3) -> int:
     fig, axes = plt.subplots(rows, columns, figsize=(6 * columns, 4.5 * rows), squeeze=False)
     for ax in axes.flat:
         ax.axis("off")
-    for ax, path in zip(axes.flat, plots):
+    for ax, path in zip(axes.flat, plots, strict=False):  # more axes than plots: the rest stay blank
         ax.imshow(mpimg.imread(path))
         ax.set_title(f"{path.parent.name}: {path.stem.removeprefix('pareto_')}", fontsize=10)
     fig.tight_layout()

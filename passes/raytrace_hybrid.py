@@ -131,11 +131,6 @@ class HybridShade(VisibilityImpl):
         self.extent = setup.extent_of("color")
         self.push = frame_constants(self.data, self.extent, max_depth_of(setup))
 
-    def record(self, rec: Any, frame_set: int) -> None:
-        self._bind(rec, frame_set)
-        rec.push(self.pipeline, self.push)
-        rec.trace_rays(self.pipeline, *self.extent)
-
 
 @register("rt_hybrid_secondary")
 class HybridSecondary(VisibilityImpl):
@@ -147,7 +142,4 @@ class HybridSecondary(VisibilityImpl):
         self.push = frame_constants(self.data, setup.extent_of("color"), max_depth_of(setup))
 
     def record(self, rec: Any, frame_set: int) -> None:
-        self._bind(rec, frame_set)
-        rec.push(self.pipeline, self.push)
-        args, _size = self.setup.buffer("ray_args", frame_set)
-        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(args))
+        self.trace_list(rec, frame_set, "ray_args")

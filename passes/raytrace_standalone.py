@@ -157,6 +157,20 @@ class RayTracingImpl(PassImpl):
             self.written.add(frame_set)
         rec.bind(self.pipeline, [self.sets[frame_set], self.as_sets[frame_set]])
 
+    def record(self, rec: Any, frame_set: int) -> None:
+        """One ray per texel of ``self.extent`` with ``self.push`` (passes that trace over a
+        list override this)."""
+        self._bind(rec, frame_set)
+        rec.push(self.pipeline, self.push)
+        rec.trace_rays(self.pipeline, *self.extent)
+
+    def trace_list(self, rec: Any, frame_set: int, args: str) -> None:
+        """One ray per entry of a compacted list: the indirect trace arguments in buffer ``args``."""
+        self._bind(rec, frame_set)
+        rec.push(self.pipeline, self.push)
+        buffer, _size = self.setup.buffer(args, frame_set)
+        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(buffer))
+
     def destroy(self) -> None:
         self.pipeline.destroy()
 
@@ -168,8 +182,3 @@ class RTStandalone(RayTracingImpl):
         super().__init__(setup, [Binding(7, "storage_image", self.output)])
         self.extent = setup.extent_of(self.output)
         self.push = frame_constants(self.data, self.extent, max_depth_of(setup))
-
-    def record(self, rec: Any, frame_set: int) -> None:
-        self._bind(rec, frame_set)
-        rec.push(self.pipeline, self.push)
-        rec.trace_rays(self.pipeline, *self.extent)

@@ -123,11 +123,6 @@ class WaveShade(WaveImpl):
         super().__init__(setup, bindings, defines, True)
         self.extent = setup.extent_of("color")
 
-    def record(self, rec: Any, frame_set: int) -> None:
-        self._bind(rec, frame_set)
-        rec.push(self.pipeline, self.push)
-        rec.trace_rays(self.pipeline, *self.extent)
-
 
 @register("rt_wave")
 class Wave(WaveImpl):
@@ -148,10 +143,7 @@ class Wave(WaveImpl):
     def record(self, rec: Any, frame_set: int) -> None:
         if self.pipeline is None:
             return
-        self._bind(rec, frame_set)
-        rec.push(self.pipeline, self.push)
-        args, _size = self.setup.buffer(list_args(self.level), frame_set)
-        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(args))
+        self.trace_list(rec, frame_set, list_args(self.level))
 
 
 @register("rt_wave_listed")
@@ -169,10 +161,7 @@ class WaveListed(WaveImpl):
         super().__init__(setup, [*GBUFFER, Binding(9, "storage_image", "ray_list"), *more], defines, True)
 
     def record(self, rec: Any, frame_set: int) -> None:
-        self._bind(rec, frame_set)
-        rec.push(self.pipeline, self.push)
-        args, _size = self.setup.buffer("ray_args", frame_set)
-        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(args))
+        self.trace_list(rec, frame_set, "ray_args")
 
 
 @register("rt_wave_resolve")

@@ -210,16 +210,17 @@ class Executable:
         frame 0 again (camera, animation, probe values), so images do not depend on how many
         warm-up frames the wall time allowed; otherwise the warm-up frames count (the data
         check knows them)."""
+        from rgraph.plan.state import carries_state
         from rgraph.vk.runtime.frames import run_for
 
-        if (seconds <= 0) if frames is None else frames <= 0:
-            return 0
-        from rgraph.plan.state import carries_state
-
         if frames is None:
+            if seconds <= 0:
+                return 0
             frames = run_for(self.executor.run_frames, seconds)
-        else:
+        elif frames > 0:
             self.executor.run_frames(frames)
+        else:
+            return 0
         if not carries_state(self.plan):
             self.executor.frame_origin = self.executor.frames_done
         return frames

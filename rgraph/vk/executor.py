@@ -96,6 +96,9 @@ class Executor:
         self.value_slots: list[list[tuple[Any, int]]] = []
         self.layer_edges = 0  # semaphore edges added only to avoid the 1.3.239 layer's racing false positive
         self.host_buffers: list[HostBuffer] = []
+        # host buffers reused by later read-backs and receives ((purpose, resource) -> buffer;
+        # also in host_buffers for teardown): the staged multi-device path moves tiles every frame
+        self.staging: dict[tuple[str, str], HostBuffer] = {}
         self.barrier_batches: list[BarrierBatch] = []
         self.frames_done = 0
         # frames_done at the first frame whose content is frame 0 (``Executable.warm_up`` moves it

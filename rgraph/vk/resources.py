@@ -96,6 +96,19 @@ class HostBuffer:
         v.vkFreeMemory(self.device.handle, self.memory, None)
 
 
+def staging_buffer(ex: Any, purpose: str, name: str, size: int, usage: int) -> HostBuffer:
+    """The executor ``ex``'s host buffer for ``purpose`` ("readback" or "upload") of resource
+    ``name``: made on first use (readback: HOST_CACHED preferred) and reused while it is big
+    enough; the caller has waited for the previous use. Destroyed with ``ex.host_buffers``."""
+    key = (purpose, name)
+    buf = ex.staging.get(key)
+    if buf is None or buf.size < size:
+        buf = HostBuffer.create(ex.device, size, usage, readback=purpose == "readback")
+        ex.host_buffers.append(buf)
+        ex.staging[key] = buf
+    return buf
+
+
 class ResourceSet:
     """Every plan resource for every frame-in-flight set, bound into per-heap memory."""
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph.vk.loader import vk
-from rgraph.vk.resources import HostBuffer
+from rgraph.vk.resources import staging_buffer
 from rgraph.vk.runtime.one_time import _any_access, buffer_barrier, copy_write, submit_once
 
 
@@ -24,7 +24,7 @@ def refill(executable: Any, received: dict[str, bytes]) -> None:
             from rgraph.vk.errors import ExecutionError
 
             raise ExecutionError(f"device 0's plan has no receiving buffer {name!r}")
-        staging = HostBuffer.create(ex.device, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
+        staging = staging_buffer(ex, "upload", name, len(data), v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
         staging.write(data)
         work.append((r, staging, len(data)))
 
@@ -35,8 +35,4 @@ def refill(executable: Any, received: dict[str, bytes]) -> None:
             v.vkCmdCopyBuffer(cb, staging.handle, r.handle, 1, [v.VkBufferCopy(srcOffset=0, dstOffset=0, size=size)])
             buffer_barrier(cb, r, copy_write(), _any_access())
 
-    try:
-        submit_once(ex, "graphics", record)
-    finally:  # waited for: this frame's staging buffers go now (not at close: one set per frame)
-        for _r, staging, _size in work:
-            staging.destroy()
+    submit_once(ex, "graphics", record)  # waited for: the next frame's receive may reuse the staging buffers

@@ -8,7 +8,7 @@ from rgraph.probe.semantics import mip_extent
 from rgraph.stages import CAPABILITIES, fit_to_queue
 from rgraph.vk import names
 from rgraph.vk.loader import vk
-from rgraph.vk.resources import HostBuffer
+from rgraph.vk.resources import staging_buffer
 from rgraph.vk.runtime.one_time import buffer_barrier, image_barrier, submit_once, whole_range
 from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
 from rgraph.vk.runtime.staging import image_copy_regions, texel_bytes
@@ -38,8 +38,7 @@ def read_back(ex: Any, frames: int | None = None) -> dict[tuple, bytes]:
                 regions, size = image_copy_regions(res, whole)
             else:
                 regions, size = None, int(res["size_bytes"] or res["bytes"])
-            buf = HostBuffer.create(ex.device, size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback=True)
-            ex.host_buffers.append(buf)
+            buf = staging_buffer(ex, "readback", res["name"], size, v.VK_BUFFER_USAGE_TRANSFER_DST_BIT)
             jobs.append((res, r, buf, regions, size))
 
         capabilities = ex.device.capabilities.get(queue, CAPABILITIES)

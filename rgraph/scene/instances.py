@@ -150,7 +150,17 @@ def naive_commands(scene: SceneData, frame: int, calls: list, views: int, ipd: f
             table[rows, 0], table[rows, 2], table[rows, 3] = call.index_count, call.first_index, call.vertex_offset
             table[rows, 4] = np.arange(call.first_instance, call.first_instance + call.instances)
         scene._naive_table = table  # type: ignore[attr-defined]
+    table[:scene.draw_count, 1] = _visible_of_frame(scene, frame, views, ipd)
+    return table.tobytes()
+
+
+def _visible_of_frame(scene: SceneData, frame: int, views: int, ipd: float) -> np.ndarray:
     cam = scene.camera(frame)
     projs = eye_view_projs(scene, frame, views, ipd) if views > 1 else [cam.view_proj]
-    table[:scene.draw_count, 1] = visible(scene, cam.position, projs)
-    return table.tobytes()
+    return visible(scene, cam.position, projs)
+
+
+def naive_visible(scene: SceneData, frame: int, views: int, ipd: float) -> list[int]:
+    """draw.mode=naive with direct draws, every frame: the CPU frustum test of every object;
+    the ids of the visible ones, ascending (a list: the recording loop iterates it)."""
+    return np.flatnonzero(_visible_of_frame(scene, frame, views, ipd)).tolist()

@@ -28,6 +28,17 @@ VALIDATION_ENV = {
     "VK_LAYER_DUPLICATE_MESSAGE_LIMIT": "1000",
 }
 
+#: ``RGRAPH_GPU_AV=1`` with validation: GPU-assisted validation (shader instrumentation:
+#: out-of-bounds descriptor accesses, indirect draw and dispatch arguments) instead of
+#: synchronization validation (layer 1.3.239: VK_LAYER_ENABLES and VkValidationFeaturesEXT).
+GPU_AV_ENABLES = ("VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_EXT:"
+                  "VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_RESERVE_BINDING_SLOT_EXT")
+
+
+def gpu_assisted() -> bool:
+    """GPU-assisted validation asked for (environment ``RGRAPH_GPU_AV=1``)."""
+    return os.environ.get("RGRAPH_GPU_AV", "") not in ("", "0")
+
 
 @dataclass(frozen=True)
 class ValidationMessage:
@@ -135,6 +146,8 @@ def create_instance(validate: bool, app_name: str = "rgraph") -> Instance:
                 f"--validate needs {VALIDATION_LAYER}; install it with `apt-get install vulkan-validationlayers`"
             )
         os.environ.update(VALIDATION_ENV)
+        if gpu_assisted():
+            os.environ["VK_LAYER_ENABLES"] = GPU_AV_ENABLES
         layers.append(VALIDATION_LAYER)
     if "VK_EXT_debug_utils" in available_ext:
         extensions.append("VK_EXT_debug_utils")
@@ -142,7 +155,9 @@ def create_instance(validate: bool, app_name: str = "rgraph") -> Instance:
         pApplicationName=app_name, applicationVersion=1, pEngineName="rgraph", engineVersion=1,
         apiVersion=v.VK_MAKE_VERSION(1, 3, 0),
     )
-    enables = [v.VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT]
+    enables = ([v.VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_EXT,
+                v.VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_RESERVE_BINDING_SLOT_EXT] if gpu_assisted()
+               else [v.VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT])
     features = (
         v.VkValidationFeaturesEXT(enabledValidationFeatureCount=len(enables), pEnabledValidationFeatures=enables)
         if validate else None

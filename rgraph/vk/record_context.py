@@ -87,6 +87,13 @@ class RecordContext(RayTracingCommands):
                      first_instance: int = 0) -> None:
         vk().vkCmdDrawIndexed(self._cb, indices, instances, first_index, vertex_offset, first_instance)
 
+    def draw_indexed_each(self, indices: int, first_index: int, vertex_offset: int, instances: list[int]) -> None:
+        """One ``vkCmdDrawIndexed`` per id in ``instances`` (firstInstance = the id, one
+        instance each): the raw cffi call in a loop, as an engine's per-object draws."""
+        draw, cb = vk().lib.vkCmdDrawIndexed, self._cb
+        for d in instances:
+            draw(cb, indices, 1, first_index, vertex_offset, d)
+
     def draw_indirect(self, buffer: Any, offset: int) -> None:
         vk().vkCmdDrawIndirect(self._cb, buffer, offset, 1, 16)
 

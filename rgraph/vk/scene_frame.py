@@ -78,7 +78,11 @@ class SceneFrames:
             words[TIME_WORD] = seconds
             words[TIME_WORD + 1] = frame
         if naive:
-            sc.naive_buffers[frame_set].write(scene_instances.naive_commands(data, frame, sc.calls, sc.views, sc.ipd))
+            if sc.naive.direct:  # the draws are recorded per frame (SceneGPU.rerecord): the visible ids
+                sc.naive.visible[frame_set] = scene_instances.naive_visible(data, frame, sc.views, sc.ipd)
+            else:
+                sc.naive_buffers[frame_set].write(
+                    scene_instances.naive_commands(data, frame, sc.calls, sc.views, sc.ipd))
         if logic is None:
             if skin.active:
                 skin.update(seconds, frame_set)

@@ -26,6 +26,7 @@ Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(fr
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,7 +40,7 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.passkit import VertexInput
 from rgraph.vk.resources import HostBuffer
-from rgraph.vk.scene_modes import draw_mode, view_count
+from rgraph.vk.scene_modes import draw_mode, naive_way, view_count
 from rgraph.vk.skin_gpu import BINDING_BONES, BINDING_SKIN_FRAME, BINDING_SKIN_VERTICES, SkinGPU
 
 (BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS, BINDING_VIEWS,
@@ -67,6 +68,7 @@ class SceneGPU:
         self.device = device
         self.sets = sets
         self.mode = draw_mode(plan)
+        self.naive_way = naive_way(plan)
         self.views = view_count(plan)
         self.ipd = float(plan.get("params", {}).get("views.ipd", scene_instances.DEFAULT_IPD))
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
@@ -207,7 +209,7 @@ class SceneGPU:
             from rgraph.vk.scene_naive import NaiveTables
 
             self.naive = NaiveTables(self.sets, draws_size, data.draw_count, device_buffer=self._device_buffer,
-                                     host_buffer=self._host_buffer)
+                                     host_buffer=self._host_buffer, direct=self.naive_way == "direct")
             self.draw_buffers = self.naive.host_draws
         else:
             self.draw_buffers = [] if gpu else [self._host_buffer(draws_size, storage) for _ in range(self.sets)]
@@ -312,6 +314,12 @@ class SceneGPU:
         if self.naive is not None:
             self.naive.record(cb, frame_set)
 
+    @property
+    def records_per_frame(self) -> bool:
+        """The frame's command buffers are recorded again every frame (draw.mode=naive, direct
+        draws of the objects the CPU found visible: ``rgraph.vk.runtime.commands.rerecord``)."""
+        return self.naive is not None and self.naive.direct
+
     def refresh_instances(self) -> None:
         """After instances moved (``SceneMesh.positions`` changed in ``self.data``): drop the
         per-scene caches and, with draw.mode=gpu, upload the persistent instance table again -
@@ -330,7 +338,8 @@ class SceneGPU:
         - ``args`` (the graph buffer ``draw_args`` of ``draw_cull``, draw.mode=gpu): one
           ``vkCmdDrawIndexedIndirectCount`` over the culled commands (count at offset 0,
           commands from offset 16), then the deformable meshes directly;
-        - draw.mode=naive: one ``vkCmdDrawIndexedIndirect`` per object (its CPU-culled command);
+        - draw.mode=naive: one ``vkCmdDrawIndexed`` per CPU-visible object (``draw.naive=direct``,
+          recorded per frame) or one ``vkCmdDrawIndexedIndirect`` per object (``indirect``);
         - otherwise one drawIndexed per mesh (instances = the mesh's instances, firstInstance =
           its first draw index).
         ``share = [device, devices]`` (sort-last, ``params["rgraph.draws"]``): only this device's
@@ -361,12 +370,22 @@ class SceneGPU:
                 rec.bind_vertex_buffers([want])
                 bound = want
             if self.mode == "naive" and not call.deformable:
-                commands = self.naive.commands[frame_set].handle
-                for d in range(call.first_instance, call.first_instance + call.instances):
-                    rec.draw_indexed_indirect(commands, 20 * d)
+                self._draw_naive(rec, call, frame_set)
                 continue
             rec.draw_indexed(call.index_count, call.instances, call.first_index, call.vertex_offset,
                              call.first_instance)
+
+    def _draw_naive(self, rec: Any, call: DrawCall, frame_set: int) -> None:
+        """draw.mode=naive: one draw per object of ``call`` (``rgraph.vk.scene_naive``)."""
+        first, end = call.first_instance, call.first_instance + call.instances
+        if not self.naive.direct:
+            commands = self.naive.commands[frame_set].handle
+            for d in range(first, end):
+                rec.draw_indexed_indirect(commands, 20 * d)
+            return
+        ids = self.naive.visible[frame_set]
+        lo, hi = bisect_left(ids, first), bisect_left(ids, end)
+        rec.draw_indexed_each(call.index_count, call.first_index, call.vertex_offset, ids[lo:hi])
 
     # ----------------------------------------------------------------- teardown
     def destroy(self) -> None:

@@ -7,8 +7,9 @@
   (``draw_cull``) into indirect commands and a count drawn by ``vkCmdDrawIndexedIndirectCount``;
   the CPU does no per-object work per frame.
 - ``naive`` (``rgraph run --naive-cpu``): the engines' way - per frame the CPU tests every
-  object against the frustum, writes its matrix and one draw command per object, and the
-  command buffer holds one draw call per object.
+  object against the frustum, writes its matrix, and the frame's command buffers are
+  recorded again with one draw call per visible object (param ``draw.naive``:
+  ``rgraph.vk.scene_naive``).
 
 Param ``views`` (1 or 2): stereo with VK_KHR_multiview (``RGRAPH_VIEWS``); ``views.ipd`` metres.
 """
@@ -28,6 +29,18 @@ def draw_mode(plan: dict) -> str:
     if mode not in MODES:
         raise ExecutionError(f"draw.mode must be one of {', '.join(MODES)}, got {mode!r}")
     return mode
+
+
+NAIVE_WAYS = ("direct", "indirect")
+
+
+def naive_way(plan: dict) -> str:
+    """How draw.mode=naive draws (param ``draw.naive``, ``rgraph.vk.scene_naive``): ``direct``
+    (default: the draws of the visible objects recorded per frame) or ``indirect``."""
+    way = str(plan.get("params", {}).get("draw.naive", "direct"))
+    if way not in NAIVE_WAYS:
+        raise ExecutionError(f"draw.naive must be one of {', '.join(NAIVE_WAYS)}, got {way!r}")
+    return way
 
 
 def view_count(plan: dict) -> int:

@@ -9,6 +9,7 @@ from typing import Any
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
 from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
+from rgraph.vk.runtime.commands import rerecord
 
 #: Vulkan calls bracketed in ``run_frames`` marks before the submits, in order.
 FRAME_CALLS = ("vkWaitForFences", "vkGetQueryPoolResults", "vkResetFences", "vkResetQueryPool")
@@ -80,6 +81,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     submitted = [False] * FRAMES_IN_FLIGHT
     scene, updaters = ex.scene_gpu, ex.updaters
     update = scene.update if scene is not None else None
+    records = scene is not None and scene.records_per_frame
     wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
     get_queries, reset_queries = lib.vkGetQueryPoolResults, lib.vkResetQueryPool
     # per set: (queue, infos count, infos, fence, context) of each vkQueueSubmit2; semaphore values
@@ -148,6 +150,8 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             for p in updaters:
                 p.update(content, s)
             update_s[local] = perf() - u0
+            if records:  # draw.mode=naive: this frame's draws of the CPU-visible objects
+                rerecord(ex, s)
             for slot, offset in slots_of[s]:
                 slot.value = frame + offset
             for queue, infos_count, infos, fence, context in calls_of[s]:

@@ -19,6 +19,9 @@ clocks; its first frames run ~3x slow):
   medians of its Python and Vulkan-call parts;
 - per pass, the GPU ms of stereo over mono (what doubles with the second eye, what more).
 
+Each (test, views, mode) row runs in its own process with its own device (``--row``), so a
+lost device or a crash costs that row only: the table then says ``failed (...)`` for it.
+
 The render thread reads one frame's timestamps in ``--timestamps-every`` (default 4; the
 per-pass medians then come from a quarter of the frames; the mean includes the reads).
 
@@ -34,7 +37,9 @@ from __future__ import annotations
 import argparse
 import inspect
 import json
+import os
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -97,7 +102,36 @@ def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, f
             "render_cpu_us": statistics.fmean(runtime) if runtime else None,
             "render_cpu_median_us": median("runtime"), "python_median_us": median("python"),
             "vulkan_median_us": median("vulkan"), "submit_median_us": median("submit"),
-            "timestamps_every": timestamps_every, "logic": timings.get("logic"), "passes_ms": timings["passes"]}
+            "timestamps_every": timestamps_every, "submits": calls, "logic": timings.get("logic"),
+            "passes_ms": timings["passes"]}
+
+
+ROW_PREFIX = "vr_tests-row: "
+
+
+def _one_row(args: argparse.Namespace, test: str, size: tuple[int, int], views: int, mode: str) -> int:
+    """The child of ``_row_in_subprocess``: measure one row, print it as one JSON line."""
+    import rgraph
+
+    with rgraph.open_device(validate=False, verbose=False) as gpu:
+        r = measure(gpu, test, size, views, mode, args.frames, args.warmup, args.logic_hz, args.timestamps_every)
+        r["device"] = gpu.choice.get("name", "?") if isinstance(gpu.choice, dict) else "?"
+    print(ROW_PREFIX + json.dumps(r), flush=True)
+    return 0
+
+
+def _row_in_subprocess(argv: list[str], test: str, views: int, mode: str) -> dict[str, Any]:
+    """One (test, views, mode) row measured in its own process and device, so a lost device
+    or a crash costs that row only (an ``error`` row then)."""
+    cmd = [sys.executable, "-m", "benchmarks.vr_tests", *argv, "--row", f"{test},{views},{mode}"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    done = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, check=False)
+    for line in reversed(done.stdout.splitlines()):
+        if line.startswith(ROW_PREFIX):
+            return json.loads(line[len(ROW_PREFIX):])
+    last = [ln for ln in (done.stderr + done.stdout).splitlines() if ln.strip()]
+    return {"test": test, "views": views, "mode": mode,
+            "error": f"exit {done.returncode}: {last[-1] if last else 'no output'}"}
 
 
 def _f(v: float | None, fmt: str) -> str:
@@ -105,29 +139,35 @@ def _f(v: float | None, fmt: str) -> str:
 
 
 def table(rows: list[dict[str, Any]]) -> str:
-    """Markdown: a line per test and view count, gpu and naive side by side."""
+    """Markdown: a line per test and view count, gpu and naive side by side (a failed row: its
+    FPS cell says so)."""
     head = ("| test | views | draws | FPS (gpu) | GPU busy (gpu) | render CPU us mean (gpu) | GPU ms (gpu) | "
             "FPS (naive) | GPU busy (naive) | render CPU us mean (naive) | stereo / mono frame (gpu) | study (Ultra) |")
     lines = [head, "|" + "---|" * 12]
     by = {(r["test"], r["views"], r["mode"]): r for r in rows}
-    for (test, views, mode), r in by.items():
-        if mode != "gpu" and (test, views, "gpu") in by:
-            continue
-        n = by.get((test, views, "naive"), {})
-        mono = by.get((test, 1, mode))
-        ratio = (r["wall_ms"] / mono["wall_ms"]) if views > 1 and mono else None
+    for test, views in dict.fromkeys((r["test"], r["views"]) for r in rows):
+        g, n = by.get((test, views, "gpu"), {}), by.get((test, views, "naive"), {})
+        mono = by.get((test, 1, "gpu"), {})
+        ratio = (g["wall_ms"] / mono["wall_ms"]) if views > 1 and g.get("wall_ms") and mono.get("wall_ms") else None
         study = STUDY.get(test)
+        draws = next((r["draws"] for r in (g, n) if r.get("draws")), "-")
         lines.append(
-            f"| {test} | {views} | {r['draws']} | {_f(r['fps'], '.0f')} | {_f(_pct(r['gpu_busy']), '.1f')}% | "
-            f"{_f(r['render_cpu_us'], '.1f')} | {_f(r['gpu_span_ms'], '.3f')} | {_f(n.get('fps'), '.0f')} | "
+            f"| {test} | {views} | {draws} | {_fps(g)} | {_f(_pct(g.get('gpu_busy')), '.1f')}% | "
+            f"{_f(g.get('render_cpu_us'), '.1f')} | {_f(g.get('gpu_span_ms'), '.3f')} | {_fps(n)} | "
             f"{_f(_pct(n.get('gpu_busy')), '.1f')}% | {_f(n.get('render_cpu_us'), '.1f')} | {_f(ratio, '.2f')} | "
             f"{'-' if not study or views > 1 else f'{study[0]}% / {study[1]}'} |")
     return "\n".join(lines)
 
 
+def _fps(r: dict[str, Any]) -> str:
+    if "error" in r:
+        return "failed (" + r["error"].replace("|", "/")[:60] + ")"
+    return _f(r.get("fps"), ".0f")
+
+
 def pass_ratios(rows: list[dict[str, Any]]) -> str:
     """Markdown: per test (gpu mode), each pass's GPU ms mono, stereo and stereo / mono."""
-    by = {(r["test"], r["views"]): r for r in rows if r["mode"] == "gpu"}
+    by = {(r["test"], r["views"]): r for r in rows if r["mode"] == "gpu" and "error" not in r}
     lines = ["| test | pass | mono ms | stereo ms | stereo / mono |", "|---|---|---:|---:|---:|"]
     for (test, views), mono in by.items():
         stereo = by.get((test, 2))
@@ -159,6 +199,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timestamps-every", dest="timestamps_every", type=int, default=4,
                         help="read one frame's timestamps in this many (default 4; 1: every frame)")
     parser.add_argument("--json", type=Path, help="write every figure as JSON")
+    parser.add_argument("--row", help=argparse.SUPPRESS)  # TEST,VIEWS,MODE: measure one row in this process
     parser.add_argument("--from-json", dest="from_json", type=Path, nargs="+",
                         help="measure nothing: print the tables of these --json files' rows together")
     args = parser.parse_args(argv)
@@ -182,22 +223,26 @@ def main(argv: list[str] | None = None) -> int:
     tests = available_tests(asked)
     for missing in sorted(set(asked) - set(tests)):
         print(f"vr_tests: {missing}: skipped ({TESTS[missing]} does not exist)")
-    import rgraph
-
+    if args.row:
+        test, views, mode = args.row.split(",")
+        return _one_row(args, test, (w, h), int(views), mode)
     rows = []
-    with rgraph.open_device(validate=False, verbose=False) as gpu:  # one device for every run
-        device = gpu.choice.get("name", "?") if isinstance(gpu.choice, dict) else "?"
-        for test in tests:
-            for views in (int(v) for v in args.views.split(",")):
-                for mode in (m.strip() for m in args.modes.split(",")):
-                    r = measure(gpu, test, (w, h), views, mode, args.frames, args.warmup, args.logic_hz,
-                                args.timestamps_every)
-                    rows.append(r)
-                    print(f"{test} views={views} {mode}: {r['fps']:.1f} FPS, GPU busy {_f(_pct(r['gpu_busy']), '.1f')}%, "
-                          f"render CPU {_f(r['render_cpu_us'], '.1f')} us/frame mean, "
-                          f"{_f(r['render_cpu_median_us'], '.1f')} median (Python {_f(r['python_median_us'], '.1f')}, "
-                          f"Vulkan calls {_f(r['vulkan_median_us'], '.1f')}, of it submits "
-                          f"{_f(r['submit_median_us'], '.1f')}), GPU {_f(r['gpu_span_ms'], '.3f')} ms", flush=True)
+    device = "?"
+    for test in tests:
+        for views in (int(v) for v in args.views.split(",")):
+            for mode in (m.strip() for m in args.modes.split(",")):
+                r = _row_in_subprocess(argv if argv is not None else sys.argv[1:], test, views, mode)
+                device = r.pop("device", device)
+                rows.append(r)
+                if "error" in r:
+                    print(f"{test} views={views} {mode}: FAILED: {r['error']}", flush=True)
+                    continue
+                print(f"{test} views={views} {mode}: {r['fps']:.1f} FPS, GPU busy {_f(_pct(r['gpu_busy']), '.1f')}%, "
+                      f"render CPU {_f(r['render_cpu_us'], '.1f')} us/frame mean, "
+                      f"{_f(r['render_cpu_median_us'], '.1f')} median (Python {_f(r['python_median_us'], '.1f')}, "
+                      f"Vulkan calls {_f(r['vulkan_median_us'], '.1f')}, of it submits "
+                      f"{_f(r['submit_median_us'], '.1f')}; {r.get('submits', '?')} vkQueueSubmit2 per frame), "
+                      f"GPU {_f(r['gpu_span_ms'], '.3f')} ms", flush=True)
     print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up, "
           f"timestamps read every {args.timestamps_every} frames, logic thread "
           + (f"at {args.logic_hz:g} Hz" if args.logic_hz else "off"))

@@ -35,6 +35,13 @@ GPU_AV_ENABLES = ("VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_EXT:"
                   "VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_RESERVE_BINDING_SLOT_EXT")
 
 
+def submit_per_pass(validate: bool) -> bool:
+    """One command buffer and one vkQueueSubmit2 per pass: under validation (messages name
+    their pass), or asked for with ``RGRAPH_SUBMIT_PER_PASS=1`` (a validated run's submission
+    without the layer: tells a layer-timing effect from a submission-structure one)."""
+    return validate or os.environ.get("RGRAPH_SUBMIT_PER_PASS", "") not in ("", "0")
+
+
 def gpu_assisted() -> bool:
     """GPU-assisted validation asked for (environment ``RGRAPH_GPU_AV=1``)."""
     return os.environ.get("RGRAPH_GPU_AV", "") not in ("", "0")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from rgraph.vk import names
+from rgraph.vk.instance import submit_per_pass
 from rgraph.vk.loader import vk
 from rgraph.vk.lower.semaphores import batch_semaphores, semaphore_count
 from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
@@ -52,7 +53,7 @@ def build(ex: Any) -> None:
         last_of[family[batch.queue]] = bi
     fence_batches = sorted(set(last_of.values()))
     runs: list[list[int]] = []
-    if ex.instance.validate:
+    if submit_per_pass(ex.instance.validate):
         runs = [[bi] for bi in recording.order]
     elif ex.one_call_per_queue:  # waits may come before their signals: timeline semantics allow it
         per_queue: dict[int, list[int]] = {}

@@ -113,7 +113,7 @@ def _one_row(args: argparse.Namespace, test: str, size: tuple[int, int], views: 
     """The child of ``_row_in_subprocess``: measure one row, print it as one JSON line."""
     import rgraph
 
-    with rgraph.open_device(validate=False, verbose=False) as gpu:
+    with rgraph.open_device(validate=False, verbose=False, one_queue=args.queues == "one") as gpu:
         r = measure(gpu, test, size, views, mode, args.frames, args.warmup, args.logic_hz, args.timestamps_every)
         r["device"] = gpu.choice.get("name", "?") if isinstance(gpu.choice, dict) else "?"
     print(ROW_PREFIX + json.dumps(r), flush=True)
@@ -199,6 +199,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timestamps-every", dest="timestamps_every", type=int, default=4,
                         help="read one frame's timestamps in this many (default 4; 1: every frame)")
     parser.add_argument("--json", type=Path, help="write every figure as JSON")
+    parser.add_argument("--queues", choices=("device", "one"), default="device",
+                        help="device: the plan's queues on the device's families (async compute); one: every "
+                             "pass on one VkQueue (one vkQueueSubmit2 per frame)")
     parser.add_argument("--row", help=argparse.SUPPRESS)  # TEST,VIEWS,MODE: measure one row in this process
     parser.add_argument("--from-json", dest="from_json", type=Path, nargs="+",
                         help="measure nothing: print the tables of these --json files' rows together")
@@ -244,7 +247,7 @@ def main(argv: list[str] | None = None) -> int:
                       f"{_f(r['submit_median_us'], '.1f')}; {r.get('submits', '?')} vkQueueSubmit2 per frame), "
                       f"GPU {_f(r['gpu_span_ms'], '.3f')} ms", flush=True)
     print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up, "
-          f"timestamps read every {args.timestamps_every} frames, logic thread "
+          f"timestamps read every {args.timestamps_every} frames, queues: {args.queues}, logic thread "
           + (f"at {args.logic_hz:g} Hz" if args.logic_hz else "off"))
     print(table(rows))
     ratios = pass_ratios(rows)

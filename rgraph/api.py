@@ -63,7 +63,7 @@ class Gpu:
     """One instance and one device (``open_device``); loads plans into ``Executable``s."""
 
     def __init__(self, validate: bool = True, device: int | None = None, verbose: bool = True,
-                 ray_tracing: bool | None = None) -> None:
+                 ray_tracing: bool | None = None, one_queue: bool = False) -> None:
         from rgraph.vk.device import choose_physical_device, create_device, list_physical_devices
         from rgraph.vk.instance import create_instance
         from rgraph.vk.probe_rt import layer_crashes
@@ -76,7 +76,8 @@ class Gpu:
             if ray_tracing is None:  # the plans are not known yet: ray tracing whenever the device has it
                 ray_tracing = supported(choose_physical_device(list_physical_devices(self.instance), device).handle)
             self.device = create_device(self.instance, device, verbose=verbose, ray_tracing=ray_tracing,
-                                        rt_pipelines=ray_tracing and not (validate and layer_crashes()))
+                                        rt_pipelines=ray_tracing and not (validate and layer_crashes()),
+                                        one_queue=one_queue)
         except BaseException:
             self.instance.destroy()
             raise
@@ -143,14 +144,15 @@ class Gpu:
 
 
 def open_device(validate: bool = True, device: int | None = None, verbose: bool = True,
-                ray_tracing: bool | None = None) -> Gpu:
+                ray_tracing: bool | None = None, one_queue: bool = False) -> Gpu:
     """One Vulkan instance (Khronos validation + synchronization validation when ``validate``)
     and one device (``device``: physical device index; default the first discrete, else the
     first); use as a context manager. ``ray_tracing``: enable acceleration structures and ray
     tracing pipelines (``rgraph.vk.rt_device``); None (default): whenever the physical device
     supports them, as the plans are not known yet; False: never (loading a plan with accels
-    or raytrace passes is then refused)."""
-    return Gpu(validate=validate, device=device, verbose=verbose, ray_tracing=ray_tracing)
+    or raytrace passes is then refused). ``one_queue``: every plan queue on one VkQueue (the
+    graphics+compute family's; ``rgraph.vk.device.create_device``)."""
+    return Gpu(validate=validate, device=device, verbose=verbose, ray_tracing=ray_tracing, one_queue=one_queue)
 
 
 class Executable:

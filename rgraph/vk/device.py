@@ -187,10 +187,11 @@ def offered_extensions(physical: Any) -> set[str]:
 
 
 def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True,
-                  ray_tracing: bool = False, rt_pipelines: bool = False) -> Device:
+                  ray_tracing: bool = False, rt_pipelines: bool = False, one_queue: bool = False) -> Device:
     """Choose a physical device, check required features, create the queues. ``ray_tracing``
     enables acceleration structures, ray tracing pipelines and buffer device addresses
-    (``rgraph.vk.rt_device``)."""
+    (``rgraph.vk.rt_device``). ``one_queue``: every plan queue on the graphics+compute family's
+    one VkQueue (no async compute: one vkQueueSubmit2 per frame, no cross-queue semaphores)."""
     v = vk()
     physical = choose_physical_device(list_physical_devices(instance), device_index)
     if physical.api_version < (1, 3, 0):
@@ -202,7 +203,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
     if missing:
         raise VulkanUnavailable(f"{physical.name} lacks required Vulkan features: {', '.join(missing)}")
     families = v.vkGetPhysicalDeviceQueueFamilyProperties(physical.handle)
-    plan_families = {q: _family_for(families, q) for q in PLAN_QUEUES}
+    plan_families = {q: _family_for(families, "graphics" if one_queue else q) for q in PLAN_QUEUES}
     distinct = sorted(set(plan_families.values()))
     priorities = [1.0]
     queue_infos = [

@@ -2,8 +2,10 @@
 
 Host-visible, written by the CPU: a *ring* of ``SLOTS`` position states (every deformable
 vertex, float32), and per frame-in-flight set a 16-byte *header* (``alpha``, the previous and
-the current state's slot). Without a logic thread, set s's frame writes its positions into slot
-s (header: alpha 1, slots s, s). With one (``rgraph.vk.runtime.logic``) the logic thread writes
+the current state's slot). Without a logic thread, the render thread writes the next frame's
+positions right after a frame's submits (``prepare``: into one of ``AHEAD_SLOTS``, which no
+frame in flight reads) and the frame's update points its set's header at that slot (alpha 1);
+a frame not prepared writes slot s of its set s then. With one (``rgraph.vk.runtime.logic``) the logic thread writes
 each tick's positions into a free slot (``write_slot``: not the published pair, not a pair a
 frame in flight reads; all under ``lock``) and the render thread writes only the header
 (``rgraph.vk.scene_frame``: it marks the slots it takes in ``in_use`` under the same lock).
@@ -39,6 +41,7 @@ SHADER = "scene/deform_normals.comp"
 GROUP_SIZE = 64
 HEADER_BYTES = 16
 SLOTS = 8  # >= 2 sets x 2 slots in flight + the published pair + the one being written
+AHEAD_SLOTS = (2, 3, 4)  # no logic thread: frames written ahead of their fence wait (DeformGPU.prepare)
 TANGENT_BYTES = 16
 PUSH_BYTES = 16
 
@@ -108,13 +111,30 @@ class DeformGPU:
         self.in_use: list[tuple[int, int]] = [(s, s) for s in range(sets)]  # per set: the slots its frame reads
         for s in range(sets):
             self.set_header(s, 1.0, s, s)
+        self._ahead: tuple[int, float, int] | None = None  # (content frame, seconds, slot) of prepare
         self._make_pipeline()
 
     # ----------------------------------------------------------------- per frame (host)
-    def write(self, seconds: float, frame_set: int) -> None:
-        """Without a logic thread: the positions at ``seconds`` into slot ``frame_set`` (its header
-        stays alpha 1, slots (frame_set, frame_set))."""
+    def write(self, seconds: float, frame_set: int, frame: int | None = None) -> None:
+        """Without a logic thread: set ``frame_set`` shows the positions at ``seconds`` (header:
+        alpha 1, one slot): the slot ``prepare`` filled for content frame ``frame`` ahead of
+        time, else slot ``frame_set``, written now."""
+        ahead = self._ahead
+        if frame is not None and ahead is not None and ahead[0] == frame and ahead[1] == seconds:
+            self.set_header(frame_set, 1.0, ahead[2], ahead[2])
+            return
         self.write_positions(frame_set, seconds)
+        self.set_header(frame_set, 1.0, frame_set, frame_set)
+
+    def prepare(self, frame: int, seconds: float) -> None:
+        """Without a logic thread, right after the previous frame's submits (the CPU is still
+        warm; positions written after the fence wait took 5-8x as long on the H200 host):
+        content frame ``frame``'s positions into ``AHEAD_SLOTS[frame % 3]``, a slot neither
+        frame in flight reads (they read the two other ahead slots, or slots 0 and 1)."""
+        slot = AHEAD_SLOTS[frame % len(AHEAD_SLOTS)]
+        self._ahead = None  # the slot is being written
+        self.write_positions(slot, seconds)
+        self._ahead = (frame, seconds, slot)
 
     def write_positions(self, slot: int, seconds: float) -> None:
         cur = self.slots[slot]

@@ -9,7 +9,8 @@ The render thread's only scene work per frame. What it writes, per frame-in-flig
   of the mapped memory - no per-frame allocation, no matrix work;
 - the camera-relative Draws (draw modes cpu and naive), Decals and Views with the camera;
   draw.mode=naive (the engines' way) writes every object's matrix and draw command every frame;
-- without a logic thread: the skinning state and deformable positions of the frame's time;
+- without a logic thread: the skinning state and deformable positions of the frame's time
+  (the positions written ahead, right after the previous frame's submits: ``prepare``);
 - with one (``rgraph run --logic-hz``): only the interpolation headers - the logic thread
   (``logic_step``) writes each tick's deformable positions and packed bones straight into
   free slots of the two host-visible rings; ``update`` takes the last two states and marks
@@ -87,7 +88,7 @@ class SceneFrames:
             if skin.active:
                 skin.update(seconds, frame_set)
             if deform is not None:
-                deform.write(seconds, frame_set)
+                deform.write(seconds, frame_set, frame)
             return
         if skin.active:  # the logic thread wrote these states' bones (logic_step)
             skin.show_slots(frame_set, prev.value[1], cur.value[1], alpha)
@@ -107,6 +108,14 @@ class SceneFrames:
             sc.decal_buffers[frame_set].write(packing.decals_bytes(data, frame))
         if sc.views > 1:
             sc.view_buffers[frame_set].write(scene_instances.cached_views_bytes(data, frame, sc.views, sc.ipd))
+
+    def prepare(self, frame: int) -> None:
+        """After frame ``frame - 1``'s submits, without a logic thread: what of content frame
+        ``frame`` can be written ahead, while the CPU is warm (the deformable positions:
+        ``DeformGPU.prepare``)."""
+        sc = self.scene
+        if sc.logic is None and sc.deform is not None:
+            sc.deform.prepare(frame, sc.data.seconds(frame))
 
     # ----------------------------------------------------------------- logic thread
     def logic_step(self, seconds: float) -> tuple[int | None, int | None]:

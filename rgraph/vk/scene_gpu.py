@@ -286,6 +286,11 @@ class SceneGPU:
         writes one draw command per object."""
         self.frames.update(frame, frame_set)
 
+    def prepare(self, frame: int) -> None:
+        """Right after the submits of the frame before content frame ``frame``: write what of
+        it can be written ahead (``SceneFrames.prepare``)."""
+        self.frames.prepare(frame)
+
     def attach_logic(self, logic: Any) -> None:
         """Take scene time, deformable positions and bones from ``logic`` (a started-on-demand
         ``rgraph.vk.runtime.logic.LogicThread`` whose step is ``logic_step`` and whose lock is

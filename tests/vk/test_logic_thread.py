@@ -215,3 +215,34 @@ def test_bad_logic_rates_are_one_line_errors(value, capsys):
         main(["run", "surgery", "--logic-hz", value])
     err = capsys.readouterr().err.strip().splitlines()
     assert exc.value.code == 2 and "--logic-hz" in err[-1] and "Traceback" not in "".join(err)
+
+
+def test_without_logic_positions_are_written_ahead_into_free_slots():
+    """No logic thread: each frame's positions are written right after the previous frame's
+    submits (DeformGPU.prepare) into an ahead slot no frame in flight reads; each of the last
+    two frames' headers names the slot holding its own time's positions (alpha 1), and the
+    next frame's prepared slot is a third one."""
+    from rgraph.vk.scene_deform import AHEAD_SLOTS
+
+    with rgraph.open_device(validate=True, verbose=False) as gpu:
+        plan = rgraph.compile("surgery", size=(32, 24), device=gpu)
+        exe = gpu.load(plan)
+        exe.run(6)
+        ex = exe.executor
+        scene, deform = ex.scene_gpu, ex.scene_gpu.deform
+        (part,) = deform.parts
+        done = ex.frames_done
+        shown = []
+        for frame in (done - 2, done - 1):
+            f, u = deform.header_views[frame % 2]
+            assert float(f[0]) == 1.0 and int(u[1]) == int(u[2])
+            slot = int(u[2])
+            assert slot in AHEAD_SLOTS
+            content = frame - ex.frame_origin
+            expected = part.deformer.positions(scene.data.seconds(content))
+            np.testing.assert_allclose(deform.slots[slot], expected, rtol=0, atol=1e-6)
+            shown.append(slot)
+        ahead = deform._ahead
+        assert ahead is not None and ahead[0] == done - ex.frame_origin and ahead[2] not in shown
+        assert len(set(shown)) == 2
+        assert [str(m) for m in exe.close()] == []

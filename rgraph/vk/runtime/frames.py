@@ -82,6 +82,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     scene, updaters = ex.scene_gpu, ex.updaters
     update = scene.update if scene is not None else None
     records = scene is not None and scene.records_per_frame
+    prepare = scene.prepare if scene is not None and scene.deform is not None and ex.logic is None else None
     wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
     get_queries, reset_queries = lib.vkGetQueryPoolResults, lib.vkResetQueryPool
     # per set: (queue, infos count, infos, fence, context) of each vkQueueSubmit2; semaphore values
@@ -165,6 +166,8 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
                 if timed:
                     mark(perf())
             submitted[s] = True
+            if prepare is not None:  # the next frame's host data, while the CPU is warm
+                prepare(content + 1)
             cpu_s[local] = perf() - t0
     finally:
         if logic is not None:

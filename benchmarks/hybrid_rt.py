@@ -127,11 +127,13 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
-            hybrid_params: dict[str, str] | None = None, async_shade: bool = False) -> dict[str, Any]:
+            hybrid_params: dict[str, str] | None = None, async_shade: bool = False,
+            dump: Path | None = None) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
-    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns)."""
+    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns).
+    ``dump``: a folder for ``SCENE_CAMERA.npz`` (both colour images as float16, the visibility ids)."""
     from rgraph.compiler.pipeline import compile_graph
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
@@ -156,6 +158,10 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
+    if dump is not None:
+        dump.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(dump / f"{scene}_{camera}.npz", alone=alone["outputs"]["color"].astype(np.float16),
+                            hybrid=out["color"].astype(np.float16), visibility=out["visibility"][..., 0])
     lists = [np.frombuffer(out[name].tobytes()[:16], dtype=np.uint32) for name in levels if name in out]
     row.update(level_rays=[traced] + [int(a[0]) for a in lists], level_overflow=any(bool(a[3]) for a in lists))
     if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
@@ -271,6 +277,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="a param of graphs/rt_hybrid.yaml for the hybrid (repeatable), e.g. rt.wave_subgroup=1")
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
+    parser.add_argument("--dump", type=Path, help="write each camera's two images (SCENE_CAMERA.npz) here")
     args = parser.parse_args(argv)
     size = SIZES.get(args.size) or tuple(int(v) for v in args.size.lower().split("x"))
     small = args.size == "small"
@@ -291,7 +298,7 @@ def main(argv: list[str] | None = None) -> int:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
                                         chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
-                                        async_shade=args.async_shade))
+                                        async_shade=args.async_shade, dump=args.dump))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

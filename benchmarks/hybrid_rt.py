@@ -153,6 +153,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     T = alone["timings"]["total_ms"]
     out = hybrid["outputs"]
     traced = int(np.frombuffer(out["ray_args"].tobytes()[:16], dtype=np.uint32)[3]) if "ray_args" in out else 0
+    if not traced:  # in-thread (rt.wavefront 0): no pixel list; the pixels whose surface needs secondary rays
+        traced = classified_pixels(out["visibility"][..., 0], path, size, camera)
     row = {"scene": scene, "camera": camera, "size": list(size), "frames": frames, "max_depth": depth,
            "hybrid_params": hybrid_params or {},
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
@@ -177,6 +179,17 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         row.update(vis_differs_share=float((ids != raster_ids).mean()),
                    vis_holes_share=float(((ids == 0) & (raster_ids != 0)).mean()))
     return row
+
+
+def classified_pixels(ids: np.ndarray, path: Path, size: tuple[int, int], camera: int) -> int:
+    """Pixels whose visible surface reflects or refracts (the ones classify.comp would list)."""
+    from rgraph.passes.raytrace_hybrid import decode_visibility, instance_materials, needs_secondary_rays, prim_bits
+    from rgraph.scene.build import load_scene_data
+
+    data = load_scene_data(path, size, camera)
+    inst, _prim = decode_visibility(ids, prim_bits(data))
+    mask = needs_secondary_rays(data.materials)[instance_materials(data)]
+    return int(mask[inst[inst >= 0]].sum())
 
 
 def prim_bits_of(path: Path, size: tuple[int, int], camera: int) -> int:

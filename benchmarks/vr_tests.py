@@ -102,11 +102,22 @@ def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, f
             "render_cpu_us": statistics.fmean(runtime) if runtime else None,
             "render_cpu_median_us": median("runtime"), "python_median_us": median("python"),
             "vulkan_median_us": median("vulkan"), "submit_median_us": median("submit"),
+            "render_cpu_p90_us": _quantile(runtime, 0.9), "render_cpu_max_us": max(runtime) if runtime else None,
+            "python_mean_us": _mean(parts["python"]), "vulkan_mean_us": _mean(parts["vulkan"]),
+            "submit_mean_us": _mean(parts["submit"]),
             "timestamps_every": timestamps_every, "submits": calls, "logic": timings.get("logic"),
             "passes_ms": timings["passes"]}
 
 
 ROW_PREFIX = "vr_tests-row: "
+
+
+def _mean(values: list[float]) -> float | None:
+    return statistics.fmean(values) if values else None
+
+
+def _quantile(values: list[float], q: float) -> float | None:
+    return sorted(values)[min(len(values) - 1, int(q * len(values)))] if values else None
 
 
 def _one_row(args: argparse.Namespace, test: str, size: tuple[int, int], views: int, mode: str) -> int:
@@ -245,6 +256,8 @@ def main(argv: list[str] | None = None) -> int:
                       f"{_f(r['render_cpu_median_us'], '.1f')} median (Python {_f(r['python_median_us'], '.1f')}, "
                       f"Vulkan calls {_f(r['vulkan_median_us'], '.1f')}, of it submits "
                       f"{_f(r['submit_median_us'], '.1f')}; {r.get('submits', '?')} vkQueueSubmit2 per frame), "
+                      f"p90 {_f(r.get('render_cpu_p90_us'), '.1f')}, means: Python {_f(r.get('python_mean_us'), '.1f')}, "
+                      f"Vulkan {_f(r.get('vulkan_mean_us'), '.1f')}, "
                       f"GPU {_f(r['gpu_span_ms'], '.3f')} ms", flush=True)
     print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up, "
           f"timestamps read every {args.timestamps_every} frames, queues: {args.queues}, logic thread "

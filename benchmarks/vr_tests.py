@@ -72,11 +72,11 @@ def load_kwargs(gpu: Any, logic_hz: float | None) -> dict[str, Any]:
 
 
 def measure(gpu: Any, test: str, size: tuple[int, int], views: int, mode: str, frames: int, warmup: float,
-            logic_hz: float | None, timestamps_every: int = 1) -> dict[str, Any]:
+            logic_hz: float | None, timestamps_every: int = 1, extra: dict[str, str] | None = None) -> dict[str, Any]:
     from benchmarks.frame_cpu import frame_parts
     from rgraph.compiler.pipeline import compile_graph
 
-    params = {"views": str(views), "draw.mode": mode}
+    params = {**(extra or {}), "views": str(views), "draw.mode": mode}
     plan = compile_graph(GRAPH, scene_path=SCENES / TESTS[test], size=size, params=params,
                          memory=gpu.memory_requirements())
     marks: list[float] = []
@@ -125,7 +125,10 @@ def _one_row(args: argparse.Namespace, test: str, size: tuple[int, int], views: 
     import rgraph
 
     with rgraph.open_device(validate=False, verbose=False, one_queue=args.queues == "one") as gpu:
-        r = measure(gpu, test, size, views, mode, args.frames, args.warmup, args.logic_hz, args.timestamps_every)
+        extra = dict(kv.split("=", 1) for kv in args.param)
+        r = measure(gpu, test, size, views, mode, args.frames, args.warmup, args.logic_hz, args.timestamps_every,
+                    extra)
+        r["params"] = extra
         r["device"] = gpu.choice.get("name", "?") if isinstance(gpu.choice, dict) else "?"
     print(ROW_PREFIX + json.dumps(r), flush=True)
     return 0
@@ -213,6 +216,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--queues", choices=("device", "one"), default="device",
                         help="device: the plan's queues on the device's families (async compute); one: every "
                              "pass on one VkQueue (one vkQueueSubmit2 per frame)")
+    parser.add_argument("-p", "--param", action="append", default=[], metavar="KEY=VALUE",
+                        help="a graph param for every run (e.g. skin.threads=4, draw.naive=indirect)")
     parser.add_argument("--row", help=argparse.SUPPRESS)  # TEST,VIEWS,MODE: measure one row in this process
     parser.add_argument("--from-json", dest="from_json", type=Path, nargs="+",
                         help="measure nothing: print the tables of these --json files' rows together")

@@ -73,6 +73,7 @@ class SceneGPU:
         self.ipd = float(plan.get("params", {}).get("views.ipd", scene_instances.DEFAULT_IPD))
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
         self.plan_logic_hz = plan.get("logic_hz")  # skinning's logic rate (default 60 Hz)
+        self.skin_threads = int(plan.get("params", {}).get("skin.threads", 1))
         try:
             self.data: SceneData = load_scene_data(source, self.extent, int(plan.get("camera", 0)))
         except (OSError, ValueError) as exc:
@@ -199,7 +200,8 @@ class SceneGPU:
         uploads.append((self.meshes_buffer, meshes))
         self._upload(submit_once, [(b, d) for b, d in uploads if d])
         self.skin = SkinGPU(self.device, data, self.sets, skinned, vertex_space.size,
-                            float(self.plan_logic_hz) if self.plan_logic_hz else 60.0)
+                            float(self.plan_logic_hz) if self.plan_logic_hz else 60.0,
+                            threads=self.skin_threads)
 
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]

@@ -43,11 +43,12 @@ class SkinGPU:
     buffer) of every skinned mesh; ``rigid_vertices``: that buffer's vertex count."""
 
     def __init__(self, device: Device, data: SceneData, sets: int, rigid_bases: list[tuple[Any, int]],
-                 rigid_vertices: int, logic_hz: float = LOGIC_HZ) -> None:
+                 rigid_vertices: int, logic_hz: float = LOGIC_HZ, threads: int = 1) -> None:
         from rgraph.vk.loader import vk
 
         v = vk()
         self.data, self.sets, self.logic_hz = data, sets, float(logic_hz)
+        self.threads = max(1, int(threads))  # a tick's characters split over this many threads (Animator.state)
         self.meshes = list(rigid_bases)
         self.bones = data.bone_count
         self.slots = max(SLOTS, 2 * sets + 3)
@@ -116,7 +117,7 @@ class SkinGPU:
         """Logic state ``tick``: every skinned mesh's packed bones, concatenated (cached: two)."""
         got = self._states.get(tick)
         if got is None:
-            parts = [m.animator.state(tick, self.logic_hz).reshape(-1, 8) for m in self.data.skinned]
+            parts = [m.animator.state(tick, self.logic_hz, self.threads).reshape(-1, 8) for m in self.data.skinned]
             got = np.concatenate(parts) if len(parts) > 1 else parts[0]
             self._states = {k: s for k, s in self._states.items() if k >= tick - 1}
             self._states[tick] = got

@@ -31,9 +31,9 @@ def test_naive_frames_in_flight_draw_their_own_camera(tmp_path, monkeypatch, way
     vkCmdDrawIndexed per CPU-visible object (no indirect draw); ``indirect``: recorded once,
     per-set command tables."""
     import rgraph
+    from rgraph.compiler.pipeline import compile_graph
     from rgraph.scene.instances import naive_visible
     from rgraph.vk.record_context import RecordContext
-    from rgraph.compiler.pipeline import compile_graph
     from rgraph.vk.runtime.readback import decode_outputs
 
     paths = [scene_file(tmp_path, LIGHTS, camera=_moved_camera(np.array(o)), meshes=MESHES, name=f"cam{k}")

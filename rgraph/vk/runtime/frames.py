@@ -8,8 +8,8 @@ from typing import Any
 
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.loader import vk
-from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
 from rgraph.vk.runtime.commands import rerecord
+from rgraph.vk.runtime.setup import FRAMES_IN_FLIGHT
 
 #: Vulkan calls bracketed in ``run_frames`` marks before the submits, in order.
 FRAME_CALLS = ("vkWaitForFences", "vkGetQueryPoolResults", "vkResetFences", "vkResetQueryPool")

@@ -26,7 +26,6 @@ Passes use ``set_layout`` (set 0 of their pipeline layouts), ``descriptor_set(fr
 
 from __future__ import annotations
 
-from bisect import bisect_left
 from dataclasses import dataclass
 from typing import Any
 
@@ -377,22 +376,10 @@ class SceneGPU:
                 rec.bind_vertex_buffers([want])
                 bound = want
             if self.mode == "naive" and not call.deformable:
-                self._draw_naive(rec, call, frame_set)
+                self.naive.draw(rec, call, frame_set)
                 continue
             rec.draw_indexed(call.index_count, call.instances, call.first_index, call.vertex_offset,
                              call.first_instance)
-
-    def _draw_naive(self, rec: Any, call: DrawCall, frame_set: int) -> None:
-        """draw.mode=naive: one draw per object of ``call`` (``rgraph.vk.scene_naive``)."""
-        first, end = call.first_instance, call.first_instance + call.instances
-        if not self.naive.direct:
-            commands = self.naive.commands[frame_set].handle
-            for d in range(first, end):
-                rec.draw_indexed_indirect(commands, 20 * d)
-            return
-        ids = self.naive.visible[frame_set]
-        lo, hi = bisect_left(ids, first), bisect_left(ids, end)
-        rec.draw_indexed_each(call.index_count, call.first_index, call.vertex_offset, ids[lo:hi])
 
     # ----------------------------------------------------------------- teardown
     def destroy(self) -> None:

@@ -29,6 +29,7 @@ bus (``--naive-cpu`` lost the device on an NVIDIA H200 with host-memory commands
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from typing import Any
 
 from rgraph.vk.device_local import barrier
@@ -72,3 +73,17 @@ class NaiveTables:
         barrier(cb, outputs, copy, write, readers,
                 v.VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT | v.VK_ACCESS_2_SHADER_STORAGE_READ_BIT)
         self.recorded[frame_set] = True
+
+    def draw(self, rec: Any, call: Any, frame_set: int) -> None:
+        """One draw per object of ``call`` (a ``SceneGPU`` DrawCall): ``direct``, one
+        vkCmdDrawIndexed per object of set ``frame_set``'s visible ids in the call's range;
+        ``indirect``, one vkCmdDrawIndexedIndirect per object (its command at ``20 d``)."""
+        first, end = call.first_instance, call.first_instance + call.instances
+        if not self.direct:
+            commands = self.commands[frame_set].handle
+            for d in range(first, end):
+                rec.draw_indexed_indirect(commands, COMMAND_BYTES * d)
+            return
+        ids = self.visible[frame_set]
+        lo, hi = bisect_left(ids, first), bisect_left(ids, end)
+        rec.draw_indexed_each(call.index_count, call.first_index, call.vertex_offset, ids[lo:hi])

@@ -41,8 +41,8 @@ def test_gpu_interpolates_along_the_shortest_arc(tmp_path, monkeypatch):
 
     plain = Animator.state
 
-    def flipped(self, tick, hz=60.0):
-        packed = plain(self, tick, hz)
+    def flipped(self, tick, hz=60.0, threads=1):
+        packed = plain(self, tick, hz, threads)
         if tick % 2:
             packed = packed.copy()
             packed[..., 4:8] = -packed[..., 4:8]

@@ -75,7 +75,7 @@ def place(
             for b, offset in zip(group, tlsf_offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)
         elif chosen.kind in ("aliased", "optimal"):
-            result = place_class(Instance.build(group, conflicts), time_budget_s)
+            result = place_class(Instance.build(group, conflicts), time_budget_s, exact=chosen.kind == "optimal")
             heap_id = new_heap(result.peak, memory_class, max_align)
             for b, offset in zip(group, result.offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)

@@ -236,21 +236,25 @@ class CapacitySearch:
         return False
 
 
-def solve_capacity(inst: Instance, capacity: int, node_budget: int,
+def solve_capacity(inst: Instance, capacity: int, ops_budget: int, rounds: int | None = None,
+                   orders: Sequence[Sequence[int]] | None = None,
                    heuristics: Sequence[str] = PREORDERINGS) -> tuple[list[int] | None, int, bool]:
-    """MiniMalloc's round robin: each heuristic in turn with a node limit that starts at
-    ``2 n`` and doubles each round, until one finds a placement or proves there is none,
-    or ``node_budget`` runs out. Returns (offsets or None, nodes spent, proven infeasible)."""
-    orders = [preorder(inst, h) for h in heuristics]
-    limit, spent = max(inst.n, 1), 0
-    while spent < node_budget:
+    """MiniMalloc's round robin (``RoundRobin`` in solver.cc): each heuristic in turn with
+    a node limit that starts at ``2 n`` and doubles each round, until one finds a placement
+    or proves there is none, ``rounds`` rounds are done or ``ops_budget`` operations are
+    spent. ``orders``: the heuristics' static preorders, if already computed.
+    Returns (offsets or None, operations spent, proven infeasible)."""
+    orders = [preorder(inst, h) for h in heuristics] if orders is None else orders
+    limit, spent, done = max(inst.n, 1), 0, 0
+    while spent < ops_budget and (rounds is None or done < rounds):
         limit *= 2
+        done += 1
         for h, order in zip(heuristics, orders):
-            if spent >= node_budget:
+            if spent >= ops_budget:
                 break
-            run = CapacitySearch(inst, order, capacity, min(limit, node_budget - spent), h)
+            run = CapacitySearch(inst, order, capacity, limit, h, ops_budget - spent)
             found = run.run()
-            spent += max(run.work, 1)
+            spent += max(run.ops, 1)
             if found is not None:
                 return found, spent, False
             if not run.exhausted:

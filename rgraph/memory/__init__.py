@@ -18,8 +18,9 @@ from rgraph.memory.policy import Policy, parse_policy
 
 __all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "parse_place_args", "place"]
 
-#: Budget of the ``optimal`` policy when the caller leaves the default.
-OPTIMAL_BUDGET_S = 2.0
+#: Budget of the ``optimal`` policy when the caller leaves the default: MiniMalloc's own
+#: solver takes 0.6-5 s on the challenging traces on the 2-core machine (docs/memory.md).
+OPTIMAL_BUDGET_S = 10.0
 #: The compiler's budget per memory class: it runs on every compile, so 1,000 resources
 #: must place in well under 100 ms (a graph's greedy placement is usually at the bound and
 #: the search never starts).

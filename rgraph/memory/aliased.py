@@ -97,8 +97,8 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
     budget = int(time_budget_s * OPS_PER_SECOND)
     search = _Bisection(inst, best)
     if exact:
-        left = search.run(budget // EXACT_BISECTION_SHARE)
-        left += budget - budget // EXACT_BISECTION_SHARE
+        first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))
+        left = search.run(first) + budget - first
         left = search.attempt(lb, None, left)
         search.run(left)
     else:
@@ -110,9 +110,13 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
 #: highest capacity given up on: short steps succeed far more often than halving.
 STEP = 0.25
 
-#: ``optimal``: one part in this many of the budget goes to the bisection first (a good
-#: placement early), the rest to the run at the bound.
+#: The first round's node limit per heuristic, in blocks (MiniMalloc: 2).
+FIRST_LIMIT = 2.0
+
+#: ``optimal``: one part in this many of the budget, at most ``EXACT_BISECTION_S``, goes
+#: to the bisection first (a good placement early), the rest to the run at the bound.
 EXACT_BISECTION_SHARE = 5
+EXACT_BISECTION_S = 0.5
 
 
 class _Bisection:
@@ -132,7 +136,7 @@ class _Bisection:
         """Try one capacity; returns the budget left."""
         if self.best.proven or budget <= 0:
             return budget
-        found, spent, proven = solve_capacity(self.inst, capacity, budget, rounds, self.orders)
+        found, spent, proven = solve_capacity(self.inst, capacity, budget, rounds, self.orders, first_limit=FIRST_LIMIT)
         if found is not None:
             peak = self.inst.peak(found)
             if peak < self.best.peak:

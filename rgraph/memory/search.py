@@ -58,7 +58,7 @@ def preorder(inst: Instance, heuristic: str, blocks: Sequence[int] | None = None
         else:
             field = {"W": inst.neg_width, "A": inst.neg_area, "Z": inst.neg_size}[c]
             columns.append([field[i] for i in blocks])
-    return [i for *_, i in sorted(zip(*columns, blocks))]
+    return [i for *_, i in sorted(zip(*columns, blocks, strict=True))]
 
 
 class CapacitySearch:
@@ -226,7 +226,7 @@ class CapacitySearch:
                 cuts[s] += 1
             for s in range(lo, hi):
                 total[s] += z
-            for j, old in zip(changed, olds):
+            for j, old in zip(changed, olds, strict=True):
                 mins[j] = old
             unplaced.insert(position, i)
             offsets[i] = -1
@@ -238,21 +238,22 @@ class CapacitySearch:
 
 def solve_capacity(inst: Instance, capacity: int, ops_budget: int, rounds: int | None = None,
                    orders: Sequence[Sequence[int]] | None = None,
-                   heuristics: Sequence[str] = PREORDERINGS) -> tuple[list[int] | None, int, bool]:
+                   heuristics: Sequence[str] = PREORDERINGS,
+                   first_limit: float = 2.0) -> tuple[list[int] | None, int, bool]:
     """MiniMalloc's round robin (``RoundRobin`` in solver.cc): each heuristic in turn with
     a node limit that starts at ``2 n`` and doubles each round, until one finds a placement
     or proves there is none, ``rounds`` rounds are done or ``ops_budget`` operations are
     spent. ``orders``: the heuristics' static preorders, if already computed.
     Returns (offsets or None, operations spent, proven infeasible)."""
     orders = [preorder(inst, h) for h in heuristics] if orders is None else orders
-    limit, spent, done = max(inst.n, 1), 0, 0
+    limit, spent, done = first_limit * max(inst.n, 1) / 2, 0, 0
     while spent < ops_budget and (rounds is None or done < rounds):
         limit *= 2
         done += 1
-        for h, order in zip(heuristics, orders):
+        for h, order in zip(heuristics, orders, strict=True):
             if spent >= ops_budget:
                 break
-            run = CapacitySearch(inst, order, capacity, limit, h, ops_budget - spent)
+            run = CapacitySearch(inst, order, capacity, int(limit), h, ops_budget - spent)
             found = run.run()
             spent += max(run.ops, 1)
             if found is not None:

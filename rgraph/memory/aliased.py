@@ -73,8 +73,9 @@ class ClassResult:
 
 def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> ClassResult:
     """Greedy, then (above the bound) the search within ``time_budget_s``. ``exact``
-    (the ``optimal`` policy): after a first share of bisection, the rest of the budget
-    goes to MiniMalloc's own run at the bound (round robin with no round limit)."""
+    (the ``optimal`` policy): after a first share of bisection, most of the budget goes to
+    MiniMalloc's own run at the bound (round robin with no round limit), the rest back to
+    the bisection."""
     lb = inst.lower_bound()
     best: ClassResult | None = None
     for name, order in orderings(inst):
@@ -99,7 +100,8 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
     if exact:
         first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))
         left = search.run(first) + budget - first
-        left = search.attempt(lb, None, left)
+        at_bound = int(budget * EXACT_BOUND_SHARE)
+        left = search.attempt(lb, None, min(at_bound, left)) + max(left - at_bound, 0)
         search.run(left)
     else:
         search.run(budget)
@@ -114,9 +116,12 @@ STEP = 0.25
 FIRST_LIMIT = 2.0
 
 #: ``optimal``: one part in this many of the budget, at most ``EXACT_BISECTION_S``, goes
-#: to the bisection first (a good placement early), the rest to the run at the bound.
+#: to the bisection first (a good placement early), then up to ``EXACT_BOUND_SHARE`` of it
+#: to MiniMalloc's run at the bound, the rest back to the bisection (where the bound is
+#: out of reach, as on MiniMalloc D and J).
 EXACT_BISECTION_SHARE = 5
 EXACT_BISECTION_S = 0.5
+EXACT_BOUND_SHARE = 0.7
 
 
 class _Bisection:

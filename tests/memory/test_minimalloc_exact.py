@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_memory_search import assert_valid
 
 from rgraph.memory import Block, place
 from rgraph.memory.instance import Instance
@@ -53,15 +54,6 @@ def tiny_instances(draw):
     return blocks
 
 
-def assert_fits(inst: Instance, offsets: list[int], capacity: int) -> None:
-    for i in range(inst.n):
-        assert offsets[i] >= 0 and offsets[i] % inst.align[i] == 0
-        assert offsets[i] + inst.size[i] <= capacity
-        for j in inst.neighbors[i]:
-            if inst.size[i] and inst.size[j]:
-                assert offsets[i] + inst.size[i] <= offsets[j] or offsets[j] + inst.size[j] <= offsets[i]
-
-
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(blocks=tiny_instances(), heuristic=st.sampled_from(PREORDERINGS), slack=st.integers(-1, 3))
 def test_decision_matches_brute_force(blocks, heuristic, slack):
@@ -73,7 +65,7 @@ def test_decision_matches_brute_force(blocks, heuristic, slack):
     assert not run.exhausted
     assert (found is not None) == (capacity >= optimum), (capacity, optimum)
     if found is not None:
-        assert_fits(inst, found, capacity)
+        assert_valid(inst, found, capacity)
 
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -121,7 +113,7 @@ def test_search_results_fit_their_capacity(blocks, slack):
     found, _, proven = solve_capacity(inst, capacity, 200_000)
     assert not (found is not None and proven)
     if found is not None:
-        assert_fits(inst, found, capacity)
+        assert_valid(inst, found, capacity)
 
 
 def test_hatless_pruning_and_decomposition_keep_completeness():
@@ -137,6 +129,6 @@ def test_hatless_pruning_and_decomposition_keep_completeness():
         run = CapacitySearch(inst, preorder(inst, h), 4, 10**6, h)
         found = run.run()
         assert found is not None
-        assert_fits(inst, found, 4)
+        assert_valid(inst, found, 4)
         run = CapacitySearch(inst, preorder(inst, h), 3, 10**6, h)
         assert run.run() is None and not run.exhausted

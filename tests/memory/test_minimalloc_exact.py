@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 from test_memory_search import assert_valid
 
 from rgraph.memory import Block, place
+from rgraph.memory.aliased import place_class
 from rgraph.memory.instance import Instance
 from rgraph.memory.search import PREORDERINGS, CapacitySearch, preorder, solve_capacity
 from rgraph.memory.verify import overlaps
@@ -79,6 +80,8 @@ def test_round_robin_and_optimal_policy_reach_the_brute_force_optimum(blocks):
     assert found is not None and inst.peak(found) <= optimum
     placement = place(blocks, "optimal")
     assert placement.stats.peak_bytes == optimum
+    result = place_class(inst, 1.0, exact=True)
+    assert result.peak == optimum and result.proven  # at the bound, or the peak - 1 proven too small
     assert overlaps(blocks, placement) == []
 
 
@@ -132,3 +135,18 @@ def test_hatless_pruning_and_decomposition_keep_completeness():
         assert_valid(inst, found, 4)
         run = CapacitySearch(inst, preorder(inst, h), 3, 10**6, h)
         assert run.run() is None and not run.exhausted
+
+
+def test_easy_instances_stop_at_the_bound_without_searching(monkeypatch):
+    from rgraph.memory import aliased
+    from rgraph.memory.model import by_class
+    from rgraph.memory.random_instances import random_blocks
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("the search ran although greedy reached the bound")
+
+    monkeypatch.setattr(aliased, "solve_capacity", no_search)
+    for blocks in by_class(random_blocks(200, 1)).values():
+        result = aliased.place_class(Instance.build(blocks), 1.0, exact=True)
+        assert result.proven and result.peak == result.lower_bound
+

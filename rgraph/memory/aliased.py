@@ -121,7 +121,7 @@ FIRST_LIMIT = 2.0
 #: out of reach, as on MiniMalloc D and J).
 EXACT_BISECTION_SHARE = 5
 EXACT_BISECTION_S = 0.5
-EXACT_BOUND_SHARE = 0.7
+EXACT_BOUND_SHARE = 0.85
 
 
 class _Bisection:

@@ -96,6 +96,8 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
         # reach: the search could only burn its budget proving nothing, so greedy it is.
         return best
     budget = int(time_budget_s * OPS_PER_SECOND)
+    if budget < inst.n * inst.n // 2 + inst.pair_count:
+        return best  # not even one dive (each node scans the blocks left) would finish
     search = _Bisection(inst, best)
     if exact:
         first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))

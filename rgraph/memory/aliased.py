@@ -148,7 +148,7 @@ class _Bisection:
             peak = self.inst.peak(found)
             if peak < self.best.peak:
                 self.best = ClassResult(found, peak, self.lb, f"search:{capacity}")
-        else:
+        elif proven or spent < budget:  # cut short by the budget: not given up, tried again later
             self.low = max(self.low, capacity)
             if proven:
                 self.infeasible = max(self.infeasible, capacity)

@@ -67,6 +67,27 @@ def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
     return out
 
 
+def usages_and_lifetimes(passes: Sequence[PassSpec]) -> tuple[dict[str, set[str]], dict[str, tuple[int, int]]]:
+    """``usages_by_resource`` and ``lifetimes`` of ``passes`` in one walk."""
+    used: dict[str, set[str]] = {}
+    spans: dict[str, tuple[int, int]] = {}
+    for i, p in enumerate(passes):
+        raytrace = p.kind == "raytrace"
+        for a in p.accesses:
+            name = a.resource
+            found = used.get(name)
+            if found is None:
+                used[name] = {a.usage}
+                spans[name] = (i, i)
+            else:
+                found.add(a.usage)
+                first = spans[name][0]
+                spans[name] = (first, i)
+            if raytrace and a.usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
+                used[name].add("trace_indirect")
+    return used, spans
+
+
 def lifetimes(passes: Sequence[PassSpec]) -> dict[str, tuple[int, int]]:
     """First and last executed pass index of each resource."""
     out: dict[str, tuple[int, int]] = {}

@@ -24,39 +24,49 @@ from rgraph.spec.specialize import PassSpec, ResourceSpec
 GENERAL_READS = frozenset({"sampled", "storage_read"})
 
 
-def _whole(a, res: ResourceSpec) -> bool:
-    return a.mips == (0, res.mips) and a.layers == (0, res.layers)
-
-
 def unify_read_layouts(
     passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec], syncs: list[list[Sync]]
 ) -> list[list[Sync]]:
-    """``syncs`` (per pass, per access) with mixed-layout read groups moved to GENERAL."""
-    uses: dict[str, list[tuple[int, int]]] = {}
+    """``syncs`` (per pass, per access) with mixed-layout read groups moved to GENERAL (a new
+    outer list; the inner lists of passes with a change are new too)."""
+    candidates = {
+        name for name, res in resources.items()
+        if res.is_image and res.lifetime == "transient" and res.format is not None
+        and not res.format.has_depth and not res.format.has_stencil
+    }
+    uses: dict[str, list[tuple[int, int, bool, str]]] = {}  # (pass, access, write, usage)
     excluded: set[str] = set()
-    for i, p in enumerate(passes):
-        for j, a in enumerate(p.accesses):
-            res = resources[a.resource]
-            if not res.is_image:
-                continue  # buffers have no layout
-            fmt = res.format
-            if (res.lifetime != "transient" or fmt is None or fmt.has_depth
-                    or fmt.has_stencil or not _whole(a, res)):
-                excluded.add(a.resource)
-            uses.setdefault(a.resource, []).append((i, j))
-    out = [list(s) for s in syncs]
+    if candidates:
+        for i, p in enumerate(passes):
+            for j, a in enumerate(p.accesses):
+                name = a.resource
+                if name not in candidates or name in excluded:
+                    continue  # other images are excluded (and buffers have no layout)
+                res = resources[name]
+                if a.mips != (0, res.mips) or a.layers != (0, res.layers):  # not the whole image
+                    excluded.add(name)
+                    continue
+                entry = (i, j, a.write, a.usage)
+                if name in uses:
+                    uses[name].append(entry)
+                else:
+                    uses[name] = [entry]
+    out = list(syncs)
+    copied: set[int] = set()
     for name, seq in uses.items():
         if name in excluded:
             continue
-        group: list[tuple[int, int]] = []
-        for i, j in [*seq, (-1, -1)]:  # a sentinel closes the last group
-            a = passes[i].accesses[j] if i >= 0 else None
-            if a is not None and not a.write:
-                group.append((i, j))
+        group: list[tuple[int, int]] = []  # the movable reads since the last write
+        for i, j, write, usage in [*seq, (-1, -1, True, "")]:  # a sentinel closes the last group
+            if not write:
+                if usage in GENERAL_READS:
+                    group.append((i, j))
                 continue
-            movable = [(gi, gj) for gi, gj in group if passes[gi].accesses[gj].usage in GENERAL_READS]
-            if len({out[gi][gj].layout for gi, gj in movable}) > 1:
-                for gi, gj in movable:
+            if len(group) > 1 and len({out[gi][gj].layout for gi, gj in group}) > 1:
+                for gi, gj in group:
+                    if gi not in copied:
+                        out[gi] = list(out[gi])
+                        copied.add(gi)
                     out[gi][gj] = replace(out[gi][gj], layout="GENERAL")
             group = []
     return out

@@ -19,14 +19,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
-from typing import NamedTuple
 
 from rgraph.compiler.alias_starts import PREVIOUS_FRAME, AliasStarts, with_partial_handoffs
-from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.rectangles import barriers_of, mip_layer_rectangles, rectangles
+from rgraph.compiler.sync_inputs import Use, access_syncs, sync_inputs
 from rgraph.compiler.sync_types import EMPTY, Barrier, BarrierKey, PassSync, State, SyncResult, Wait
-from rgraph.compiler.usages import Sync, merge, sync_of
+from rgraph.compiler.usages import Sync
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
@@ -36,13 +34,6 @@ __all__ = ["EMPTY", "Barrier", "BarrierKey", "PassSync", "State", "SyncResult", 
 PERSISTENT = ("persistent", "imported")
 
 
-class _Use(NamedTuple):
-    pass_pos: int
-    sync: Sync
-    write: bool
-    queue: str
-
-
 @dataclass(slots=True)
 class _Cell:
     layout: str | None
@@ -50,7 +41,7 @@ class _Cell:
     write: tuple[int, frozenset[str], frozenset[str]] | None  # (pass, stages, write access)
     reads: list[tuple[int, frozenset[str]]]  # (pass, stages) since the write
     image: bool
-    uses: list[_Use]  # the cell's timeline: every pass that touches it, in order
+    uses: list[Use]  # the cell's timeline: every pass that touches it, in order
     covered_until: int = -1  # timeline index of the last read already covered by a barrier
     cursor: int = 0  # timeline index of the next access
     aliases: tuple[str, ...] = ()
@@ -73,42 +64,6 @@ class _Cell:
         return EMPTY.union(*[s for _, s in reads])
 
 
-@lru_cache(maxsize=4096)
-def _sync(usage: str, kind: str, stages: tuple[str, ...] | None, image: bool, depth: bool, stencil: bool,
-          refit: bool) -> Sync:
-    """``sync_of`` by position (a positional cache key is cheaper to build than keywords)."""
-    return sync_of(usage, kind, explicit_stages=stages, is_image=image, depth_format=depth, stencil_format=stencil,
-                   refit=refit)
-
-
-def access_syncs(p: PassSpec, resources: Mapping[str, ResourceSpec]) -> list[Sync]:
-    out = []
-    kind = p.kind
-    for a in p.accesses:
-        res = resources[a.resource]
-        fmt = res.format
-        out.append(_sync(a.usage, kind, a.stages, res.kind == "image", bool(fmt and fmt.has_depth),
-                         bool(fmt and fmt.has_stencil), a.refit))
-    return out
-
-
-def _pass_cells(p: PassSpec, syncs: list[Sync]) -> list[tuple[Cell, Sync, bool]]:
-    """(cell, merged sync, written) for each cell ``p`` touches, in access order."""
-    accesses = p.accesses
-    if len(accesses) == 1:
-        a = accesses[0]
-        return [(c, syncs[0], a.write) for c in a.cells]
-    merged: dict[Cell, tuple[Sync, bool]] = {}
-    for a, s in zip(accesses, syncs, strict=True):
-        for c in a.cells:
-            if c in merged:
-                prev, w = merged[c]
-                merged[c] = (merge(prev, s), w or a.write)
-            else:
-                merged[c] = (s, a.write)
-    return [(c, s, w) for c, (s, w) in merged.items()]
-
-
 def synchronize(
     passes: Sequence[PassSpec],
     resources: Mapping[str, ResourceSpec],
@@ -122,31 +77,13 @@ def synchronize(
     the placed resources, so that older occupants reached through a partial hand-off count
     only where their bytes overlap.
     """
-    syncs = unify_read_layouts(passes, resources, [access_syncs(p, resources) for p in passes])
-    per_pass_cells = [_pass_cells(p, s) for p, s in zip(passes, syncs, strict=True)]
-    timeline: dict[Cell, list[_Use]] = {}
-    touched: dict[str, int] = {}  # cells per resource
-    first_pass: dict[str, int] = {}  # first pass of each resource
-    for i, (p, pc) in enumerate(zip(passes, per_pass_cells, strict=True)):
-        queue = p.queue
-        for c, s, w in pc:
-            uses = timeline.get(c)
-            if uses is None:
-                timeline[c] = [_Use(i, s, w, queue)]
-                name = c[0]
-                if name in touched:
-                    touched[name] += 1
-                else:
-                    touched[name] = 1
-                    first_pass[name] = i
-            else:
-                uses.append(_Use(i, s, w, queue))
-
-    alias_sources = with_partial_handoffs(alias_sources or {}, touched, resources, ranges)
+    inputs = sync_inputs(passes, resources)
+    syncs, per_pass_cells, timeline = inputs.syncs, inputs.per_pass_cells, inputs.timeline
+    alias_sources = with_partial_handoffs(alias_sources or {}, inputs.touched, resources, ranges)
     image = {name: res.is_image for name, res in resources.items()}
     persistent = {name for name, res in resources.items() if res.lifetime in PERSISTENT}
 
-    def fresh(c: Cell, uses: list[_Use]) -> _Cell:
+    def fresh(c: Cell, uses: list[Use]) -> _Cell:
         im = image[c[0]]
         return _Cell("UNDEFINED" if im else None, None, None, [], im, uses)
 
@@ -170,7 +107,7 @@ def synchronize(
             start[c] = fresh(c, uses)
     sim = _Simulation(passes, per_pass_cells)
     initial = {c: st.state() for c, st in start.items()}
-    sim.run(start, AliasStarts(alias_sources, start, first_pass, initial))
+    sim.run(start, AliasStarts(alias_sources, start, inputs.first_pass, initial))
     return SyncResult(sim.out, syncs, _by_resource(sim.final_states()), _by_resource(initial))
 
 
@@ -340,7 +277,7 @@ def _step(cell: _Cell, i: int, queue: str, s: Sync, write: bool):
     return key, release_at, wait_on
 
 
-def _group(uses: list[_Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
+def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
     """Stages and accesses of the read group starting at use ``k``, and its last use."""
     end = k
     last = len(uses) - 1

@@ -1,0 +1,97 @@
+"""What the sync simulation walks: each access's sync2 scope, each pass's cells, each cell's timeline.
+
+One walk over the executed passes gives every access its ``Sync`` (``usages.sync_of``, read
+groups moved to GENERAL by ``read_layouts``), every pass its (cell, merged sync, written)
+list and every cell the ordered list of its uses (``Use``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import NamedTuple
+
+from rgraph.compiler.read_layouts import unify_read_layouts
+from rgraph.compiler.usages import Sync, merge, sync_of
+from rgraph.ir.graph import Cell
+from rgraph.spec.specialize import PassSpec, ResourceSpec
+
+
+class Use(NamedTuple):
+    pass_pos: int
+    sync: Sync
+    write: bool
+    queue: str
+
+
+@dataclass
+class SyncInputs:
+    syncs: list[list[Sync]]  # per pass, per declared access
+    per_pass_cells: list[list[tuple[Cell, Sync, bool]]]  # per pass: (cell, merged sync, written), access order
+    timeline: dict[Cell, list[Use]]  # first touch order
+    touched: dict[str, int]  # cells per resource
+    first_pass: dict[str, int]  # first executed pass of each resource
+
+
+@lru_cache(maxsize=4096)
+def _sync(usage: str, kind: str, stages: tuple[str, ...] | None, image: bool, depth: bool, stencil: bool,
+          refit: bool) -> Sync:
+    """``sync_of`` by position (a positional cache key is cheaper to build than keywords)."""
+    return sync_of(usage, kind, explicit_stages=stages, is_image=image, depth_format=depth, stencil_format=stencil,
+                   refit=refit)
+
+
+def format_flags(resources: Mapping[str, ResourceSpec]) -> dict[str, tuple[bool, bool, bool]]:
+    """Per resource: (image, depth format, stencil format), the format part of ``sync_of``'s key."""
+    out = {}
+    for name, res in resources.items():
+        fmt = res.format
+        out[name] = (res.kind == "image", bool(fmt and fmt.has_depth), bool(fmt and fmt.has_stencil))
+    return out
+
+
+def access_syncs(p: PassSpec, flags: Mapping[str, tuple[bool, bool, bool]]) -> list[Sync]:
+    """The ``Sync`` of each of ``p``'s accesses (``flags``: ``format_flags``)."""
+    kind = p.kind
+    return [_sync(a.usage, kind, a.stages, *flags[a.resource], a.refit) for a in p.accesses]
+
+
+def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> SyncInputs:
+    flags = format_flags(resources)
+    syncs = unify_read_layouts(passes, resources, [access_syncs(p, flags) for p in passes])
+    per_pass_cells: list[list[tuple[Cell, Sync, bool]]] = []
+    timeline: dict[Cell, list[Use]] = {}
+    touched: dict[str, int] = {}
+    first_pass: dict[str, int] = {}
+    for i, p in enumerate(passes):
+        queue = p.queue
+        accesses = p.accesses
+        if len(accesses) == 1:
+            a = accesses[0]
+            s, w = syncs[i][0], a.write
+            items = [(c, s, w) for c in a.cells]
+        else:
+            merged: dict[Cell, tuple[Sync, bool]] = {}
+            for a, s in zip(accesses, syncs[i], strict=True):
+                for c in a.cells:
+                    if c in merged:
+                        prev, w = merged[c]
+                        merged[c] = (merge(prev, s), w or a.write)
+                    else:
+                        merged[c] = (s, a.write)
+            items = [(c, s, w) for c, (s, w) in merged.items()]
+        per_pass_cells.append(items)
+        for c, s, w in items:
+            uses = timeline.get(c)
+            if uses is None:
+                timeline[c] = [Use(i, s, w, queue)]
+                name = c[0]
+                if name in touched:
+                    touched[name] += 1
+                else:
+                    touched[name] = 1
+                    first_pass[name] = i
+            else:
+                uses.append(Use(i, s, w, queue))
+    return SyncInputs(syncs, per_pass_cells, timeline, touched, first_pass)

@@ -11,6 +11,7 @@ from rgraph.ir.graph import Cell
 
 #: (resource, mips, layers): barriers of one pass never share all three (their cells are disjoint)
 _ORDER = itemgetter(0, 1, 2)
+_new = tuple.__new__  # cheaper than a named tuple's Python-level ``__new__``
 
 
 def barriers_of(found: Sequence[tuple[Cell, BarrierKey, int | None]]) -> list[Barrier]:
@@ -18,7 +19,7 @@ def barriers_of(found: Sequence[tuple[Cell, BarrierKey, int | None]]) -> list[Ba
     equal key and release pass merged into rectangles, sorted by (resource, mips, layers)."""
     if len(found) == 1:
         (res, mip, layer), key, _ = found[0]
-        return [Barrier(res, (mip, mip + 1), (layer, layer + 1), key)]
+        return [_new(Barrier, (res, (mip, mip + 1), (layer, layer + 1), key))]
     by_res: dict[str, list[tuple[Cell, BarrierKey, int | None]]] = {}
     for item in found:
         res = item[0][0]
@@ -30,7 +31,7 @@ def barriers_of(found: Sequence[tuple[Cell, BarrierKey, int | None]]) -> list[Ba
     for res, items in by_res.items():
         if len(items) == 1:  # one cell (every buffer): its own rectangle
             (_, mip, layer), key, _ = items[0]
-            out.append(Barrier(res, (mip, mip + 1), (layer, layer + 1), key))
+            out.append(_new(Barrier, (res, (mip, mip + 1), (layer, layer + 1), key)))
             continue
         groups: dict[tuple[BarrierKey, int | None], list[Cell]] = {}
         for c, key, release_at in items:
@@ -45,7 +46,7 @@ def rectangles(res: str, key: BarrierKey, cells: Sequence[Cell]) -> list[Barrier
     """The barriers of ``cells`` (all of ``res``, one key), sorted by mips then layers."""
     if len(cells) == 1:
         _, mip, layer = cells[0]
-        return [Barrier(res, (mip, mip + 1), (layer, layer + 1), key)]
+        return [_new(Barrier, (res, (mip, mip + 1), (layer, layer + 1), key))]
     out = [Barrier(res, mips, layers, key) for mips, layers in mip_layer_rectangles((m, la) for _, m, la in cells)]
     out.sort(key=_ORDER)
     return out

@@ -52,10 +52,10 @@ class _Cell:
 
     def state(self) -> State:
         if self.reads:
-            return State(self.read_stages(), EMPTY, self.layout, self.queue)
+            return _new(State, (self.read_stages(), EMPTY, self.layout, self.queue))
         if self.write:
-            return State(self.write[1], self.write[2], self.layout, self.queue)
-        return State(EMPTY, EMPTY, self.layout, self.queue)
+            return _new(State, (self.write[1], self.write[2], self.layout, self.queue))
+        return _new(State, (EMPTY, EMPTY, self.layout, self.queue))
 
     def read_stages(self) -> frozenset[str]:
         reads = self.reads
@@ -122,6 +122,7 @@ def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
     return out
 
 
+_new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: twice the cost per value
 _NOTHING: tuple = (None, None, ())  # what ``_step`` returns when a cell needs no barrier and no wait
 
 
@@ -226,18 +227,18 @@ def _step(cell: _Cell, i: int, queue: str, s: Sync, write: bool):
     if write or layout_change:
         reads = cell.reads
         if reads:
-            src = State(reads[0][1] if len(reads) == 1 else cell.read_stages(), EMPTY, cell_layout, src_queue)
+            src = _new(State, (reads[0][1] if len(reads) == 1 else cell.read_stages(), EMPTY, cell_layout, src_queue))
         elif cell.write:
-            src = State(cell.write[1], cell.write[2], cell_layout, src_queue)
+            src = _new(State, (cell.write[1], cell.write[2], cell_layout, src_queue))
         else:
-            src = State(EMPTY, EMPTY, cell_layout, src_queue)
+            src = _new(State, (EMPTY, EMPTY, cell_layout, src_queue))
         if src.stages or src.access or layout_change or transfer:
             if write:
-                key = BarrierKey(src, State(s.stages, s.access, layout, queue), cell.aliases)
+                key = _new(BarrierKey, (src, _new(State, (s.stages, s.access, layout, queue)), cell.aliases))
             else:  # a transition for a read group: cover the whole group
                 dst_stages, dst_access, cell.covered_until = _group(cell.uses, k, layout, queue)
                 cell.visible = (dst_stages, dst_access)
-                key = BarrierKey(src, State(dst_stages, dst_access, layout, queue), cell.aliases)
+                key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, layout, queue)), cell.aliases))
         if write:
             cell.write = (i, s.stages, s.writes)
             cell.reads = []
@@ -255,15 +256,15 @@ def _step(cell: _Cell, i: int, queue: str, s: Sync, write: bool):
                         and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
             reads = cell.reads
             if reads:  # the write is already available: chain through the reads
-                src = State(reads[0][1] if len(reads) == 1 else cell.read_stages(), EMPTY, cell_layout, src_queue)
+                src = _new(State, (reads[0][1] if len(reads) == 1 else cell.read_stages(), EMPTY, cell_layout, src_queue))
             elif cell.write:
-                src = State(cell.write[1], cell.write[2], cell_layout, src_queue)
+                src = _new(State, (cell.write[1], cell.write[2], cell_layout, src_queue))
             else:
-                src = State(EMPTY, EMPTY, cell_layout, src_queue)
+                src = _new(State, (EMPTY, EMPTY, cell_layout, src_queue))
             dst_stages, dst_access, cell.covered_until = _group(cell.uses, k, layout, queue)
             cell.visible = (dst_stages, dst_access)
             if transfer or src.stages or src.access:
-                key = BarrierKey(src, State(dst_stages, dst_access, layout, queue), cell.aliases)
+                key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, layout, queue)), cell.aliases))
         cell.reads.append((i, s.stages))
     cell.layout = layout
     cell.queue = queue
@@ -282,16 +283,16 @@ def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[fro
     end = k
     last = len(uses) - 1
     while end < last:
-        u = uses[end + 1]
-        if u.write or u.sync.layout != layout or u.queue != queue:
+        _, sync, write, q = uses[end + 1]
+        if write or sync.layout != layout or q != queue:
             break
         end += 1
     if end == k:
-        only = uses[k].sync
+        only = uses[k][1]
         return only.stages, only.access, end
     stages: set[str] = set()
     access: set[str] = set()
     for u in uses[k : end + 1]:
-        stages |= u.sync.stages
-        access |= u.sync.access
+        stages |= u[1].stages
+        access |= u[1].access
     return frozenset(stages), frozenset(access), end

@@ -10,19 +10,15 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import NamedTuple
 
 from rgraph.compiler.read_layouts import unify_read_layouts
 from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
-
-class Use(NamedTuple):
-    pass_pos: int
-    sync: Sync
-    write: bool
-    queue: str
+#: One pass's use of a cell: (executed pass index, merged sync, written, queue); a plain tuple
+#: (one per cell per pass: a named tuple costs twice as much to build).
+Use = tuple[int, Sync, bool, str]
 
 
 @dataclass
@@ -85,7 +81,7 @@ def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
         for c, s, w in items:
             uses = timeline.get(c)
             if uses is None:
-                timeline[c] = [Use(i, s, w, queue)]
+                timeline[c] = [(i, s, w, queue)]
                 name = c[0]
                 if name in touched:
                     touched[name] += 1
@@ -93,5 +89,5 @@ def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
                     touched[name] = 1
                     first_pass[name] = i
             else:
-                uses.append(Use(i, s, w, queue))
+                uses.append((i, s, w, queue))
     return SyncInputs(syncs, per_pass_cells, timeline, touched, first_pass)

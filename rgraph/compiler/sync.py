@@ -1,9 +1,11 @@
 """Derive every barrier, layout transition, queue ownership transfer and semaphore.
 
 State is tracked per subresource cell (resource, mip, layer; a buffer is one cell):
-its layout, owning queue, last write and the reads since. For each pass, in executed
-order, each cell it touches gets at most one barrier; cells with identical barriers are
-merged into mip/layer rectangles, so a pass has one batch.
+its layout, owning queue, last write and the reads since. Each cell touched by a pass gets
+at most one barrier there; cells with identical barriers are merged into mip/layer
+rectangles, so a pass has one batch. Cells do not affect each other's barriers, so each
+cell's timeline is walked in one go (``_walk``: its state in local variables), resources in
+the order of their first pass, and the barriers and waits are then gathered per pass.
 
 Rules (DESIGN.md invariants): srcAccess holds writes only; a layout transition is a write;
 read-after-read in one layout needs nothing; the first read after a write gets one
@@ -18,13 +20,11 @@ resource's last accesses and UNDEFINED.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
-from rgraph.compiler.alias_starts import PREVIOUS_FRAME, AliasStarts, with_partial_handoffs
+from rgraph.compiler.alias_starts import PREVIOUS_FRAME, alias_state, with_partial_handoffs
 from rgraph.compiler.rectangles import barriers_of, mip_layer_rectangles, rectangles
 from rgraph.compiler.sync_inputs import Use, access_syncs, sync_inputs
 from rgraph.compiler.sync_types import EMPTY, Barrier, BarrierKey, PassSync, State, SyncResult, Wait
-from rgraph.compiler.usages import Sync
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
@@ -32,36 +32,15 @@ __all__ = ["EMPTY", "Barrier", "BarrierKey", "PassSync", "State", "SyncResult", 
            "mip_layer_rectangles", "synchronize"]
 
 PERSISTENT = ("persistent", "imported")
+_new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: twice the cost per value
 
-
-@dataclass(slots=True)
-class _Cell:
-    layout: str | None
-    queue: str | None
-    write: tuple[int, frozenset[str], frozenset[str]] | None  # (pass, stages, write access)
-    reads: list[tuple[int, frozenset[str]]]  # (pass, stages) since the write
-    image: bool
-    uses: list[Use]  # the cell's timeline: every pass that touches it, in order
-    covered_until: int = -1  # timeline index of the last read already covered by a barrier
-    cursor: int = 0  # timeline index of the next access
-    aliases: tuple[str, ...] = ()
-    last_pass: int | None = None
-    last_in_previous_frame: bool = False
-    visible: tuple[frozenset[str], frozenset[str]] = (EMPTY, EMPTY)  # dst scope since the write
-    alias_waits: tuple[tuple[str, int], ...] = ()  # (queue, last pass) of each previous occupant
-
-    def state(self) -> State:
-        if self.reads:
-            return _new(State, (self.read_stages(), EMPTY, self.layout, self.queue))
-        if self.write:
-            return _new(State, (self.write[1], self.write[2], self.layout, self.queue))
-        return _new(State, (EMPTY, EMPTY, self.layout, self.queue))
-
-    def read_stages(self) -> frozenset[str]:
-        reads = self.reads
-        if len(reads) == 1:
-            return reads[0][1]
-        return EMPTY.union(*[s for _, s in reads])
+#: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
+#: is (pass, stages, write access) or None, reads the (pass, stages) since it, visible the dst
+#: scope (stages, access) of the barriers since it.
+CellEnd = tuple
+#: What a pass gets from one of its cells: (position in the pass's cells, cell, barrier key or
+#: None, release pass or None, [(queue, pass)] to wait for, the cell's sync in the pass).
+Event = tuple
 
 
 def synchronize(
@@ -78,204 +57,213 @@ def synchronize(
     only where their bytes overlap.
     """
     inputs = sync_inputs(passes, resources)
-    syncs, per_pass_cells, timeline = inputs.syncs, inputs.per_pass_cells, inputs.timeline
-    alias_sources = with_partial_handoffs(alias_sources or {}, inputs.touched, resources, ranges)
-    image = {name: res.is_image for name, res in resources.items()}
-    persistent = {name for name, res in resources.items() if res.lifetime in PERSISTENT}
-
-    def fresh(c: Cell, uses: list[Use]) -> _Cell:
-        im = image[c[0]]
-        return _Cell("UNDEFINED" if im else None, None, None, [], im, uses)
-
-    # Frame 1 from scratch gives the end-of-frame state; frame 2 starts persistent cells there.
-    first_cells: dict[Cell, _Cell] = {}
-    if persistent:
-        first = _Simulation(passes, per_pass_cells)
-        first.run_states({c: fresh(c, uses) for c, uses in timeline.items() if c[0] in persistent})
-        first_cells = first.cells
-    start: dict[Cell, _Cell] = {}
-    for c, uses in timeline.items():
-        if c[0] in persistent:
-            st = first_cells[c]
-            write = (PREVIOUS_FRAME, st.write[1], st.write[2]) if st.write else None
-            reads = [(PREVIOUS_FRAME, stages) for _, stages in st.reads]
-            start[c] = _Cell(
-                st.layout, st.queue, write, reads, st.image, uses, last_pass=st.last_pass,
-                last_in_previous_frame=True, visible=st.visible,
-            )
+    first_pass = inputs.first_pass
+    sources = with_partial_handoffs(alias_sources or {}, inputs.touched, resources, ranges)
+    cells_of: dict[str, list[tuple[Cell, list[Use]]]] = {}
+    for c, uses in inputs.timeline.items():
+        if c[0] in cells_of:
+            cells_of[c[0]].append((c, uses))
         else:
-            start[c] = fresh(c, uses)
-    sim = _Simulation(passes, per_pass_cells)
-    initial = {c: st.state() for c, st in start.items()}
-    sim.run(start, AliasStarts(alias_sources, start, inputs.first_pass, initial))
-    return SyncResult(sim.out, syncs, _by_resource(sim.final_states()), _by_resource(initial))
-
-
-def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
-    out: dict[str, dict[Cell, State]] = {}
-    for c, st in states.items():
-        name = c[0]
-        if name in out:
-            out[name][c] = st
+            cells_of[c[0]] = [(c, uses)]
+    events: list[list[Event] | None] = [None] * len(passes)
+    initial: dict[str, dict[Cell, State]] = {}
+    final: dict[str, dict[Cell, State]] = {}
+    ends: dict[str, list[tuple[State, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
+    wanted = {pred for name, preds in sources.items() if preds for pred in preds}
+    # every earlier occupant of a resource's memory ends before its first pass: walked before it
+    for name in sorted(cells_of, key=first_pass.__getitem__):
+        res = resources[name]
+        image = res.is_image
+        layout = "UNDEFINED" if image else None
+        starts: dict[Cell, State] = {}
+        finals: dict[Cell, State] = {}
+        kept = ends[name] = [] if name in wanted else None
+        preds = sources.get(name)
+        if res.lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
+            for c, uses in cells_of[name]:
+                lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
+                                                                 (), (), False, None, c)
+                start = (lay, queue, (PREVIOUS_FRAME, write[1], write[2]) if write else None,
+                         [(PREVIOUS_FRAME, stages) for _, stages in reads], last, visible)
+                starts[c] = _state(start)
+                end = _walk(uses, image, start, (), (), True, events, c)
+                finals[c] = st = _state(end)
+                if kept is not None:
+                    kept.append((st, end[4]))
         else:
-            out[name] = {c: st}
+            aliases: tuple[str, ...] = ()
+            waits: tuple[tuple[str, int], ...] = ()
+            queue = write = last = None
+            if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
+                stages, access, queue, last, aliases, waits = alias_state(
+                    preds, [end for pred in preds for end in ends.get(pred, ())], first_pass[name])
+                write = (PREVIOUS_FRAME, stages, access) if stages or access else None
+            for c, uses in cells_of[name]:
+                start = (layout, queue, write, [], last, EMPTY2)
+                starts[c] = _state(start)
+                end = _walk(uses, image, start, aliases, waits, False, events, c)
+                finals[c] = st = _state(end)
+                if kept is not None:
+                    kept.append((st, end[4]))
+        initial[name] = starts
+        final[name] = finals
+    return SyncResult(_gather(events), inputs.syncs, final, initial)
+
+
+EMPTY2 = (EMPTY, EMPTY)
+
+
+def _state(end: CellEnd) -> State:
+    """What later accesses must wait for: the reads since the write, else the write."""
+    layout, queue, write, reads, _, _ = end
+    if reads:
+        return _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[s for _, s in reads]), EMPTY, layout,
+                            queue))
+    if write:
+        return _new(State, (write[1], write[2], layout, queue))
+    return _new(State, (EMPTY, EMPTY, layout, queue))
+
+
+def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...],
+          alias_waits: tuple[tuple[str, int], ...], last_prev: bool, events: list | None, c: Cell) -> CellEnd:
+    """Walk one cell through its uses from ``start``; append each pass's ``Event`` to
+    ``events[pass]`` (None: end state only). ``aliases``/``alias_waits``: the earlier occupants
+    of its memory (and (queue, last pass) of each) that its first use hands over and waits for;
+    ``last_prev``: the start state is the previous frame's."""
+    layout, cq, write, reads, last_pass, visible = start
+    covered_until = -1  # index in ``uses`` of the last read already covered by a barrier
+    for k, (i, s, w, queue, pos) in enumerate(uses):
+        cross = cq is not None and cq != queue
+        if alias_waits:  # aliased memory used on another queue
+            wait_on = [(q, j) for q, j in alias_waits if q != queue]
+        elif cross:
+            wait_on = []
+        else:
+            wait_on = ()
+        transfer = False
+        release_at = None
+        if cross:
+            if last_pass is not None and not last_prev:
+                wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
+            if image:
+                transfer = layout not in (None, "UNDEFINED")
+            else:
+                transfer = not aliases and (write is not None or bool(reads))
+            if transfer:
+                release_at = last_pass
+        src_queue = cq if transfer else queue
+        new_layout = s.layout
+        layout_change = new_layout != layout
+        key = None
+        if w or layout_change:
+            if reads:
+                src = _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]), EMPTY,
+                                   layout, src_queue))
+            elif write:
+                src = _new(State, (write[1], write[2], layout, src_queue))
+            else:
+                src = _new(State, (EMPTY, EMPTY, layout, src_queue))
+            if src[0] or src[1] or layout_change or transfer:
+                if w:
+                    key = _new(BarrierKey, (src, _new(State, (s.stages, s.access, new_layout, queue)), aliases))
+                else:  # a transition for a read group: cover the whole group
+                    dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                    visible = (dst_stages, dst_access)
+                    key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, new_layout, queue)), aliases))
+            if w:
+                write = (i, s.stages, s.writes)
+                reads = []
+                covered_until = k
+                visible = EMPTY2
+            elif layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
+                write = (i, s.stages, EMPTY) if layout != "UNDEFINED" else None
+                reads = [(i, s.stages)]
+            else:
+                reads.append((i, s.stages))
+        else:  # a read in the current layout
+            if transfer or (write and k > covered_until
+                            and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
+                if reads:  # the write is already available: chain through the reads
+                    src = _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]),
+                                       EMPTY, layout, src_queue))
+                elif write:
+                    src = _new(State, (write[1], write[2], layout, src_queue))
+                else:
+                    src = _new(State, (EMPTY, EMPTY, layout, src_queue))
+                dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                visible = (dst_stages, dst_access)
+                if transfer or src[0] or src[1]:
+                    key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, new_layout, queue)), aliases))
+            reads.append((i, s.stages))
+        layout = new_layout
+        cq = queue
+        last_pass = i
+        if aliases or alias_waits or last_prev:
+            aliases = ()
+            alias_waits = ()
+            last_prev = False
+        if events is not None and (key is not None or wait_on):
+            event = (pos, c, key, release_at if key is not None else None, wait_on, s)
+            found = events[i]
+            if found is None:
+                events[i] = [event]
+            else:
+                found.append(event)
+    return layout, cq, write, reads, last_pass, visible
+
+
+def _gather(events: list[list[Event] | None]) -> list[PassSync]:
+    """Each pass's barriers, the releases it owes later acquires, its waits and signal."""
+    out = [PassSync() for _ in events]
+    for i, found in enumerate(events):
+        if found is None:
+            continue
+        if len(found) > 1:
+            found.sort(key=_position)  # the pass's cell order
+        queue = None
+        barriers: list[tuple[Cell, BarrierKey, int | None]] = []
+        # acquires grouped by their release pass too, so that each acquire's rectangles equal
+        # its release's (the layer pairs ownership transfers by exact subresource range)
+        release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] | None = None
+        waits: dict[str, tuple[int, set[str]]] | None = None
+        for _, c, key, release_at, wait_on, s in found:
+            if key is not None:
+                if wait_on:
+                    queue = key.dst.queue
+                    wait_stages = set(s.stages)
+                    if key.src.queue == queue:
+                        # A semaphore wait orders only its own stages, and a barrier chains after it
+                        # only through its source stages: they must meet (the swapchain-acquire pattern).
+                        if not key.src.stages:
+                            key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
+                        wait_stages |= key.src.stages
+                barriers.append((c, key, release_at))
+                if release_at is not None:
+                    if release_groups is None:
+                        release_groups = {}
+                    release_groups.setdefault((release_at, c[0], key), []).append(c)
+            else:
+                wait_stages = set(s.stages)
+            if wait_on:
+                if waits is None:
+                    waits = {}
+                for q, j in wait_on:
+                    prev = waits.get(q)
+                    waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
+        if barriers:
+            out[i].barriers = barriers_of(barriers)
+        if release_groups:
+            for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
+                out[j].releases.extend(rectangles(res, key, cs))
+        if waits:
+            for q, (j, stages) in sorted(waits.items()):
+                out[i].waits.append(Wait(q, j, frozenset(stages)))
+                out[j].signal = True
     return out
 
 
-_new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: twice the cost per value
-_NOTHING: tuple = (None, None, ())  # what ``_step`` returns when a cell needs no barrier and no wait
-
-
-class _Simulation:
-    def __init__(self, passes: Sequence[PassSpec], per_pass_cells: list[list[tuple[Cell, Sync, bool]]]) -> None:
-        self.passes = passes
-        self.per_pass_cells = per_pass_cells
-        self.out = [PassSync() for _ in passes]
-        self.cells: dict[Cell, _Cell] = {}
-
-    def run_states(self, start: dict[Cell, _Cell]) -> None:
-        """``run`` for the end states of the cells in ``start`` only (others are skipped): the
-        barriers it would derive are not kept."""
-        self.cells = start
-        get = start.get
-        for i, p in enumerate(self.passes):
-            queue = p.queue
-            for c, s, w in self.per_pass_cells[i]:
-                cell = get(c)
-                if cell is not None:
-                    _step(cell, i, queue, s, w)
-
-    def run(self, start: dict[Cell, _Cell], alias_starts: AliasStarts) -> None:
-        self.cells = cells_now = start
-        out = self.out
-        starting = alias_starts.at
-        for i, p in enumerate(self.passes):
-            if i in starting:
-                alias_starts.apply(i)
-            found: list[tuple[Cell, BarrierKey, int | None]] = []
-            # acquires grouped by their release pass too, so that each acquire's rectangles equal
-            # its release's (the layer pairs ownership transfers by exact subresource range)
-            release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] | None = None
-            waits: dict[str, tuple[int, set[str]]] | None = None
-            queue = p.queue
-            for c, s, w in self.per_pass_cells[i]:
-                key, release_at, wait_on = _step(cells_now[c], i, queue, s, w)
-                if key is not None:
-                    if wait_on:
-                        wait_stages = set(s.stages)
-                        if key.src.queue == queue:
-                            # A semaphore wait orders only its own stages, and a barrier chains after it
-                            # only through its source stages: they must meet (the swapchain-acquire pattern).
-                            if not key.src.stages:
-                                key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
-                            wait_stages |= key.src.stages
-                    found.append((c, key, release_at))
-                    if release_at is not None:
-                        if release_groups is None:
-                            release_groups = {}
-                        release_groups.setdefault((release_at, c[0], key), []).append(c)
-                elif wait_on:
-                    wait_stages = set(s.stages)
-                if wait_on:
-                    if waits is None:
-                        waits = {}
-                    for q, j in wait_on:
-                        prev = waits.get(q)
-                        waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
-            if found:
-                out[i].barriers = barriers_of(found)
-            if release_groups:
-                for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
-                    out[j].releases.extend(rectangles(res, key, cs))
-            if waits:
-                for q, (j, stages) in sorted(waits.items()):
-                    out[i].waits.append(Wait(q, j, frozenset(stages)))
-                    out[j].signal = True
-
-    def final_states(self) -> dict[Cell, State]:
-        return {c: cell.state() for c, cell in self.cells.items()}
-
-
-def _step(cell: _Cell, i: int, queue: str, s: Sync, write: bool):
-    """Update one cell for pass ``i``; return (barrier key, release pass, [(queue, wait pass)])."""
-    k = cell.cursor
-    cell.cursor = k + 1
-    cell_queue = cell.queue
-    cross = cell_queue is not None and cell_queue != queue
-    if cell.alias_waits:  # aliased memory used on another queue
-        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue]
-    elif cross:
-        wait_on = []
-    else:
-        wait_on = ()
-    transfer = False
-    release_at = None
-    if cross:
-        if cell.last_pass is not None and not cell.last_in_previous_frame:
-            wait_on.append((cell_queue, cell.last_pass))  # earlier frames: the runtime's frame-boundary waits
-        if cell.image:
-            transfer = cell.layout not in (None, "UNDEFINED")
-        else:
-            transfer = not cell.aliases and (cell.write is not None or bool(cell.reads))
-        if transfer:
-            release_at = cell.last_pass
-    src_queue = cell_queue if transfer else queue
-    layout = s.layout
-    cell_layout = cell.layout
-    layout_change = layout != cell_layout
-    key: BarrierKey | None = None
-    if write or layout_change:
-        reads = cell.reads
-        if reads:
-            src = _new(State, (reads[0][1] if len(reads) == 1 else cell.read_stages(), EMPTY, cell_layout, src_queue))
-        elif cell.write:
-            src = _new(State, (cell.write[1], cell.write[2], cell_layout, src_queue))
-        else:
-            src = _new(State, (EMPTY, EMPTY, cell_layout, src_queue))
-        if src.stages or src.access or layout_change or transfer:
-            if write:
-                key = _new(BarrierKey, (src, _new(State, (s.stages, s.access, layout, queue)), cell.aliases))
-            else:  # a transition for a read group: cover the whole group
-                dst_stages, dst_access, cell.covered_until = _group(cell.uses, k, layout, queue)
-                cell.visible = (dst_stages, dst_access)
-                key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, layout, queue)), cell.aliases))
-        if write:
-            cell.write = (i, s.stages, s.writes)
-            cell.reads = []
-            cell.covered_until = k
-            cell.visible = (EMPTY, EMPTY)
-        else:
-            if layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
-                cell.write = (i, s.stages, EMPTY) if cell_layout != "UNDEFINED" else None
-                cell.reads = [(i, s.stages)]
-            else:
-                reads.append((i, s.stages))
-    else:  # a read in the current layout
-        visible = cell.visible
-        if transfer or (cell.write and k > cell.covered_until
-                        and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
-            reads = cell.reads
-            if reads:  # the write is already available: chain through the reads
-                src = _new(State, (reads[0][1] if len(reads) == 1 else cell.read_stages(), EMPTY, cell_layout, src_queue))
-            elif cell.write:
-                src = _new(State, (cell.write[1], cell.write[2], cell_layout, src_queue))
-            else:
-                src = _new(State, (EMPTY, EMPTY, cell_layout, src_queue))
-            dst_stages, dst_access, cell.covered_until = _group(cell.uses, k, layout, queue)
-            cell.visible = (dst_stages, dst_access)
-            if transfer or src.stages or src.access:
-                key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, layout, queue)), cell.aliases))
-        cell.reads.append((i, s.stages))
-    cell.layout = layout
-    cell.queue = queue
-    if cell.aliases or cell.alias_waits:
-        cell.aliases = ()
-        cell.alias_waits = ()
-    cell.last_pass = i
-    cell.last_in_previous_frame = False
-    if key is None:
-        return _NOTHING if not wait_on else (None, None, wait_on)
-    return key, release_at, wait_on
+def _position(event: Event) -> int:
+    return event[0]
 
 
 def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
@@ -283,7 +271,7 @@ def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[fro
     end = k
     last = len(uses) - 1
     while end < last:
-        _, sync, write, q = uses[end + 1]
+        _, sync, write, q, _ = uses[end + 1]
         if write or sync.layout != layout or q != queue:
             break
         end += 1

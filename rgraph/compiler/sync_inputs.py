@@ -16,9 +16,10 @@ from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
-#: One pass's use of a cell: (executed pass index, merged sync, written, queue); a plain tuple
-#: (one per cell per pass: a named tuple costs twice as much to build).
-Use = tuple[int, Sync, bool, str]
+#: One pass's use of a cell: (executed pass index, merged sync, written, queue, position of the
+#: cell in the pass's cell list); a plain tuple (one per cell per pass: a named tuple costs twice
+#: as much to build).
+Use = tuple[int, Sync, bool, str, int]
 
 
 @dataclass
@@ -78,10 +79,10 @@ def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
                         merged[c] = (s, a.write)
             items = [(c, s, w) for c, (s, w) in merged.items()]
         per_pass_cells.append(items)
-        for c, s, w in items:
+        for pos, (c, s, w) in enumerate(items):
             uses = timeline.get(c)
             if uses is None:
-                timeline[c] = [(i, s, w, queue)]
+                timeline[c] = [(i, s, w, queue, pos)]
                 name = c[0]
                 if name in touched:
                     touched[name] += 1
@@ -89,5 +90,5 @@ def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
                     touched[name] = 1
                     first_pass[name] = i
             else:
-                uses.append((i, s, w, queue))
+                uses.append((i, s, w, queue, pos))
     return SyncInputs(syncs, per_pass_cells, timeline, touched, first_pass)

@@ -218,30 +218,34 @@ def _gather(events: list[list[Event] | None]) -> list[PassSync]:
     for i, found in enumerate(events):
         if found is None:
             continue
-        if len(found) > 1:
-            found.sort(key=_position)  # the pass's cell order
-        queue = None
         barriers: list[tuple[Cell, BarrierKey, int | None]] = []
         # acquires grouped by their release pass too, so that each acquire's rectangles equal
         # its release's (the layer pairs ownership transfers by exact subresource range)
-        release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] | None = None
+        release_groups: dict[tuple[int, str, BarrierKey], tuple[int, list[Cell]]] | None = None
         waits: dict[str, tuple[int, set[str]]] | None = None
-        for _, c, key, release_at, wait_on, s in found:
+        for pos, c, key, release_at, wait_on, s in found:
             if key is not None:
                 if wait_on:
-                    queue = key.dst.queue
                     wait_stages = set(s.stages)
-                    if key.src.queue == queue:
+                    src = key.src
+                    if src.queue == key.dst.queue:
                         # A semaphore wait orders only its own stages, and a barrier chains after it
                         # only through its source stages: they must meet (the swapchain-acquire pattern).
-                        if not key.src.stages:
-                            key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
+                        if not src.stages:
+                            key = key._replace(src=src._replace(stages=frozenset(s.stages)))
                         wait_stages |= key.src.stages
                 barriers.append((c, key, release_at))
                 if release_at is not None:
                     if release_groups is None:
                         release_groups = {}
-                    release_groups.setdefault((release_at, c[0], key), []).append(c)
+                    group = (release_at, c[0], key)
+                    if group in release_groups:
+                        first, cs = release_groups[group]
+                        cs.append(c)
+                        if pos < first:
+                            release_groups[group] = (pos, cs)
+                    else:
+                        release_groups[group] = (pos, [c])
             else:
                 wait_stages = set(s.stages)
             if wait_on:
@@ -253,7 +257,8 @@ def _gather(events: list[list[Event] | None]) -> list[PassSync]:
         if barriers:
             out[i].barriers = barriers_of(barriers)
         if release_groups:
-            for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
+            # by release pass and resource, then in the order the pass touches the cells
+            for (j, res, key), (_, cs) in sorted(release_groups.items(), key=_release_order):
                 out[j].releases.extend(rectangles(res, key, cs))
         if waits:
             for q, (j, stages) in sorted(waits.items()):
@@ -262,8 +267,9 @@ def _gather(events: list[list[Event] | None]) -> list[PassSync]:
     return out
 
 
-def _position(event: Event) -> int:
-    return event[0]
+def _release_order(item: tuple) -> tuple[int, str, int]:
+    (j, res, _), (first, _) = item
+    return j, res, first
 
 
 def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:

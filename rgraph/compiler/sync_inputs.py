@@ -1,8 +1,8 @@
 """What the sync simulation walks: each access's sync2 scope, each pass's cells, each cell's timeline.
 
 One walk over the executed passes gives every access its ``Sync`` (``usages.sync_of``, read
-groups moved to GENERAL by ``read_layouts``), every pass its (cell, merged sync, written)
-list and every cell the ordered list of its uses (``Use``).
+groups moved to GENERAL by ``read_layouts``) and every cell the ordered list of its uses
+(``Use``: accesses of one pass to one cell merged into one).
 """
 
 from __future__ import annotations
@@ -25,7 +25,6 @@ Use = tuple[int, Sync, bool, str, int]
 @dataclass
 class SyncInputs:
     syncs: list[list[Sync]]  # per pass, per declared access
-    per_pass_cells: list[list[tuple[Cell, Sync, bool]]]  # per pass: (cell, merged sync, written), access order
     timeline: dict[Cell, list[Use]]  # first touch order
     touched: dict[str, int]  # cells per resource
     first_pass: dict[str, int]  # first executed pass of each resource
@@ -57,38 +56,35 @@ def access_syncs(p: PassSpec, flags: Mapping[str, tuple[bool, bool, bool]]) -> l
 def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> SyncInputs:
     flags = format_flags(resources)
     syncs = unify_read_layouts(passes, resources, [access_syncs(p, flags) for p in passes])
-    per_pass_cells: list[list[tuple[Cell, Sync, bool]]] = []
     timeline: dict[Cell, list[Use]] = {}
     touched: dict[str, int] = {}
     first_pass: dict[str, int] = {}
     for i, p in enumerate(passes):
         queue = p.queue
-        accesses = p.accesses
-        if len(accesses) == 1:
-            a = accesses[0]
-            s, w = syncs[i][0], a.write
-            items = [(c, s, w) for c in a.cells]
-        else:
-            merged: dict[Cell, tuple[Sync, bool]] = {}
-            for a, s in zip(accesses, syncs[i], strict=True):
-                for c in a.cells:
-                    if c in merged:
-                        prev, w = merged[c]
-                        merged[c] = (merge(prev, s), w or a.write)
+        index: dict[Cell, tuple[int, Sync, bool]] | None = {} if len(p.accesses) > 1 else None  # this pass's cells
+        pos = 0
+        for a, s in zip(p.accesses, syncs[i], strict=True):
+            w = a.write
+            for c in a.cells:
+                if index is not None:
+                    prev = index.get(c)
+                    if prev is not None:  # a second access to the cell in this pass: one merged use
+                        k, ps, pw = prev
+                        s2, w2 = merge(ps, s), pw or w
+                        index[c] = (k, s2, w2)
+                        timeline[c][-1] = (i, s2, w2, queue, k)
+                        continue
+                    index[c] = (pos, s, w)
+                uses = timeline.get(c)
+                if uses is None:
+                    timeline[c] = [(i, s, w, queue, pos)]
+                    name = c[0]
+                    if name in touched:
+                        touched[name] += 1
                     else:
-                        merged[c] = (s, a.write)
-            items = [(c, s, w) for c, (s, w) in merged.items()]
-        per_pass_cells.append(items)
-        for pos, (c, s, w) in enumerate(items):
-            uses = timeline.get(c)
-            if uses is None:
-                timeline[c] = [(i, s, w, queue, pos)]
-                name = c[0]
-                if name in touched:
-                    touched[name] += 1
+                        touched[name] = 1
+                        first_pass[name] = i
                 else:
-                    touched[name] = 1
-                    first_pass[name] = i
-            else:
-                uses.append((i, s, w, queue, pos))
-    return SyncInputs(syncs, per_pass_cells, timeline, touched, first_pass)
+                    uses.append((i, s, w, queue, pos))
+                pos += 1
+    return SyncInputs(syncs, timeline, touched, first_pass)

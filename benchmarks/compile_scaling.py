@@ -44,31 +44,49 @@ def timed(spec: Spec, policy: str, repeats: int) -> tuple[float, float, Plan]:
 
 
 def phase_times(spec: Spec, policy: str, repeats: int) -> dict[str, float]:
-    """Minimum CPU seconds of each compiler phase (``rgraph.compiler.phases.PHASES``)."""
+    """Minimum CPU seconds of each compiler phase (``rgraph.compiler.phases.PHASES``), and of
+    the placement search inside ``place`` (``rgraph.memory.place``, key ``placement search``)."""
     import gc
 
+    import rgraph.memory
     from rgraph.compiler.phases import PHASES, Compilation
     from rgraph.compiler.pipeline import DEFAULT_PROFILE, _default_provider
 
     best: dict[str, float] = {}
+    search = rgraph.memory.place
+    spent = [0.0]
+
+    def timed_search(*args, **kwargs):
+        start = time.process_time()
+        try:
+            return search(*args, **kwargs)
+        finally:
+            spent[0] += time.process_time() - start
+
     enabled = gc.isenabled()
     gc.disable()  # as in pipeline.compilation
+    rgraph.memory.place = timed_search  # looked up at each call (rgraph.compiler.memory.place_resources)
     try:
         for _ in range(repeats):
             c = Compilation(spec, policy, _default_provider(), DEFAULT_PROFILE)
+            spent[0] = 0.0
             for name, phase in PHASES:
                 start = time.process_time()
                 c = phase(c)
                 best[name] = min(best.get(name, math.inf), time.process_time() - start)
+            best["placement search"] = min(best.get("placement search", math.inf), spent[0])
     finally:
+        rgraph.memory.place = search
         if enabled:
             gc.enable()
     return best
 
 
 def phases_line(spec: Spec, policy: str, repeats: int) -> str:
-    return "  phases, min cpu ms: " + ", ".join(
-        f"{name} {seconds * 1e3:.1f}" for name, seconds in phase_times(spec, policy, repeats).items())
+    times = phase_times(spec, policy, repeats)
+    search = times.pop("placement search")
+    return "  phases, min cpu ms: " + ", ".join(f"{name} {seconds * 1e3:.1f}" for name, seconds in times.items()) + \
+        f" (of place: placement search {search * 1e3:.1f})"
 
 
 def measure(passes: int, policy: str, repeats: int) -> tuple[float, float, int, int, Spec]:

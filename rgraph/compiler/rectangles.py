@@ -10,7 +10,7 @@ from rgraph.compiler.sync_types import Barrier, BarrierKey
 from rgraph.ir.graph import Cell
 
 #: (resource, mips, layers): barriers of one pass never share all three (their cells are disjoint)
-_ORDER = itemgetter(0, 1, 2)
+BARRIER_ORDER = itemgetter(0, 1, 2)
 _new = tuple.__new__  # cheaper than a named tuple's Python-level ``__new__``
 
 
@@ -38,7 +38,7 @@ def barriers_of(found: Sequence[tuple[Cell, BarrierKey, int | None]]) -> list[Ba
             groups.setdefault((key, release_at), []).append(c)
         for (key, _), cs in groups.items():
             out += rectangles(res, key, cs)
-    out.sort(key=_ORDER)
+    out.sort(key=BARRIER_ORDER)
     return out
 
 
@@ -48,7 +48,7 @@ def rectangles(res: str, key: BarrierKey, cells: Sequence[Cell]) -> list[Barrier
         _, mip, layer = cells[0]
         return [_new(Barrier, (res, (mip, mip + 1), (layer, layer + 1), key))]
     out = [Barrier(res, mips, layers, key) for mips, layers in mip_layer_rectangles((m, la) for _, m, la in cells)]
-    out.sort(key=_ORDER)
+    out.sort(key=BARRIER_ORDER)
     return out
 
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from rgraph.compiler.alias_starts import PREVIOUS_FRAME, alias_state, with_partial_handoffs
-from rgraph.compiler.rectangles import barriers_of, mip_layer_rectangles, rectangles
+from rgraph.compiler.rectangles import BARRIER_ORDER, barriers_of, mip_layer_rectangles, rectangles
 from rgraph.compiler.sync_inputs import Use, access_syncs, sync_inputs
 from rgraph.compiler.sync_types import EMPTY, Barrier, BarrierKey, PassSync, State, SyncResult, Wait
 from rgraph.ir.graph import Cell
@@ -39,7 +39,8 @@ _new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: tw
 #: scope (stages, access) of the barriers since it.
 CellEnd = tuple
 #: What a pass gets from one of its cells: (position in the pass's cells, cell, barrier key or
-#: None, release pass or None, [(queue, pass)] to wait for, the cell's sync in the pass).
+#: None, release pass or None, [(queue, pass)] to wait for, the wait's stages, and the barrier
+#: itself when the cell is its resource's only one, else None).
 Event = tuple
 
 
@@ -79,6 +80,7 @@ def synchronize(
         finals: dict[Cell, State] = {}
         kept = ends[name] = [] if name in wanted else None
         preds = sources.get(name)
+        single = len(cells_of[name]) == 1
         if res.lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
             for c, uses in cells_of[name]:
                 lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
@@ -86,7 +88,7 @@ def synchronize(
                 start = (lay, queue, (PREVIOUS_FRAME, write[1], write[2]) if write else None,
                          [(PREVIOUS_FRAME, stages) for _, stages in reads], last, visible)
                 starts[c] = _state(start)
-                end = _walk(uses, image, start, (), (), True, events, c)
+                end = _walk(uses, image, start, (), (), True, events, c, single)
                 finals[c] = st = _state(end)
                 if kept is not None:
                     kept.append((st, end[4]))
@@ -101,7 +103,7 @@ def synchronize(
             for c, uses in cells_of[name]:
                 start = (layout, queue, write, [], last, EMPTY2)
                 starts[c] = _state(start)
-                end = _walk(uses, image, start, aliases, waits, False, events, c)
+                end = _walk(uses, image, start, aliases, waits, False, events, c, single)
                 finals[c] = st = _state(end)
                 if kept is not None:
                     kept.append((st, end[4]))
@@ -125,11 +127,13 @@ def _state(end: CellEnd) -> State:
 
 
 def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...],
-          alias_waits: tuple[tuple[str, int], ...], last_prev: bool, events: list | None, c: Cell) -> CellEnd:
+          alias_waits: tuple[tuple[str, int], ...], last_prev: bool, events: list | None, c: Cell,
+          single: bool = False) -> CellEnd:
     """Walk one cell through its uses from ``start``; append each pass's ``Event`` to
     ``events[pass]`` (None: end state only). ``aliases``/``alias_waits``: the earlier occupants
     of its memory (and (queue, last pass) of each) that its first use hands over and waits for;
-    ``last_prev``: the start state is the previous frame's."""
+    ``last_prev``: the start state is the previous frame's; ``single``: the cell is its
+    resource's only one (its barriers need no merging into rectangles)."""
     layout, cq, write, reads, last_pass, visible = start
     covered_until = -1  # index in ``uses`` of the last read already covered by a barrier
     for k, (i, s, w, queue, pos) in enumerate(uses):
@@ -203,7 +207,20 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
             alias_waits = ()
             last_prev = False
         if events is not None and (key is not None or wait_on):
-            event = (pos, c, key, release_at if key is not None else None, wait_on, s)
+            wait_stages = EMPTY
+            if wait_on:
+                wait_stages = s.stages
+                if key is not None and src_queue == queue:
+                    # A semaphore wait orders only its own stages, and a barrier chains after it
+                    # only through its source stages: they must meet (the swapchain-acquire pattern).
+                    if not key[0][0]:
+                        key = key._replace(src=key[0]._replace(stages=s.stages))
+                    wait_stages = wait_stages | key[0][0]
+            if key is None:
+                event = (pos, c, None, None, wait_on, wait_stages, None)
+            else:
+                event = (pos, c, key, release_at, wait_on, wait_stages,
+                         _new(Barrier, (c[0], (c[1], c[1] + 1), (c[2], c[2] + 1), key)) if single else None)
             found = events[i]
             if found is None:
                 events[i] = [event]
@@ -218,23 +235,18 @@ def _gather(events: list[list[Event] | None]) -> list[PassSync]:
     for i, found in enumerate(events):
         if found is None:
             continue
-        barriers: list[tuple[Cell, BarrierKey, int | None]] = []
+        ready: list[Barrier] = []  # one-cell resources' barriers
+        merged: list[tuple[Cell, BarrierKey, int | None]] = []  # cells of resources with several
         # acquires grouped by their release pass too, so that each acquire's rectangles equal
         # its release's (the layer pairs ownership transfers by exact subresource range)
         release_groups: dict[tuple[int, str, BarrierKey], tuple[int, list[Cell]]] | None = None
-        waits: dict[str, tuple[int, set[str]]] | None = None
-        for pos, c, key, release_at, wait_on, s in found:
+        waits: dict[str, tuple[int, frozenset[str]]] | None = None
+        for pos, c, key, release_at, wait_on, wait_stages, barrier in found:
             if key is not None:
-                if wait_on:
-                    wait_stages = set(s.stages)
-                    src = key.src
-                    if src.queue == key.dst.queue:
-                        # A semaphore wait orders only its own stages, and a barrier chains after it
-                        # only through its source stages: they must meet (the swapchain-acquire pattern).
-                        if not src.stages:
-                            key = key._replace(src=src._replace(stages=frozenset(s.stages)))
-                        wait_stages |= key.src.stages
-                barriers.append((c, key, release_at))
+                if barrier is not None:
+                    ready.append(barrier)
+                else:
+                    merged.append((c, key, release_at))
                 if release_at is not None:
                     if release_groups is None:
                         release_groups = {}
@@ -246,16 +258,18 @@ def _gather(events: list[list[Event] | None]) -> list[PassSync]:
                             release_groups[group] = (pos, cs)
                     else:
                         release_groups[group] = (pos, [c])
-            else:
-                wait_stages = set(s.stages)
             if wait_on:
                 if waits is None:
                     waits = {}
                 for q, j in wait_on:
                     prev = waits.get(q)
-                    waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
-        if barriers:
-            out[i].barriers = barriers_of(barriers)
+                    waits[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
+        if merged:
+            ready += barriers_of(merged)
+        if ready:
+            if len(ready) > 1:
+                ready.sort(key=BARRIER_ORDER)
+            out[i].barriers = ready
         if release_groups:
             # by release pass and resource, then in the order the pass touches the cells
             for (j, res, key), (_, cs) in sorted(release_groups.items(), key=_release_order):

@@ -8,10 +8,10 @@ groups moved to GENERAL by ``read_layouts``) and every cell the ordered list of 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
-from rgraph.compiler.read_layouts import unify_read_layouts
+from rgraph.compiler.read_layouts import ReadGroups
 from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
@@ -54,16 +54,27 @@ def access_syncs(p: PassSpec, flags: Mapping[str, tuple[bool, bool, bool]]) -> l
 
 
 def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> SyncInputs:
+    """Scopes and timelines in one walk; the reads ``read_layouts`` moves to GENERAL are
+    patched in afterwards (a few per graph)."""
     flags = format_flags(resources)
-    syncs = unify_read_layouts(passes, resources, [access_syncs(p, flags) for p in passes])
+    groups = ReadGroups(resources)
+    candidates = groups.candidates
+    syncs: list[list[Sync]] = []
     timeline: dict[Cell, list[Use]] = {}
     touched: dict[str, int] = {}
     first_pass: dict[str, int] = {}
     for i, p in enumerate(passes):
-        queue = p.queue
-        index: dict[Cell, tuple[int, Sync, bool]] | None = {} if len(p.accesses) > 1 else None  # this pass's cells
+        queue, kind = p.queue, p.kind
+        accesses = p.accesses
+        row: list[Sync] = []
+        index: dict[Cell, tuple[int, Sync, bool]] | None = {} if len(accesses) > 1 else None  # this pass's cells
         pos = 0
-        for a, s in zip(p.accesses, syncs[i], strict=True):
+        for j, a in enumerate(accesses):
+            name = a.resource
+            s = _sync(a.usage, kind, a.stages, *flags[name], a.refit)
+            row.append(s)
+            if name in candidates:
+                groups.note(i, j, a)
             w = a.write
             for c in a.cells:
                 if index is not None:
@@ -78,7 +89,6 @@ def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
                 uses = timeline.get(c)
                 if uses is None:
                     timeline[c] = [(i, s, w, queue, pos)]
-                    name = c[0]
                     if name in touched:
                         touched[name] += 1
                     else:
@@ -87,4 +97,25 @@ def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
                 else:
                     uses.append((i, s, w, queue, pos))
                 pos += 1
+        syncs.append(row)
+    moved = groups.to_general(syncs)
+    for i, j in moved:
+        syncs[i][j] = replace(syncs[i][j], layout="GENERAL")
+    for i, j in moved:
+        _repatch(passes[i], i, passes[i].accesses[j].cells, syncs[i], timeline)
     return SyncInputs(syncs, timeline, touched, first_pass)
+
+
+def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], timeline: dict[Cell, list[Use]]) -> None:
+    """Pass ``i``'s use of ``cells`` with its accesses' (changed) syncs merged again."""
+    for c in cells:
+        merged = None
+        for a, s in zip(p.accesses, row, strict=True):
+            if c in a.cells:
+                merged = s if merged is None else merge(merged, s)
+        uses = timeline[c]
+        for k in range(len(uses) - 1, -1, -1):
+            if uses[k][0] == i:
+                _, _, w, queue, pos = uses[k]
+                uses[k] = (i, merged, w, queue, pos)
+                break

@@ -127,11 +127,13 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
-            hybrid_params: dict[str, str] | None = None, async_shade: bool = False) -> dict[str, Any]:
+            hybrid_params: dict[str, str] | None = None, async_shade: bool = False,
+            dump: Path | None = None) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
-    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns)."""
+    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns).
+    ``dump``: a folder for ``SCENE_CAMERA.npz`` (both colour images as float16, the visibility ids)."""
     from rgraph.compiler.pipeline import compile_graph
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
@@ -151,11 +153,17 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     T = alone["timings"]["total_ms"]
     out = hybrid["outputs"]
     traced = int(np.frombuffer(out["ray_args"].tobytes()[:16], dtype=np.uint32)[3]) if "ray_args" in out else 0
+    if not traced:  # in-thread (rt.wavefront 0): no pixel list; the pixels whose surface needs secondary rays
+        traced = classified_pixels(out["visibility"][..., 0], path, size, camera)
     row = {"scene": scene, "camera": camera, "size": list(size), "frames": frames, "max_depth": depth,
            "hybrid_params": hybrid_params or {},
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
+    if dump is not None:
+        dump.mkdir(parents=True, exist_ok=True)
+        np.savez_compressed(dump / f"{scene}_{camera}.npz", alone=alone["outputs"]["color"].astype(np.float16),
+                            hybrid=out["color"].astype(np.float16), visibility=out["visibility"][..., 0])
     lists = [np.frombuffer(out[name].tobytes()[:16], dtype=np.uint32) for name in levels if name in out]
     row.update(level_rays=[traced] + [int(a[0]) for a in lists], level_overflow=any(bool(a[3]) for a in lists))
     if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)
@@ -171,6 +179,17 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         row.update(vis_differs_share=float((ids != raster_ids).mean()),
                    vis_holes_share=float(((ids == 0) & (raster_ids != 0)).mean()))
     return row
+
+
+def classified_pixels(ids: np.ndarray, path: Path, size: tuple[int, int], camera: int) -> int:
+    """Pixels whose visible surface reflects or refracts (the ones classify.comp would list)."""
+    from rgraph.passes.raytrace_hybrid import decode_visibility, instance_materials, needs_secondary_rays, prim_bits
+    from rgraph.scene.build import load_scene_data
+
+    data = load_scene_data(path, size, camera)
+    inst, _prim = decode_visibility(ids, prim_bits(data))
+    mask = needs_secondary_rays(data.materials)[instance_materials(data)]
+    return int(mask[inst[inst >= 0]].sum())
 
 
 def prim_bits_of(path: Path, size: tuple[int, int], camera: int) -> int:
@@ -271,6 +290,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="a param of graphs/rt_hybrid.yaml for the hybrid (repeatable), e.g. rt.wave_subgroup=1")
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
+    parser.add_argument("--dump", type=Path, help="write each camera's two images (SCENE_CAMERA.npz) here")
     args = parser.parse_args(argv)
     size = SIZES.get(args.size) or tuple(int(v) for v in args.size.lower().split("x"))
     small = args.size == "small"
@@ -291,7 +311,7 @@ def main(argv: list[str] | None = None) -> int:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
                                         chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
-                                        async_shade=args.async_shade))
+                                        async_shade=args.async_shade, dump=args.dump))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

@@ -14,8 +14,8 @@
 // float precision everywhere (like reversed Z), 0 = nothing.
 //
 // Edges are inclusive with a small relative epsilon: two triangles sharing an edge evaluate the
-// same cross product with opposite signs (exact negation; `precise` forbids contraction), so no
-// pixel centre falls between them (no cracks). Over-coverage (a triangle claiming a pixel whose
+// same cross product with opposite signs (exact negation: edge_cross orders the edge by vertex
+// index), so no pixel centre falls between them (no cracks). Over-coverage (a triangle claiming a pixel whose
 // centre it just misses) is safe: the hybrid's shading passes trace the camera ray where the
 // pixel centre misses the claimed triangle or the pixel borders another instance or the sky
 // (shaders/rt/hybrid.glsl: first_hit), so such a pixel gets the stand-alone's answer.
@@ -121,6 +121,16 @@ vec3 world_vertex(Instance I, uint v) {
     return w;
 }
 
+// a x b for the edge from vertex ia to ib, always evaluated with the lower vertex index first:
+// the two triangles sharing an edge then compute bit-identical products, and exact negations of
+// them, whatever the compiler does inside cross. With cross(p1, p2) against cross(p2, p1), the
+// H200 gave a far surface of the same mesh (a torus's back) on about 180 pixels of gallery camera
+// 3 at 1280x720; lavapipe never did (docs/raytracing.md, session 9).
+vec3 edge_cross(vec3 a, uint ia, vec3 b, uint ib) {
+    precise vec3 c = ia < ib ? cross(a, b) : -cross(b, a);
+    return c;
+}
+
 // Setup of global triangle t; false when it covers no pixel (degenerate, behind, off screen).
 bool setup_triangle(uint t, out Tri tri) {
     uint instance = instance_of(t);
@@ -136,7 +146,8 @@ bool setup_triangle(uint t, out Tri tri) {
     precise float h = dot(n, p0);
     if (!(abs(h) > 0.0) || isinf(h)) return false;  // the plane passes through the camera (edge-on) or degenerate
     float s = h > 0.0 ? 1.0 : -1.0;
-    precise vec3 c0 = s * cross(p1, p2), c1 = s * cross(p2, p0), c2 = s * cross(p0, p1);
+    uint i0 = idx[base], i1 = idx[base + 1u], i2 = idx[base + 2u];
+    precise vec3 c0 = s * edge_cross(p1, i1, p2, i2), c1 = s * edge_cross(p2, i2, p0, i0), c2 = s * edge_cross(p0, i0, p1, i1);
     precise vec3 nh = n / h;
     precise vec3 eps = 1e-6 * vec3(length(c0), length(c1), length(c2));
     tri.c0 = c0; tri.c1 = c1; tri.c2 = c2; tri.n = nh; tri.eps = eps;

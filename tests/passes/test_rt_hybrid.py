@@ -24,10 +24,10 @@ from rgraph.passes.raytrace_hybrid import (  # noqa: E402,E501
 SCENE = ROOT / "graphs" / "scenes" / "rt_tiny.yaml"
 
 
-def _run(graph: str, size: int, scene=SCENE, extra=()):
+def _run(graph: str, size: int, scene=SCENE, extra=(), params=None):
     from rgraph.vk.executor import execute_plan
 
-    plan = compile_graph(graph, scene_path=scene, size=(size, size), extra_outputs=list(extra))
+    plan = compile_graph(graph, scene_path=scene, size=(size, size), extra_outputs=list(extra), params=params or {})
     try:
         result = execute_plan(plan, frames=1, read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
@@ -42,9 +42,11 @@ def psnr(a, b) -> float:
 
 
 @pytest.mark.vulkan
-@pytest.mark.parametrize("graph", ["rt_hybrid", "rt_hybrid_raster"])  # compute / hardware visibility buffer
-def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels(graph):
-    _plan, hybrid = _run(graph, 20, extra=("ray_args", "visibility"))
+@pytest.mark.parametrize("graph, wave", [("rt_hybrid", "1"), ("rt_hybrid", "0"), ("rt_hybrid_raster", None)])
+def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels(graph, wave):
+    """Compute visibility buffer (the tree by levels or, the default, in-thread) / hardware raster."""
+    params = {} if wave is None else {"rt.wavefront": wave}
+    _plan, hybrid = _run(graph, 20, extra=("ray_args", "visibility"), params=params)
     _plan, alone = _run("rt_standalone", 20)
     a, b = alone["color"][..., :3].astype(np.float64), hybrid["color"][..., :3].astype(np.float64)
     assert np.isfinite(b).all()
@@ -58,9 +60,13 @@ def test_hybrid_agrees_with_stand_alone_and_traces_only_the_classified_pixels(gr
     assert (instance < len(mask)).all()
     expected = int(mask[instance[instance >= 0]].sum())
     args = np.frombuffer(hybrid["ray_args"].tobytes()[:16], dtype=np.uint32)
-    # the wavefront's pixel list: (resolve groups, 1, 1, count); the raster variant's: (count, 1, 1)
+    # the wavefront's pixel list: (resolve groups, 1, 1, count); the raster variant's: (count, 1, 1);
+    # in-thread (rt.wavefront 0) the shade pass walks the trees and lists nothing
     traced = int(args[3] if graph == "rt_hybrid" else args[0])
-    assert 0 < traced == expected < ids.size
+    if wave == "0":
+        assert traced == 0 and 0 < expected < ids.size
+    else:
+        assert 0 < traced == expected < ids.size
 
 
 def test_no_reflective_or_refractive_materials_culls_the_secondary_rays(tmp_path):

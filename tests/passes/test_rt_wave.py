@@ -41,7 +41,9 @@ LISTS = ("rays_1_args", "rays_2_args", "rays_3_args")
 def _run(graph: str, **params: str) -> dict:
     from rgraph.vk.executor import execute_plan
 
-    plan = compile_graph(graph, scene_path=SCENE, size=(SIZE, SIZE), params={"rt.max_depth": str(DEPTH), **params},
+    wave = {"rt.wavefront": "1"} if graph == "rt_hybrid" else {}  # the tree by levels (graphs/rt_hybrid.yaml: 0)
+    plan = compile_graph(graph, scene_path=SCENE, size=(SIZE, SIZE),
+                         params={"rt.max_depth": str(DEPTH), **wave, **params},
                          extra_outputs=["ray_args", *LISTS] if graph != "rt_standalone" else [])
     try:
         result = execute_plan(plan, frames=1, read_outputs=True)

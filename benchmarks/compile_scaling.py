@@ -1,7 +1,7 @@
 """Median compile time (parsed spec -> plan) for random graphs of 250 .. 16k passes.
 
     .venv/bin/python benchmarks/compile_scaling.py [--sizes 250,1000,4000,16000] [--policy aliased]
-        [--chain 10000] [--side-effects 5000] [--phases]
+        [--chain 10000] [--side-effects 5000] [--phases] [--repeats N]
 
 Prints one row per size and the growth exponent fitted on log(time) vs log(passes) (of the
 wall medians and of the minimum CPU times: on a shared machine the second is steadier), then
@@ -182,12 +182,14 @@ def main() -> None:
     parser.add_argument("--chain", type=int, default=10000, help="resources of the chain graph (0: skip)")
     parser.add_argument("--side-effects", type=int, default=5000, help="side-effect buffers (0: skip)")
     parser.add_argument("--phases", action="store_true", help="also the minimum CPU time of each compiler phase")
+    parser.add_argument("--repeats", type=int, default=0,
+                        help="compiles per random graph size (default: 3-15, fewer for larger graphs)")
     args = parser.parse_args()
     sizes = [int(s) for s in args.sizes.split(",")]
     rows = []
     print(f"{'passes':>8} {'executed':>9} {'barriers':>9} {'median ms':>10} {'us/pass':>8} {'min cpu ms':>11}")
     for n in sizes:
-        repeats = max(3, min(15, 16000 // n))
+        repeats = args.repeats or max(3, min(15, 16000 // n))
         median, cpu, executed, barriers, spec = measure(n, args.policy, repeats)
         rows.append((n, median, cpu))
         print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f} {cpu * 1e3:>11.1f}")
@@ -203,6 +205,8 @@ def main() -> None:
             print(f"{label} of {count}: {executed} passes, median {median * 1e3:.1f} ms (min cpu {cpu * 1e3:.1f} ms)")
             if args.phases:
                 print(phases_line(spec, args.policy, 3))
+    if args.repeats:
+        return  # a phase comparison: no cache figures
     print(f"unchanged 1,000-pass graph through PlanCache: median {cache_hit_us(1000):.1f} us")
     reuse, full = incremental_ms()
     print(f"surgery with a changed value-only param through PlanCache: median {reuse:.1f} ms "

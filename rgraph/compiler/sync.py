@@ -70,7 +70,7 @@ def synchronize(
     initial: dict[str, dict[Cell, State]] = {}
     final: dict[str, dict[Cell, State]] = {}
     ends: dict[str, list[tuple[State, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
-    wanted = {pred for name, preds in sources.items() if preds for pred in preds}
+    wanted = {pred for preds in sources.values() for pred in preds}
     # every earlier occupant of a resource's memory ends before its first pass: walked before it
     for name in sorted(cells_of, key=first_pass.__getitem__):
         res = resources[name]
@@ -78,7 +78,9 @@ def synchronize(
         layout = "UNDEFINED" if image else None
         starts: dict[Cell, State] = {}
         finals: dict[Cell, State] = {}
-        kept = ends[name] = [] if name in wanted else None
+        kept: list[tuple[State, int | None]] | None = None
+        if name in wanted:
+            kept = ends[name] = []
         preds = sources.get(name)
         single = len(cells_of[name]) == 1
         if res.lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in

@@ -121,12 +121,11 @@ vec3 world_vertex(Instance I, uint v) {
     return w;
 }
 
-// a x b for the edge from vertex ia to ib, always evaluated in the order of the lower vertex
-// index first: the two triangles sharing an edge then compute the very same product (whatever
-// the compiler contracts or reorders inside cross: NVIDIA's did, `precise` notwithstanding,
-// leaving cracks of a few 1e-4 of a sub-pixel triangle's edge values through which a far
-// surface of the same mesh won about 180 pixels of gallery camera 3 at 1280x720) and exact
-// negations of it, so no pixel centre falls between them.
+// a x b for the edge from vertex ia to ib, always evaluated with the lower vertex index first:
+// the two triangles sharing an edge then compute bit-identical products, and exact negations of
+// them, whatever the compiler does inside cross. With cross(p1, p2) against cross(p2, p1), the
+// H200 gave a far surface of the same mesh (a torus's back) on about 180 pixels of gallery camera
+// 3 at 1280x720; lavapipe never did (docs/raytracing.md, session 9).
 vec3 edge_cross(vec3 a, uint ia, vec3 b, uint ib) {
     precise vec3 c = ia < ib ? cross(a, b) : -cross(b, a);
     return c;

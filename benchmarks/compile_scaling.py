@@ -1,7 +1,7 @@
 """Median compile time (parsed spec -> plan) for random graphs of 250 .. 16k passes.
 
     .venv/bin/python benchmarks/compile_scaling.py [--sizes 250,1000,4000,16000] [--policy aliased]
-        [--chain 10000] [--side-effects 5000] [--phases]
+        [--chain 10000] [--side-effects 5000] [--phases] [--repeats N]
 
 Prints one row per size and the growth exponent fitted on log(time) vs log(passes) (of the
 wall medians and of the minimum CPU times: on a shared machine the second is steadier), then
@@ -44,31 +44,49 @@ def timed(spec: Spec, policy: str, repeats: int) -> tuple[float, float, Plan]:
 
 
 def phase_times(spec: Spec, policy: str, repeats: int) -> dict[str, float]:
-    """Minimum CPU seconds of each compiler phase (``rgraph.compiler.phases.PHASES``)."""
+    """Minimum CPU seconds of each compiler phase (``rgraph.compiler.phases.PHASES``), and of
+    the placement search inside ``place`` (``rgraph.memory.place``, key ``placement search``)."""
     import gc
 
+    import rgraph.memory
     from rgraph.compiler.phases import PHASES, Compilation
     from rgraph.compiler.pipeline import DEFAULT_PROFILE, _default_provider
 
     best: dict[str, float] = {}
+    search = rgraph.memory.place
+    spent = [0.0]
+
+    def timed_search(*args, **kwargs):
+        start = time.process_time()
+        try:
+            return search(*args, **kwargs)
+        finally:
+            spent[0] += time.process_time() - start
+
     enabled = gc.isenabled()
     gc.disable()  # as in pipeline.compilation
+    rgraph.memory.place = timed_search  # looked up at each call (rgraph.compiler.memory.place_resources)
     try:
         for _ in range(repeats):
             c = Compilation(spec, policy, _default_provider(), DEFAULT_PROFILE)
+            spent[0] = 0.0
             for name, phase in PHASES:
                 start = time.process_time()
                 c = phase(c)
                 best[name] = min(best.get(name, math.inf), time.process_time() - start)
+            best["placement search"] = min(best.get("placement search", math.inf), spent[0])
     finally:
+        rgraph.memory.place = search
         if enabled:
             gc.enable()
     return best
 
 
 def phases_line(spec: Spec, policy: str, repeats: int) -> str:
-    return "  phases, min cpu ms: " + ", ".join(
-        f"{name} {seconds * 1e3:.1f}" for name, seconds in phase_times(spec, policy, repeats).items())
+    times = phase_times(spec, policy, repeats)
+    search = times.pop("placement search")
+    return "  phases, min cpu ms: " + ", ".join(f"{name} {seconds * 1e3:.1f}" for name, seconds in times.items()) + \
+        f" (of place: placement search {search * 1e3:.1f})"
 
 
 def measure(passes: int, policy: str, repeats: int) -> tuple[float, float, int, int, Spec]:
@@ -164,12 +182,14 @@ def main() -> None:
     parser.add_argument("--chain", type=int, default=10000, help="resources of the chain graph (0: skip)")
     parser.add_argument("--side-effects", type=int, default=5000, help="side-effect buffers (0: skip)")
     parser.add_argument("--phases", action="store_true", help="also the minimum CPU time of each compiler phase")
+    parser.add_argument("--repeats", type=int, default=0,
+                        help="compiles per random graph size (default: 3-15, fewer for larger graphs)")
     args = parser.parse_args()
     sizes = [int(s) for s in args.sizes.split(",")]
     rows = []
     print(f"{'passes':>8} {'executed':>9} {'barriers':>9} {'median ms':>10} {'us/pass':>8} {'min cpu ms':>11}")
     for n in sizes:
-        repeats = max(3, min(15, 16000 // n))
+        repeats = args.repeats or max(3, min(15, 16000 // n))
         median, cpu, executed, barriers, spec = measure(n, args.policy, repeats)
         rows.append((n, median, cpu))
         print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f} {cpu * 1e3:>11.1f}")
@@ -185,6 +205,8 @@ def main() -> None:
             print(f"{label} of {count}: {executed} passes, median {median * 1e3:.1f} ms (min cpu {cpu * 1e3:.1f} ms)")
             if args.phases:
                 print(phases_line(spec, args.policy, 3))
+    if args.repeats:
+        return  # a phase comparison: no cache figures
     print(f"unchanged 1,000-pass graph through PlanCache: median {cache_hit_us(1000):.1f} us")
     reuse, full = incremental_ms()
     print(f"surgery with a changed value-only param through PlanCache: median {reuse:.1f} ms "

@@ -2,7 +2,7 @@
 
 Instances: the MiniMalloc "challenging" traces in ``shared/data/minimalloc`` (beside the
 repository, or ``$RGRAPH_SHARED``) and seeded random render-graph-like instances.
-Run: ``.venv/bin/python benchmarks/placement.py [--quick]``.
+Run: ``.venv/bin/python benchmarks/placement.py [--quick] [--only LABELS] [--aliased-budgets 0.2,0.5]``.
 """
 
 from __future__ import annotations
@@ -120,8 +120,10 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="fewer random instances")
     parser.add_argument("--only", help="comma-separated policy labels to run")
+    parser.add_argument("--aliased-budgets", help="comma-separated extra budgets (s) for aliased@S columns")
     args = parser.parse_args()
-    chosen = [p for p in POLICIES if not args.only or p[0] in args.only.split(",")]
+    extra = [(f"aliased@{b}s", "aliased", float(b)) for b in args.aliased_budgets.split(",")] if args.aliased_budgets else []
+    chosen = [p for p in POLICIES + extra if not args.only or p[0] in args.only.split(",")]
     rows = []
     for group, name, blocks in instances(args.quick):
         row: dict[str, object] = {"group": group, "instance": name, "blocks": len(blocks)}

@@ -154,6 +154,16 @@ class ProfileMemoryRequirements:
 
     def image(self, format_vk_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
               usage_names: Sequence[str]) -> Requirements:
+        """The requirements of an image (memoized per argument tuple: a profile does not change)."""
+        memo = self.__dict__.setdefault("_image_memo", {})
+        args = (format_vk_name, tuple(extent), mips, layers, samples, tuple(usage_names))
+        found = memo.get(args)
+        if found is None:
+            found = memo[args] = self._image(format_vk_name, extent, mips, layers, samples, usage_names)
+        return found
+
+    def _image(self, format_vk_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
+               usage_names: Sequence[str]) -> Requirements:
         key = format_vk_name.upper().removeprefix("VK_FORMAT_")
         entry = self.profile["formats"].get(key)
         if entry is None:
@@ -218,6 +228,15 @@ class ProfileMemoryRequirements:
         return int(self._accel_section()["scratch_alignment"])
 
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
+        """The requirements of a buffer (memoized per argument tuple, like ``image``)."""
+        memo = self.__dict__.setdefault("_buffer_memo", {})
+        args = (size, tuple(usage_names))
+        found = memo.get(args)
+        if found is None:
+            found = memo[args] = self._buffer(size, usage_names)
+        return found
+
+    def _buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
         accel = sorted(set(usage_names) & ACCEL_BUFFER_USAGES)
         if accel:
             rules = self._accel_section()["buffer"]

@@ -15,7 +15,7 @@ from rgraph.compiler import sync as csync
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
-from rgraph.spec.specialize import PassSpec, ResourceSpec
+from rgraph.spec.specialize import PassSpec
 
 if TYPE_CHECKING:
     from rgraph.compiler.phases import Compilation
@@ -36,21 +36,6 @@ def _names(values: frozenset[str]) -> tuple[str, ...]:
 @lru_cache(maxsize=65536)
 def plan_state(st: csync.State) -> pm.State:
     return pm.State(_names(st.stages), _names(st.access), st.layout, st.queue)
-
-
-@lru_cache(maxsize=65536)
-def _range_pair(mips: tuple[int, int], layers: tuple[int, int]) -> pm.Subresource:
-    return pm.Subresource(mips, layers)  # immutable: one object per distinct pair of ranges
-
-
-def _subresource(res: ResourceSpec, mips, layers) -> pm.Subresource | None:
-    return _range_pair(tuple(mips), tuple(layers)) if res.is_image else None
-
-
-def _barrier(b: csync.Barrier, resources: Mapping[str, ResourceSpec]) -> pm.Barrier:
-    key = b.key
-    return _Barrier(b.resource, _subresource(resources[b.resource], b.mips, b.layers), plan_state(key.src),
-                      plan_state(key.dst), key.aliases)
 
 
 def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.EndState:
@@ -86,18 +71,40 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
     resources, passes, sync = c.spec.resources, c.passes, c.sync
     assert sync is not None
     signal_values = _signal_values(passes, sync)
+    images = {name for name, res in resources.items() if res.is_image}
+    subresources: dict[tuple, pm.Subresource] = {}  # (mips, layers) -> one immutable object per pair
+    state = plan_state
+    builder_ = _Barrier
+
+    def barriers(bs: list[csync.Barrier]) -> tuple[pm.Barrier, ...]:
+        out = []
+        for res, mips, layers, key in bs:
+            if res in images:
+                sub = subresources.get((mips, layers))
+                if sub is None:
+                    sub = subresources[(mips, layers)] = pm.Subresource(mips, layers)
+            else:
+                sub = None
+            out.append(builder_(res, sub, state(key.src), state(key.dst), key.aliases))
+        return tuple(out)
+
     out = []
     for i, p in enumerate(passes):
         ps = sync.passes[i]
-        accesses = tuple([
-            _Access(a.resource, _subresource(resources[a.resource], a.mips, a.layers), a.usage,
-                      _names(s.stages), _names(s.access), s.layout, a.write)
-            for a, s in zip(p.accesses, sync.access_sync[i], strict=True)
-        ])
+        accesses = []
+        for a, s in zip(p.accesses, sync.access_sync[i], strict=True):
+            mips = a.mips
+            if mips is None:  # buffers and accels
+                sub = None
+            else:
+                sub = subresources.get((mips, a.layers))
+                if sub is None:
+                    sub = subresources[(mips, a.layers)] = pm.Subresource(mips, a.layers)
+            accesses.append(_Access(a.resource, sub, a.usage, _names(s.stages), _names(s.access), s.layout, a.write))
         out.append(_Pass(
-            p.name, i, 0, p.queue, p.kind, p.impl, _frozen(p.params), accesses,
-            tuple([_barrier(b, resources) for b in ps.barriers]) if ps.barriers else (),
-            tuple([_barrier(b, resources) for b in ps.releases]) if ps.releases else (),
+            p.name, i, 0, p.queue, p.kind, p.impl, _frozen(p.params), tuple(accesses),
+            barriers(ps.barriers) if ps.barriers else (),
+            barriers(ps.releases) if ps.releases else (),
             tuple([_Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits])
             if ps.waits else (),
             (_Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),

@@ -67,6 +67,27 @@ def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
     return out
 
 
+def usages_and_lifetimes(passes: Sequence[PassSpec]) -> tuple[dict[str, set[str]], dict[str, tuple[int, int]]]:
+    """``usages_by_resource`` and ``lifetimes`` of ``passes`` in one walk."""
+    used: dict[str, set[str]] = {}
+    spans: dict[str, tuple[int, int]] = {}
+    for i, p in enumerate(passes):
+        raytrace = p.kind == "raytrace"
+        for a in p.accesses:
+            name = a.resource
+            found = used.get(name)
+            if found is None:
+                used[name] = {a.usage}
+                spans[name] = (i, i)
+            else:
+                found.add(a.usage)
+                first = spans[name][0]
+                spans[name] = (first, i)
+            if raytrace and a.usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
+                used[name].add("trace_indirect")
+    return used, spans
+
+
 def lifetimes(passes: Sequence[PassSpec]) -> dict[str, tuple[int, int]]:
     """First and last executed pass index of each resource."""
     out: dict[str, tuple[int, int]] = {}
@@ -178,47 +199,33 @@ def alias_sources(placement: Placement, memory: Mapping[str, ResourceMemory]) ->
     for names in by_heap.values():
         if len(names) < 2:
             continue
-        ordered = sorted(names, key=lambda n: (memory[n].first, n))
-        by_last = sorted(names, key=lambda n: (memory[n].last, n))
-        lasts = [memory[n].last for n in by_last]
+        # per resource: (first pass, last pass, first byte, end byte)
+        span = {}
+        for n in names:
+            m = memory[n]
+            off = placement.offsets[n][1]
+            span[n] = (m.first, m.last, off, off + m.bytes)
+        ordered = sorted(names, key=lambda n: (span[n][0], n))
+        by_last = sorted(names, key=lambda n: (span[n][1], n))
+        lasts = [span[n][1] for n in by_last]
         for r in ordered:
-            r_first = memory[r].first
-            r_rng = _range(placement, memory, r)
-            visited: list[tuple[int, tuple[int, int]]] = []  # (first, byte range) of earlier occupants
+            r_first, _, r_lo, r_hi = span[r]
+            visited: list[tuple[int, int, int]] = []  # (first, first byte, end byte) of earlier occupants
             stop = -1  # occupants that ended before this first are covered by one holding all of r
             keep = []
             for k in range(bisect_left(lasts, r_first) - 1, -1, -1):
                 p = by_last[k]
-                p_last = lasts[k]
+                p_first, p_last, p_lo, p_hi = span[p]
                 if p_last < stop:
                     break
-                p_rng = _range(placement, memory, p)
-                if not _overlaps(r_rng, p_rng):
+                if not (r_lo < p_hi and p_lo < r_hi):
                     continue
-                part = _intersect(p_rng, r_rng)
-                if not any(first > p_last and _contains(rng, part) for first, rng in visited):
+                lo, hi = max(p_lo, r_lo), min(p_hi, r_hi)  # the bytes both hold
+                if not any(first > p_last and v_lo <= lo and hi <= v_hi for first, v_lo, v_hi in visited):
                     keep.append(p)
-                p_first = memory[p].first
-                visited.append((p_first, p_rng))
-                if _contains(p_rng, r_rng):
+                visited.append((p_first, p_lo, p_hi))
+                if p_lo <= r_lo and r_hi <= p_hi:
                     stop = max(stop, p_first)
             if keep:
-                out[r] = sorted(keep, key=lambda n: (memory[n].first, n))
+                out[r] = sorted(keep, key=lambda n: (span[n][0], n))
     return out
-
-
-def _range(placement: Placement, memory: Mapping[str, ResourceMemory], name: str) -> tuple[int, int]:
-    off = placement.offsets[name][1]
-    return off, off + memory[name].bytes
-
-
-def _overlaps(a: tuple[int, int], b: tuple[int, int]) -> bool:
-    return a[0] < b[1] and b[0] < a[1]
-
-
-def _intersect(a: tuple[int, int], b: tuple[int, int]) -> tuple[int, int]:
-    return max(a[0], b[0]), min(a[1], b[1])
-
-
-def _contains(outer: tuple[int, int], inner: tuple[int, int]) -> bool:
-    return outer[0] <= inner[0] and inner[1] <= outer[1]

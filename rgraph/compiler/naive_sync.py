@@ -24,7 +24,7 @@ from collections import defaultdict
 from dataclasses import replace
 from typing import Any, overload
 
-from rgraph.compiler.sync import mip_layer_rectangles
+from rgraph.compiler.rectangles import mip_layer_rectangles
 from rgraph.plan import from_json_dict, to_json_dict
 from rgraph.plan.model import Barrier, CellState, EndState, Plan, PlanResource, State, Subresource
 

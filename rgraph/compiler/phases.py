@@ -97,13 +97,13 @@ def measure(c: Compilation) -> Compilation:
     """Sizes, alignments and memory classes of the used resources (and of culled-only ones)."""
     assert c.culling is not None
     spec = c.spec
-    used = memory.usages_by_resource(c.passes)
+    used, spans = memory.usages_and_lifetimes(c.passes)
     reqs = memory.requirements(spec.resources, used, spec.outputs, c.provider)
     culled = {x.pass_name for x in c.culling.culled}
     culled_used = {r: u for r, u in memory.usages_by_resource([p for p in spec.passes if p.name in culled]).items()
-                   if r not in reqs}
-    culled_reqs = memory.requirements(spec.resources, culled_used, spec.outputs, c.provider)
-    return replace(c, memory=memory.resource_memory(reqs, used, memory.lifetimes(c.passes)),
+                   if r not in reqs} if culled else {}
+    culled_reqs = memory.requirements(spec.resources, culled_used, spec.outputs, c.provider) if culled_used else {}
+    return replace(c, memory=memory.resource_memory(reqs, used, spans),
                    culled_bytes={r: q.bytes for r, q in culled_reqs.items()})
 
 

@@ -45,25 +45,39 @@ def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str
         return {}
     wanted = set(candidates)
     firsts: dict[str, set[tuple[int, str]]] = {}  # resource -> (first pass of a cell, its queue)
-    ends: dict[tuple, tuple[int, str]] = {}  # cell -> (last pass, queue)
-    seen: set[tuple] = set()
     span: dict[str, list[int]] = {}
+    last: dict[tuple, tuple[str, int]] = {}  # cell -> (queue, last pass)
+    waits: list[dict[str, int]] = []  # ``direct_waits``, in the same walk
     for i, p in enumerate(passes):
+        queue = p.queue
+        pass_waits: dict[str, int] = {}
         for a in p.accesses:
-            if a.resource not in wanted:
-                continue
-            s = span.setdefault(a.resource, [i, i])
-            s[1] = i
+            name = a.resource
+            want = name in wanted
+            if want:
+                s = span.get(name)
+                if s is None:
+                    span[name] = [i, i]
+                else:
+                    s[1] = i
             for c in a.cells:
-                if c not in seen:
-                    seen.add(c)
-                    firsts.setdefault(a.resource, set()).add((i, p.queue))
-                ends[c] = (i, p.queue)
+                prev = last.get(c)
+                if prev is None:
+                    if want:
+                        if name in firsts:
+                            firsts[name].add((i, queue))
+                        else:
+                            firsts[name] = {(i, queue)}
+                elif prev[0] != queue and prev[1] != i and pass_waits.get(prev[0], -1) < prev[1]:
+                    pass_waits[prev[0]] = prev[1]
+                last[c] = (queue, i)
+        waits.append(pass_waits)
     lasts: dict[str, dict[str, int]] = {}  # resource -> queue -> last pass of a cell ending there
-    for c, (i, q) in ends.items():
-        per = lasts.setdefault(c[0], {})
-        per[q] = max(per.get(q, -1), i)
-    waits = direct_waits(passes)
+    for c, (q, i) in last.items():
+        if c[0] in wanted:
+            per = lasts.setdefault(c[0], {})
+            if per.get(q, -1) < i:
+                per[q] = i
     # Per queue q: the resources with a cell last used on q, by that last use. Sharing with a
     # later r adds a wait iff some cell of r first used on another queue does not already
     # wait for q at or after it: a range of this order, found by bisection.
@@ -77,13 +91,20 @@ def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str
     out: dict[str, set[str]] = {}
     for r in sorted(span):
         r_first = span[r][0]
+        r_firsts = firsts[r]
         for q, rows in by_queue.items():
-            have = [waits[v].get(q, -1) for v, qv in firsts[r] if qv != q]
+            have = [waits[v].get(q, -1) for v, qv in r_firsts if qv != q]
             if not have:
                 continue  # r starts on q only: a pipeline barrier orders it
             lo, hi = bisect_right(keys[q], min(have)), bisect_left(keys[q], r_first)
             for _, p in rows[lo:hi]:
                 if span[p][1] < r_first:
-                    out.setdefault(r, set()).add(p)
-                    out.setdefault(p, set()).add(r)
+                    if r in out:
+                        out[r].add(p)
+                    else:
+                        out[r] = {p}
+                    if p in out:
+                        out[p].add(r)
+                    else:
+                        out[p] = {r}
     return out

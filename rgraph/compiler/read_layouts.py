@@ -24,39 +24,69 @@ from rgraph.spec.specialize import PassSpec, ResourceSpec
 GENERAL_READS = frozenset({"sampled", "storage_read"})
 
 
-def _whole(a, res: ResourceSpec) -> bool:
-    return a.mips == (0, res.mips) and a.layers == (0, res.layers)
+class ReadGroups:
+    """The accesses ``unify_read_layouts`` looks at, noted one by one in executed order."""
+
+    def __init__(self, resources: Mapping[str, ResourceSpec]) -> None:
+        self.resources = resources
+        self.candidates = {
+            name for name, res in resources.items()
+            if res.is_image and res.lifetime == "transient" and res.format is not None
+            and not res.format.has_depth and not res.format.has_stencil
+        }
+        self.uses: dict[str, list[tuple[int, int, bool, str]]] = {}  # (pass, access, write, usage)
+        self.excluded: set[str] = set()
+
+    def note(self, i: int, j: int, a) -> None:
+        """Access ``j`` of pass ``i`` (call only for a resource in ``candidates``)."""
+        name = a.resource
+        if name in self.excluded:
+            return
+        res = self.resources[name]
+        if a.mips != (0, res.mips) or a.layers != (0, res.layers):  # not the whole image
+            self.excluded.add(name)
+            return
+        entry = (i, j, a.write, a.usage)
+        if name in self.uses:
+            self.uses[name].append(entry)
+        else:
+            self.uses[name] = [entry]
+
+    def to_general(self, syncs: Sequence[Sequence[Sync]]) -> list[tuple[int, int]]:
+        """(pass, access) of the reads to move to GENERAL: the movable reads of each group
+        between two writes whose layouts differ."""
+        out = []
+        for name, seq in self.uses.items():
+            if name in self.excluded:
+                continue
+            group: list[tuple[int, int]] = []  # the movable reads since the last write
+            for i, j, write, usage in [*seq, (-1, -1, True, "")]:  # a sentinel closes the last group
+                if not write:
+                    if usage in GENERAL_READS:
+                        group.append((i, j))
+                    continue
+                if len(group) > 1 and len({syncs[gi][gj].layout for gi, gj in group}) > 1:
+                    out += group
+                group = []
+        return out
 
 
 def unify_read_layouts(
     passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec], syncs: list[list[Sync]]
 ) -> list[list[Sync]]:
-    """``syncs`` (per pass, per access) with mixed-layout read groups moved to GENERAL."""
-    uses: dict[str, list[tuple[int, int]]] = {}
-    excluded: set[str] = set()
-    for i, p in enumerate(passes):
-        for j, a in enumerate(p.accesses):
-            res = resources[a.resource]
-            if not res.is_image:
-                continue  # buffers have no layout
-            fmt = res.format
-            if (res.lifetime != "transient" or fmt is None or fmt.has_depth
-                    or fmt.has_stencil or not _whole(a, res)):
-                excluded.add(a.resource)
-            uses.setdefault(a.resource, []).append((i, j))
-    out = [list(s) for s in syncs]
-    for name, seq in uses.items():
-        if name in excluded:
-            continue
-        group: list[tuple[int, int]] = []
-        for i, j in [*seq, (-1, -1)]:  # a sentinel closes the last group
-            a = passes[i].accesses[j] if i >= 0 else None
-            if a is not None and not a.write:
-                group.append((i, j))
-                continue
-            movable = [(gi, gj) for gi, gj in group if passes[gi].accesses[gj].usage in GENERAL_READS]
-            if len({out[gi][gj].layout for gi, gj in movable}) > 1:
-                for gi, gj in movable:
-                    out[gi][gj] = replace(out[gi][gj], layout="GENERAL")
-            group = []
+    """``syncs`` (per pass, per access) with mixed-layout read groups moved to GENERAL (a new
+    outer list; the inner lists of passes with a change are new too)."""
+    groups = ReadGroups(resources)
+    if groups.candidates:
+        for i, p in enumerate(passes):
+            for j, a in enumerate(p.accesses):
+                if a.resource in groups.candidates:
+                    groups.note(i, j, a)
+    out = list(syncs)
+    copied: set[int] = set()
+    for i, j in groups.to_general(syncs):
+        if i not in copied:
+            out[i] = list(out[i])
+            copied.add(i)
+        out[i][j] = replace(out[i][j], layout="GENERAL")
     return out

@@ -1,9 +1,11 @@
 """Derive every barrier, layout transition, queue ownership transfer and semaphore.
 
 State is tracked per subresource cell (resource, mip, layer; a buffer is one cell):
-its layout, owning queue, last write and the reads since. For each pass, in executed
-order, each cell it touches gets at most one barrier; cells with identical barriers are
-merged into mip/layer rectangles, so a pass has one batch.
+its layout, owning queue, last write and the reads since. Each cell touched by a pass gets
+at most one barrier there; cells with identical barriers are merged into mip/layer
+rectangles, so a pass has one batch. Cells do not affect each other's barriers, so each
+cell's timeline is walked in one go (``_walk``: its state in local variables), resources in
+the order of their first pass, and the barriers and waits are then gathered per pass.
 
 Rules (DESIGN.md invariants): srcAccess holds writes only; a layout transition is a write;
 read-after-read in one layout needs nothing; the first read after a write gets one
@@ -17,133 +19,29 @@ resource's last accesses and UNDEFINED.
 
 from __future__ import annotations
 
-from collections import defaultdict
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
-from functools import lru_cache
-from typing import NamedTuple
+from collections.abc import Mapping, Sequence
 
-from rgraph.compiler.read_layouts import unify_read_layouts
-from rgraph.compiler.usages import Sync, merge, sync_of
+from rgraph.compiler.alias_starts import PREVIOUS_FRAME, alias_state, with_partial_handoffs
+from rgraph.compiler.rectangles import BARRIER_ORDER, barriers_of, mip_layer_rectangles, rectangles
+from rgraph.compiler.sync_inputs import Use, access_syncs, sync_inputs
+from rgraph.compiler.sync_types import EMPTY, Barrier, BarrierKey, PassSync, State, SyncResult, Wait
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
+__all__ = ["EMPTY", "Barrier", "BarrierKey", "PassSync", "State", "SyncResult", "Wait", "access_syncs",
+           "mip_layer_rectangles", "synchronize"]
+
 PERSISTENT = ("persistent", "imported")
-PREVIOUS_FRAME = -1
+_new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: twice the cost per value
 
-
-class State(NamedTuple):
-    """Where a cell stands: stages/access of the last accesses that later ones must wait for.
-    (A named tuple: hashed and compared in C, as barrier group keys are many.)"""
-
-    stages: frozenset[str]
-    access: frozenset[str]  # writes only
-    layout: str | None
-    queue: str | None
-
-
-class BarrierKey(NamedTuple):
-    src: State
-    dst: State
-    aliases: tuple[str, ...] = ()
-
-
-EMPTY: frozenset[str] = frozenset()
-
-
-class Barrier(NamedTuple):
-    resource: str
-    mips: tuple[int, int] | None
-    layers: tuple[int, int] | None
-    key: BarrierKey
-
-
-class Wait(NamedTuple):
-    queue: str
-    signal_pass: int  # executed index of the pass whose signal is waited for
-    stages: frozenset[str]
-
-
-@dataclass(slots=True)
-class PassSync:
-    barriers: list[Barrier] = field(default_factory=list)
-    releases: list[Barrier] = field(default_factory=list)
-    waits: list[Wait] = field(default_factory=list)
-    signal: bool = False
-
-
-@dataclass
-class SyncResult:
-    passes: list[PassSync]
-    access_sync: list[list[Sync]]  # per pass, per declared access
-    final: dict[str, dict[Cell, State]]  # per resource: end-of-frame state per cell
-    initial: dict[str, dict[Cell, State]]
-
-
-@dataclass(slots=True)
-class _Cell:
-    layout: str | None
-    queue: str | None
-    write: tuple[int, frozenset[str], frozenset[str]] | None  # (pass, stages, write access)
-    reads: list[tuple[int, frozenset[str]]]  # (pass, stages) since the write
-    covered_until: int = -1  # timeline index of the last read already covered by a barrier
-    cursor: int = 0  # timeline index of the next access
-    aliases: tuple[str, ...] = ()
-    last_pass: int | None = None
-    last_in_previous_frame: bool = False
-    visible: tuple[frozenset[str], frozenset[str]] = (frozenset(), frozenset())  # dst scope since the write
-    alias_waits: tuple[tuple[str, int], ...] = ()  # (queue, last pass) of each previous occupant
-
-    def state(self) -> State:
-        if self.reads:
-            return State(self.read_stages(), EMPTY, self.layout, self.queue)
-        if self.write:
-            return State(self.write[1], self.write[2], self.layout, self.queue)
-        return State(EMPTY, EMPTY, self.layout, self.queue)
-
-    def read_stages(self) -> frozenset[str]:
-        reads = self.reads
-        if len(reads) == 1:
-            return reads[0][1]
-        return EMPTY.union(*[s for _, s in reads])
-
-
-class _Use(NamedTuple):
-    pass_pos: int
-    sync: Sync
-    write: bool
-    queue: str
-
-
-@lru_cache(maxsize=4096)
-def _sync(usage: str, kind: str, stages: tuple[str, ...] | None, image: bool, depth: bool, stencil: bool,
-          refit: bool) -> Sync:
-    """``sync_of`` by position (a positional cache key is cheaper to build than keywords)."""
-    return sync_of(usage, kind, explicit_stages=stages, is_image=image, depth_format=depth, stencil_format=stencil,
-                   refit=refit)
-
-
-def access_syncs(p: PassSpec, resources: Mapping[str, ResourceSpec]) -> list[Sync]:
-    out = []
-    kind = p.kind
-    for a in p.accesses:
-        res = resources[a.resource]
-        fmt = res.format
-        out.append(_sync(a.usage, kind, a.stages, res.kind == "image", bool(fmt and fmt.has_depth),
-                         bool(fmt and fmt.has_stencil), a.refit))
-    return out
-
-
-def _pass_cells(p: PassSpec, syncs: list[Sync]) -> dict[Cell, tuple[Sync, bool]]:
-    merged: dict[Cell, tuple[Sync, bool]] = {}
-    for a, s in zip(p.accesses, syncs, strict=True):
-        for c in a.cells:
-            if c in merged:
-                prev, w = merged[c]
-                merged[c] = (merge(prev, s), w or a.write)
-            else:
-                merged[c] = (s, a.write)
-    return merged
+#: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
+#: is (pass, stages, write access) or None, reads the (pass, stages) since it, visible the dst
+#: scope (stages, access) of the barriers since it.
+CellEnd = tuple
+#: What a pass gets from one of its cells: (position in the pass's cells, cell, barrier key or
+#: None, release pass or None, [(queue, pass)] to wait for, the wait's stages, and the barrier
+#: itself when the cell is its resource's only one, else None).
+Event = tuple
 
 
 def synchronize(
@@ -159,367 +57,252 @@ def synchronize(
     the placed resources, so that older occupants reached through a partial hand-off count
     only where their bytes overlap.
     """
-    alias_sources = alias_sources or {}
-    syncs = unify_read_layouts(passes, resources, [access_syncs(p, resources) for p in passes])
-    per_pass_cells = [_pass_cells(p, s) for p, s in zip(passes, syncs, strict=True)]
-    timeline: dict[Cell, list[_Use]] = defaultdict(list)
-    for i, (p, pc) in enumerate(zip(passes, per_pass_cells, strict=True)):
-        for c, (s, w) in pc.items():
-            timeline[c].append(_Use(i, s, w, p.queue))
-
-    alias_sources = _with_partial_handoffs(alias_sources, timeline, resources, ranges)
-
-    def fresh(c: Cell) -> _Cell:
-        res = resources[c[0]]
-        return _Cell("UNDEFINED" if res.is_image else None, None, None, [])
-
-    # Frame 1 from scratch gives the end-of-frame state; frame 2 starts persistent cells there.
-    needed = {r for r, res in resources.items() if res.lifetime in PERSISTENT}
-    first_cells: dict[Cell, _Cell] = {}
-    if needed:
-        first = _Simulation(passes, per_pass_cells, timeline, resources)
-        first.run_states({c: fresh(c) for c in timeline if c[0] in needed})  # the other cells are skipped
-        first_cells = first.cells
-    start: dict[Cell, _Cell] = {}
-    for c in timeline:
-        res = resources[c[0]]
-        if res.lifetime in PERSISTENT:
-            st = first_cells[c]
-            write = (PREVIOUS_FRAME, st.write[1], st.write[2]) if st.write else None
-            reads = [(PREVIOUS_FRAME, stages) for _, stages in st.reads]
-            start[c] = _Cell(
-                st.layout, st.queue, write, reads, last_pass=st.last_pass, last_in_previous_frame=True,
-                visible=st.visible,
-            )
+    inputs = sync_inputs(passes, resources)
+    first_pass = inputs.first_pass
+    sources = with_partial_handoffs(alias_sources or {}, inputs.touched, resources, ranges)
+    cells_of: dict[str, list[tuple[Cell, list[Use]]]] = {}
+    for c, uses in inputs.timeline.items():
+        if c[0] in cells_of:
+            cells_of[c[0]].append((c, uses))
         else:
-            start[c] = fresh(c)
-    sim = _Simulation(passes, per_pass_cells, timeline, resources)
-    initial = {c: st.state() for c, st in start.items()}
-    sim.run(start, _AliasStarts(alias_sources, start, timeline, initial))
-    final = sim.final_states()
-    return SyncResult(sim.out, syncs, _by_resource(final), _by_resource(initial))
-
-
-class _AliasStarts:
-    """Transient cells whose memory an earlier resource used start from that resource's last
-    accesses (``_alias_state``). Every earlier occupant ends before the resource's first
-    pass, so its cells already hold their end-of-frame state when that pass comes: the
-    states are taken then, from the one simulation of the frame. (A transient's end state
-    does not depend on where it started: its first access to each cell writes it or reads
-    it, and either replaces what ``state()`` reports.)"""
-
-    def __init__(self, alias_sources: Mapping[str, Sequence[str]], start: dict[Cell, _Cell],
-                 timeline: Mapping[Cell, list], initial: dict[Cell, State]) -> None:
-        self.cells_of: dict[str, list[tuple[Cell, _Cell]]] = defaultdict(list)
-        for c, st in start.items():
-            self.cells_of[c[0]].append((c, st))
-        first_pass: dict[str, int] = {}
-        for c, uses in timeline.items():
-            i = uses[0].pass_pos
-            if first_pass.get(c[0], i) >= i:
-                first_pass[c[0]] = i
-        self.at: dict[int, list[str]] = defaultdict(list)  # pass -> resources that start there
-        for name, preds in alias_sources.items():
-            if preds and name in first_pass:
-                self.at[first_pass[name]].append(name)
-        self.sources = alias_sources
-        self.initial = initial
-
-    def apply(self, i: int) -> None:
-        """Start the aliased resources whose first pass is ``i``."""
-        for name in self.at.get(i, ()):
-            stages, access, queue, last, names, waits = _alias_state(
-                self.sources[name], [st for pred in self.sources[name] for _, st in self.cells_of[pred]], i)
-            for c, cell in self.cells_of[name]:
-                cell.write = (PREVIOUS_FRAME, stages, access) if stages or access else None
-                cell.queue = queue
-                cell.last_pass = last
-                cell.aliases = names
-                cell.alias_waits = waits
-                self.initial[c] = cell.state()
-
-
-def _by_resource(states: Mapping[Cell, State]) -> dict[str, dict[Cell, State]]:
-    out: dict[str, dict[Cell, State]] = defaultdict(dict)
-    for c, st in states.items():
-        out[c[0]][c] = st
-    return dict(out)
-
-
-def _with_partial_handoffs(
-    alias_sources: Mapping[str, Sequence[str]], timeline: Mapping[Cell, list], resources: Mapping[str, ResourceSpec],
-    ranges: Mapping[str, tuple[int, int, int]] | None = None,
-) -> dict[str, list[str]]:
-    """``alias_sources`` plus, through every predecessor that touches only some of its
-    subresources, that predecessor's own predecessors (recursively).
-
-    The memory planner leaves out an older occupant whose bytes a later one fully covers,
-    counting on the later one's hand-off. But a resource hands over only the cells it
-    touches: the bytes of its untouched subresources still hold the older occupant's last
-    accesses, so the next resource must wait for those itself (random graph seed 32, 10
-    passes, aliased: img2 used on one layer of two left img4's colour writes unordered
-    before img3's first transition)."""
-    touched: dict[str, int] = defaultdict(int)
-    for c in timeline:
-        touched[c[0]] += 1
-
-    def partial(name: str) -> bool:
+            cells_of[c[0]] = [(c, uses)]
+    events: list[list[Event] | None] = [None] * len(passes)
+    initial: dict[str, dict[Cell, State]] = {}
+    final: dict[str, dict[Cell, State]] = {}
+    ends: dict[str, list[tuple[State, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
+    wanted = {pred for preds in sources.values() for pred in preds}
+    # every earlier occupant of a resource's memory ends before its first pass: walked before it
+    for name in sorted(cells_of, key=first_pass.__getitem__):
         res = resources[name]
-        return res.is_image and touched[name] < res.mips * res.layers
-
-    out: dict[str, list[str]] = {}
-    for name, preds in alias_sources.items():
-        found: list[str] = []
-        stack = list(preds)
-        while stack:
-            pred = stack.pop(0)
-            if pred in found:
-                continue
-            if ranges is not None and not _share_bytes(ranges, name, pred):
-                continue
-            found.append(pred)
-            if partial(pred):
-                stack.extend(alias_sources.get(pred, ()))
-        out[name] = found
-    return out
-
-
-def _share_bytes(ranges: Mapping[str, tuple[int, int, int]], a: str, b: str) -> bool:
-    (ha, lo_a, hi_a), (hb, lo_b, hi_b) = ranges[a], ranges[b]
-    return ha == hb and lo_a < hi_b and lo_b < hi_a
-
-
-def _alias_state(preds: Sequence[str], pred_cells: Sequence[_Cell], at: int):
-    """Union of the last accesses of an aliased resource's predecessors (their cells, each
-    last used before pass ``at``)."""
-    stages: set[str] = set()
-    access: set[str] = set()
-    last: tuple[int, str | None] = (-1, None)
-    waits: set[tuple[str, int]] = set()
-    for st in pred_cells:
-        assert st.last_pass is None or st.last_pass < at, "an earlier occupant outlives its successor's start"
-        s = st.state()
-        stages |= s.stages
-        access |= s.access
-        if st.last_pass is not None and st.last_pass > last[0]:
-            last = (st.last_pass, st.queue)
-        if st.last_pass is not None and st.queue is not None:
-            waits.add((st.queue, st.last_pass))
-    return (
-        frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
-        tuple(sorted(waits)),
-    )
+        image = res.is_image
+        layout = "UNDEFINED" if image else None
+        starts: dict[Cell, State] = {}
+        finals: dict[Cell, State] = {}
+        kept: list[tuple[State, int | None]] | None = None
+        if name in wanted:
+            kept = ends[name] = []
+        preds = sources.get(name)
+        single = len(cells_of[name]) == 1
+        if res.lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
+            for c, uses in cells_of[name]:
+                lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
+                                                                 (), (), False, None, c)
+                start = (lay, queue, (PREVIOUS_FRAME, write[1], write[2]) if write else None,
+                         [(PREVIOUS_FRAME, stages) for _, stages in reads], last, visible)
+                starts[c] = _state(start)
+                end = _walk(uses, image, start, (), (), True, events, c, single)
+                finals[c] = st = _state(end)
+                if kept is not None:
+                    kept.append((st, end[4]))
+        else:
+            aliases: tuple[str, ...] = ()
+            waits: tuple[tuple[str, int], ...] = ()
+            queue = write = last = None
+            if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
+                stages, access, queue, last, aliases, waits = alias_state(
+                    preds, [end for pred in preds for end in ends.get(pred, ())], first_pass[name])
+                write = (PREVIOUS_FRAME, stages, access) if stages or access else None
+            for c, uses in cells_of[name]:
+                start = (layout, queue, write, [], last, EMPTY2)
+                starts[c] = _state(start)
+                end = _walk(uses, image, start, aliases, waits, False, events, c, single)
+                finals[c] = st = _state(end)
+                if kept is not None:
+                    kept.append((st, end[4]))
+        initial[name] = starts
+        final[name] = finals
+    return SyncResult(_gather(events), inputs.syncs, final, initial)
 
 
-class _Simulation:
-    def __init__(self, passes, per_pass_cells, timeline, resources) -> None:
-        self.passes = passes
-        self.per_pass_cells = per_pass_cells
-        self.timeline = timeline
-        self.resources = resources
-        self.out = [PassSync() for _ in passes]
-        self.cells: dict[Cell, _Cell] = {}
-        self.image = {name: res.is_image for name, res in resources.items()}
+EMPTY2 = (EMPTY, EMPTY)
 
-    def run_states(self, start: dict[Cell, _Cell]) -> None:
-        """``run`` for the end states of the cells in ``start`` only (others are skipped): the
-        barriers it would derive are not kept."""
-        self.cells = cells_now = start
-        step, get = self._step, cells_now.get
-        for i, p in enumerate(self.passes):
-            queue = p.queue
-            for c, (s, w) in self.per_pass_cells[i].items():
-                cell = get(c)
-                if cell is not None:
-                    step(c, cell, i, queue, s, w)
 
-    def run(self, start: dict[Cell, _Cell], alias_starts: _AliasStarts | None = None) -> None:
-        self.cells = cells_now = start
-        step, out = self._step, self.out
-        starting = alias_starts.at if alias_starts is not None else {}
-        for i, p in enumerate(self.passes):
-            if i in starting:
-                alias_starts.apply(i)
-            # acquires grouped by their release pass too, so that each acquire's rectangles equal
-            # its release's (the layer pairs ownership transfers by exact subresource range)
-            groups: dict[tuple[str, BarrierKey, int | None], list[Cell]] = {}
-            release_groups: dict[tuple[int, str, BarrierKey], list[Cell]] = {}
-            waits: dict[str, tuple[int, set[str]]] = {}
-            queue = p.queue
-            for c, (s, w) in self.per_pass_cells[i].items():
-                key, release_at, wait_on = step(c, cells_now[c], i, queue, s, w)
-                if key is not None:
-                    if wait_on:
-                        wait_stages = set(s.stages)
-                        if key.src.queue == queue:
-                            # A semaphore wait orders only its own stages, and a barrier chains after it
-                            # only through its source stages: they must meet (the swapchain-acquire pattern).
-                            if not key.src.stages:
-                                key = key._replace(src=key.src._replace(stages=frozenset(s.stages)))
-                            wait_stages |= key.src.stages
-                    group = (c[0], key, release_at)
-                    if group in groups:
-                        groups[group].append(c)
+def _state(end: CellEnd) -> State:
+    """What later accesses must wait for: the reads since the write, else the write."""
+    layout, queue, write, reads, _, _ = end
+    if reads:
+        return _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[s for _, s in reads]), EMPTY, layout,
+                            queue))
+    if write:
+        return _new(State, (write[1], write[2], layout, queue))
+    return _new(State, (EMPTY, EMPTY, layout, queue))
+
+
+def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...],
+          alias_waits: tuple[tuple[str, int], ...], last_prev: bool, events: list | None, c: Cell,
+          single: bool = False) -> CellEnd:
+    """Walk one cell through its uses from ``start``; append each pass's ``Event`` to
+    ``events[pass]`` (None: end state only). ``aliases``/``alias_waits``: the earlier occupants
+    of its memory (and (queue, last pass) of each) that its first use hands over and waits for;
+    ``last_prev``: the start state is the previous frame's; ``single``: the cell is its
+    resource's only one (its barriers need no merging into rectangles)."""
+    layout, cq, write, reads, last_pass, visible = start
+    covered_until = -1  # index in ``uses`` of the last read already covered by a barrier
+    for k, (i, s, w, queue, pos) in enumerate(uses):
+        cross = cq is not None and cq != queue
+        if alias_waits:  # aliased memory used on another queue
+            wait_on = [(q, j) for q, j in alias_waits if q != queue]
+        elif cross:
+            wait_on = []
+        else:
+            wait_on = ()
+        transfer = False
+        release_at = None
+        if cross:
+            if last_pass is not None and not last_prev:
+                wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
+            if image:
+                transfer = layout not in (None, "UNDEFINED")
+            else:
+                transfer = not aliases and (write is not None or bool(reads))
+            if transfer:
+                release_at = last_pass
+        src_queue = cq if transfer else queue
+        new_layout = s.layout
+        layout_change = new_layout != layout
+        key = None
+        if w or layout_change:
+            if reads:
+                src = _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]), EMPTY,
+                                   layout, src_queue))
+            elif write:
+                src = _new(State, (write[1], write[2], layout, src_queue))
+            else:
+                src = _new(State, (EMPTY, EMPTY, layout, src_queue))
+            if src[0] or src[1] or layout_change or transfer:
+                if w:
+                    key = _new(BarrierKey, (src, _new(State, (s.stages, s.access, new_layout, queue)), aliases))
+                else:  # a transition for a read group: cover the whole group
+                    dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                    visible = (dst_stages, dst_access)
+                    key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, new_layout, queue)), aliases))
+            if w:
+                write = (i, s.stages, s.writes)
+                reads = []
+                covered_until = k
+                visible = EMPTY2
+            elif layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
+                write = (i, s.stages, EMPTY) if layout != "UNDEFINED" else None
+                reads = [(i, s.stages)]
+            else:
+                reads.append((i, s.stages))
+        else:  # a read in the current layout
+            if transfer or (write and k > covered_until
+                            and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
+                if reads:  # the write is already available: chain through the reads
+                    src = _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]),
+                                       EMPTY, layout, src_queue))
+                elif write:
+                    src = _new(State, (write[1], write[2], layout, src_queue))
+                else:
+                    src = _new(State, (EMPTY, EMPTY, layout, src_queue))
+                dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                visible = (dst_stages, dst_access)
+                if transfer or src[0] or src[1]:
+                    key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, new_layout, queue)), aliases))
+            reads.append((i, s.stages))
+        layout = new_layout
+        cq = queue
+        last_pass = i
+        if aliases or alias_waits or last_prev:
+            aliases = ()
+            alias_waits = ()
+            last_prev = False
+        if events is not None and (key is not None or wait_on):
+            wait_stages = EMPTY
+            if wait_on:
+                wait_stages = s.stages
+                if key is not None and src_queue == queue:
+                    # A semaphore wait orders only its own stages, and a barrier chains after it
+                    # only through its source stages: they must meet (the swapchain-acquire pattern).
+                    if not key[0][0]:
+                        key = key._replace(src=key[0]._replace(stages=s.stages))
+                    wait_stages = wait_stages | key[0][0]
+            if key is None:
+                event = (pos, c, None, None, wait_on, wait_stages, None)
+            else:
+                event = (pos, c, key, release_at, wait_on, wait_stages,
+                         _new(Barrier, (c[0], (c[1], c[1] + 1), (c[2], c[2] + 1), key)) if single else None)
+            found = events[i]
+            if found is None:
+                events[i] = [event]
+            else:
+                found.append(event)
+    return layout, cq, write, reads, last_pass, visible
+
+
+def _gather(events: list[list[Event] | None]) -> list[PassSync]:
+    """Each pass's barriers, the releases it owes later acquires, its waits and signal."""
+    out = [PassSync() for _ in events]
+    for i, found in enumerate(events):
+        if found is None:
+            continue
+        ready: list[Barrier] = []  # one-cell resources' barriers
+        merged: list[tuple[Cell, BarrierKey, int | None]] = []  # cells of resources with several
+        # acquires grouped by their release pass too, so that each acquire's rectangles equal
+        # its release's (the layer pairs ownership transfers by exact subresource range)
+        release_groups: dict[tuple[int, str, BarrierKey], tuple[int, list[Cell]]] | None = None
+        waits: dict[str, tuple[int, frozenset[str]]] | None = None
+        for pos, c, key, release_at, wait_on, wait_stages, barrier in found:
+            if key is not None:
+                if barrier is not None:
+                    ready.append(barrier)
+                else:
+                    merged.append((c, key, release_at))
+                if release_at is not None:
+                    if release_groups is None:
+                        release_groups = {}
+                    group = (release_at, c[0], key)
+                    if group in release_groups:
+                        first, cs = release_groups[group]
+                        cs.append(c)
+                        if pos < first:
+                            release_groups[group] = (pos, cs)
                     else:
-                        groups[group] = [c]
-                    if release_at is not None:
-                        release_groups.setdefault((release_at, c[0], key), []).append(c)
-                elif wait_on:
-                    wait_stages = set(s.stages)
+                        release_groups[group] = (pos, [c])
+            if wait_on:
+                if waits is None:
+                    waits = {}
                 for q, j in wait_on:
                     prev = waits.get(q)
-                    waits[q] = (max(j, prev[0]) if prev else j, (prev[1] if prev else set()) | wait_stages)
-            out[i].barriers = _rectangles(groups) if groups else []
-            if release_groups:
-                for (j, res, key), cs in sorted(release_groups.items(), key=lambda kv: (kv[0][0], kv[0][1])):
-                    out[j].releases.extend(_rectangles({(res, key): cs}))
-            if waits:
-                for q, (j, stages) in sorted(waits.items()):
-                    out[i].waits.append(Wait(q, j, frozenset(stages)))
-                    out[j].signal = True
-
-    def _step(self, c: Cell, cell: _Cell, i: int, queue: str, s: Sync, write: bool):
-        """Update one cell for pass ``i``; return (barrier key, release pass, (queue, wait pass))."""
-        k = cell.cursor
-        cell.cursor += 1
-        if self.image[c[0]]:
-            has_content = cell.layout not in (None, "UNDEFINED")
-        else:
-            has_content = not cell.aliases and (cell.write is not None or bool(cell.reads))
-        cross = cell.queue is not None and cell.queue != queue
-        release_at = None
-        # aliased memory used on another queue
-        wait_on = [(q, j) for q, j in cell.alias_waits if q != queue] if cell.alias_waits else []
-        if cross and cell.last_pass is not None and not cell.last_in_previous_frame:
-            wait_on.append((cell.queue, cell.last_pass))  # earlier frames: the runtime's frame-boundary waits
-        transfer = cross and has_content
-        if transfer and cell.last_pass is not None:
-            release_at = cell.last_pass
-        src_queue = cell.queue if transfer else queue
-        layout_change = s.layout != cell.layout
-        key: BarrierKey | None = None
-        if write or layout_change:
-            if cell.reads:
-                src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
-            elif cell.write:
-                src = State(cell.write[1], cell.write[2], cell.layout, src_queue)
-            else:
-                src = State(EMPTY, EMPTY, cell.layout, src_queue)
-            if src.stages or src.access or layout_change or transfer:
-                dst_stages, dst_access = s.stages, s.access
-                if not write:  # a transition for a read group: cover the whole group
-                    dst_stages, dst_access, cell.covered_until = self._group(self.timeline[c], k, s.layout, queue)
-                    cell.visible = (dst_stages, dst_access)
-                key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
-            if write:
-                cell.write = (i, s.stages, s.writes)
-                cell.reads = []
-                cell.covered_until = k
-                cell.visible = (EMPTY, EMPTY)
-            else:
-                if layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
-                    cell.write = (i, s.stages, EMPTY) if cell.layout != "UNDEFINED" else None
-                if layout_change:
-                    cell.reads = []
-                cell.reads.append((i, s.stages))
-        else:  # a read in the current layout
-            seen = s.stages <= cell.visible[0] and s.access <= cell.visible[1]  # e.g. last frame's barrier
-            if transfer or (cell.write and k > cell.covered_until and not seen):
-                if cell.reads:  # the write is already available: chain through the reads
-                    src = State(cell.read_stages(), EMPTY, cell.layout, src_queue)
-                else:
-                    src = State(cell.write[1] if cell.write else EMPTY, cell.write[2] if cell.write else EMPTY, cell.layout, src_queue)
-                dst_stages, dst_access, cell.covered_until = self._group(self.timeline[c], k, s.layout, queue)
-                cell.visible = (dst_stages, dst_access)
-                key = BarrierKey(src, State(dst_stages, dst_access, s.layout, queue), cell.aliases)
-            cell.reads.append((i, s.stages))
-        if key is not None and not (key.src.stages or key.src.access) and key.src.layout == key.dst.layout and not transfer:
-            key = None
-        if key is None:
-            release_at = None
-        cell.layout = s.layout
-        cell.queue = queue
-        cell.aliases = ()
-        cell.alias_waits = ()
-        cell.last_pass = i
-        cell.last_in_previous_frame = False
-        return key, release_at, wait_on
-
-    @staticmethod
-    def _group_end(uses: list[_Use], k: int, layout: str | None, queue: str) -> int:
-        j = k
-        while j + 1 < len(uses):
-            u = uses[j + 1]
-            if u.write or u.sync.layout != layout or u.queue != queue:
-                break
-            j += 1
-        return j
-
-    def _group(self, uses: list[_Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
-        """Stages and accesses of the read group starting at use ``k``, and its last use."""
-        end = self._group_end(uses, k, layout, queue)
-        if end == k:
-            only = uses[k].sync
-            return only.stages, only.access, end
-        stages: set[str] = set()
-        access: set[str] = set()
-        for u in uses[k : end + 1]:
-            stages |= u.sync.stages
-            access |= u.sync.access
-        return frozenset(stages), frozenset(access), end
-
-    def final_states(self) -> dict[Cell, State]:
-        return {c: cell.state() for c, cell in self.cells.items()}
-
-
-def _rectangles(groups: Mapping[tuple, list[Cell]]) -> list[Barrier]:
-    """Merge cells with one barrier into mip x layer rectangles (deterministic order); a group
-    key is (resource, BarrierKey, ...)."""
-    out = []
-    for (res, key, *_), cs in groups.items():
-        if len(cs) == 1:  # one cell (every buffer): its own rectangle
-            _, mip, layer = cs[0]
-            out.append(Barrier(res, (mip, mip + 1), (layer, layer + 1), key))
-        else:
-            out += [Barrier(res, mips, layers, key)
-                    for mips, layers in mip_layer_rectangles((mip, layer) for _, mip, layer in cs)]
-    if len(out) > 1:
-        out.sort(key=_barrier_sort_key)
+                    waits[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
+        if merged:
+            ready += barriers_of(merged)
+        if ready:
+            if len(ready) > 1:
+                ready.sort(key=BARRIER_ORDER)
+            out[i].barriers = ready
+        if release_groups:
+            # by release pass and resource, then in the order the pass touches the cells
+            for (j, res, key), (_, cs) in sorted(release_groups.items(), key=_release_order):
+                out[j].releases.extend(rectangles(res, key, cs))
+        if waits:
+            for q, (j, stages) in sorted(waits.items()):
+                out[i].waits.append(Wait(q, j, frozenset(stages)))
+                out[j].signal = True
     return out
 
 
-def mip_layer_rectangles(cells: Iterable[tuple[int, int]]) -> list[tuple[tuple[int, int], tuple[int, int]]]:
-    """(mip, layer) cells -> disjoint half-open (mips, layers) rectangles: runs of layers per
-    mip, with consecutive mips of equal runs merged."""
-    by_mip: dict[int, list[int]] = defaultdict(list)
-    for mip, layer in cells:
-        by_mip[mip].append(layer)
-    runs_by_mip = {m: _runs(sorted(ls)) for m, ls in by_mip.items()}
-    mips = sorted(runs_by_mip)
-    out = []
-    start = 0
-    while start < len(mips):
-        end = start
-        while (
-            end + 1 < len(mips)
-            and mips[end + 1] == mips[end] + 1
-            and runs_by_mip[mips[end + 1]] == runs_by_mip[mips[start]]
-        ):
-            end += 1
-        out += [((mips[start], mips[end] + 1), run) for run in runs_by_mip[mips[start]]]
-        start = end + 1
-    return out
+def _release_order(item: tuple) -> tuple[int, str, int]:
+    (j, res, _), (first, _) = item
+    return j, res, first
 
 
-def _barrier_sort_key(b: Barrier):
-    return (b.resource, b.mips or (0, 0), b.layers or (0, 0))
-
-
-def _runs(values: list[int]) -> list[tuple[int, int]]:
-    runs: list[tuple[int, int]] = []
-    for v in values:
-        if runs and runs[-1][1] == v:
-            runs[-1] = (runs[-1][0], v + 1)
-        else:
-            runs.append((v, v + 1))
-    return runs
+def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:
+    """Stages and accesses of the read group starting at use ``k``, and its last use."""
+    end = k
+    last = len(uses) - 1
+    while end < last:
+        _, sync, write, q, _ = uses[end + 1]
+        if write or sync.layout != layout or q != queue:
+            break
+        end += 1
+    if end == k:
+        only = uses[k][1]
+        return only.stages, only.access, end
+    stages: set[str] = set()
+    access: set[str] = set()
+    for u in uses[k : end + 1]:
+        stages |= u[1].stages
+        access |= u[1].access
+    return frozenset(stages), frozenset(access), end

@@ -15,7 +15,7 @@ from functools import cached_property
 
 import networkx as nx
 
-from rgraph.ir.graph import Cell, build_graph, last_writers, reads
+from rgraph.ir.graph import READ_WRITE_USAGES, Cell, build_graph, last_writers
 from rgraph.spec.specialize import PassSpec, Spec
 
 
@@ -66,23 +66,26 @@ def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
     wanted: set[Cell] = set()
     claimed: set[Cell] = set()
     alive: set[str] = set()
+    rw = READ_WRITE_USAGES
     for p in reversed(kept):
         live = p.side_effects
-        for access in p.accesses:
+        accesses = p.accesses
+        for access in accesses:
             if access.write:
                 cs = access.cells
-                if not live and (not wanted.isdisjoint(cs) or (access.resource in keep and not claimed.issuperset(cs))):
+                kept_resource = access.resource in keep
+                if not live and (not wanted.isdisjoint(cs) or (kept_resource and not claimed.issuperset(cs))):
                     live = True
-                if access.resource in keep:
+                if kept_resource:
                     claimed.update(cs)
         if not live:
             continue
         alive.add(p.name)
-        for access in p.accesses:
+        for access in accesses:
             if access.write:
                 wanted.difference_update(access.cells)
-        for access in p.accesses:
-            if reads(access):
+        for access in accesses:
+            if not access.write or access.usage in rw:  # ``reads(access)``
                 wanted.update(access.cells)
     return alive
 
@@ -104,36 +107,52 @@ def _drop_unproduced_reads(
     kept: list[PassSpec] = []
     dropped: list[DroppedRead] = []
     cascade: list[Culled] = []
+    persistent = {n for n, r in spec.resources.items() if r.lifetime in ("persistent", "imported")}
+    get = producer.get
     for p in spec.passes:
         removed = p.name in removed_reason
-        new_accesses = []
+        new_accesses = None  # the accesses kept once one is dropped
         cascade_reason = None
-        for access in p.accesses:
-            persistent = spec.resources[access.resource].lifetime in ("persistent", "imported")
-            needs_input = reads(access) and not access.write and not persistent
-            if not removed and needs_input and not all(producer.get(c) for c in access.cells):
-                culprit = next((lost[c] for c in access.cells if c in lost), None)
-                if access.optional:
-                    why = "optional read with no producer"
-                    if culprit:
-                        why += f" ('{culprit}' was removed: {removed_reason[culprit]})"
-                    dropped.append(DroppedRead(p.name, access.resource, why))
-                    continue
+        for k, access in enumerate(p.accesses):
+            # a plain read (not a read-write) of a transient needs its producer
+            if removed or access.write or access.resource in persistent:
+                if new_accesses is not None:
+                    new_accesses.append(access)
+                continue
+            cells = access.cells
+            if get(cells[0]) if len(cells) == 1 else all(get(c) for c in cells):
+                if new_accesses is not None:
+                    new_accesses.append(access)
+                continue
+            culprit = next((lost[c] for c in cells if c in lost), None) if lost else None
+            if access.optional:
+                why = "optional read with no producer"
                 if culprit:
-                    cascade_reason = f"reads '{access.resource}', whose producer '{culprit}' was removed ({removed_reason[culprit]})"
-            new_accesses.append(access)
+                    why += f" ('{culprit}' was removed: {removed_reason[culprit]})"
+                dropped.append(DroppedRead(p.name, access.resource, why))
+                if new_accesses is None:
+                    new_accesses = list(p.accesses[:k])
+                continue
+            if culprit:
+                cascade_reason = f"reads '{access.resource}', whose producer '{culprit}' was removed ({removed_reason[culprit]})"
+            if new_accesses is not None:
+                new_accesses.append(access)
         if cascade_reason and not removed:
             removed_reason[p.name] = cascade_reason
             cascade.append(Culled(p.name, cascade_reason))
             removed = True
+        name = p.name
         for access in p.accesses:
             if access.write:
-                for c in access.cells:
-                    if removed:
-                        lost[c] = p.name
-                    else:
-                        producer[c] = p.name
-                        lost.pop(c, None)
+                if removed:
+                    for c in access.cells:
+                        lost[c] = name
+                else:
+                    for c in access.cells:
+                        producer[c] = name
+                    if lost:
+                        for c in access.cells:
+                            lost.pop(c, None)
         if not removed:
-            kept.append(replace(p, accesses=tuple(new_accesses)) if len(new_accesses) != len(p.accesses) else p)
+            kept.append(replace(p, accesses=tuple(new_accesses)) if new_accesses is not None else p)
     return kept, dropped, cascade

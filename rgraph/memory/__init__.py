@@ -18,8 +18,9 @@ from rgraph.memory.policy import Policy, parse_policy
 
 __all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "parse_place_args", "place"]
 
-#: Budget of the ``optimal`` policy when the caller leaves the default.
-OPTIMAL_BUDGET_S = 2.0
+#: Budget of the ``optimal`` policy when the caller leaves the default: MiniMalloc's own
+#: solver takes 0.6-5 s on the challenging traces on the 2-core machine (docs/memory.md).
+OPTIMAL_BUDGET_S = 10.0
 #: The compiler's budget per memory class: it runs on every compile, so 1,000 resources
 #: must place in well under 100 ms (a graph's greedy placement is usually at the bound and
 #: the search never starts).
@@ -75,7 +76,7 @@ def place(
             for b, offset in zip(group, tlsf_offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)
         elif chosen.kind in ("aliased", "optimal"):
-            result = place_class(Instance.build(group, conflicts), time_budget_s)
+            result = place_class(Instance.build(group, conflicts), time_budget_s, exact=chosen.kind == "optimal")
             heap_id = new_heap(result.peak, memory_class, max_align)
             for b, offset in zip(group, result.offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)

@@ -2,13 +2,14 @@
 
 1. Greedy best fit under several orderings (size, area, lifetime, start, contention), keep
    the lowest peak: fast and already within a few percent on typical render graphs.
-2. If the peak is above the lower bound, the MiniMalloc-style search
-   (``rgraph.memory.search``) looks for placements under tighter and tighter capacities
-   (bisection between the lower bound and the best peak found), each capacity tried with a
-   few short dives under different block preorderings (``restarts.py``). Any placement it
-   finds replaces the greedy one.
+2. If the peak is above the lower bound, MiniMalloc's solver (``rgraph.memory.search``)
+   decides capacities by bisection between the bound (tried first) and the best peak
+   found, each with MiniMalloc's round robin over its three preorderings; when the
+   bisection closes it starts again with one more (doubled) round. Any placement it finds
+   replaces the greedy one; it stops at the bound or when a capacity just below the peak
+   is proven infeasible.
 
-The time budget is turned into a node count (``NODES_PER_SECOND``) so that results are
+The time budget is turned into an operation count (``OPS_PER_SECOND``) so that results are
 the same on every machine; the real time taken varies with the machine.
 """
 
@@ -22,18 +23,13 @@ import numpy as np
 from rgraph.memory.greedy import best_fit, orderings
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block
-from rgraph.memory.restarts import Preorders
-from rgraph.memory.search import CapacitySearch
+from rgraph.memory.search import PREORDERINGS, preorder, solve_capacity
 
-#: Search nodes granted per second of budget for a 100-block instance (about what a 2-core
-#: laptop visits); a node costs about linearly in the block count, which scales it down.
-NODES_PER_SECOND = 100000
-
-#: Nodes per dive, in blocks: a little backtracking beyond one full dive.
-DIVE_NODES = 2
-
-#: Dives (each under another preordering) before a capacity is given up as too tight.
-DIVES_PER_CAPACITY = 3
+#: Search operations (blocks scanned per node, neighbours and sections per placement:
+#: ``CapacitySearch.ops``) granted per second of budget, about what this 2-core machine
+#: does (2.3-6 M/s measured on the MiniMalloc traces). The budget is counted in operations,
+#: so results are the same on every machine; the real time taken varies with the machine.
+OPS_PER_SECOND = 4_000_000
 
 #: The greedy orderings cost about linearly in the pairs of blocks alive at the same time
 #: (each block is fitted among its neighbours). Past this many (ordered) pairs per second of
@@ -60,9 +56,10 @@ def too_dense(blocks: Sequence[Block], time_budget_s: float) -> bool:
     return overlapping_pairs(blocks) > max(MIN_GREEDY_PAIRS, time_budget_s * PAIRS_PER_SECOND)
 
 
-#: Budget, in dives, from which the bound itself is tried first (about half of it then
-#: remains for the bisection).
-LB_FIRST_DIVES = 6
+#: Bisection closes when the best peak is within this fraction of the highest capacity
+#: given up on; it then starts again from the highest one proven infeasible with one more
+#: round-robin round per capacity (MiniMalloc's doubling node limit).
+CLOSE = 1 / 1000
 
 
 @dataclass
@@ -71,9 +68,14 @@ class ClassResult:
     peak: int
     lower_bound: int
     how: str  # which method produced the offsets
+    proven: bool = False  # no placement under ``peak`` exists (the bound, or proven by search)
 
 
-def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
+def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> ClassResult:
+    """Greedy, then (above the bound) the search within ``time_budget_s``. ``exact``
+    (the ``optimal`` policy): after a first share of bisection, most of the budget goes to
+    MiniMalloc's own run at the bound (round robin with no round limit), the rest back to
+    the bisection."""
     lb = inst.lower_bound()
     best: ClassResult | None = None
     for name, order in orderings(inst):
@@ -86,66 +88,82 @@ def place_class(inst: Instance, time_budget_s: float) -> ClassResult:
         if best.peak <= lb:
             break  # proven optimal: no later ordering can be strictly better
     assert best is not None
-    if best.peak <= lb or inst.n == 0 or not inst.separable:
+    if best.peak <= lb:
+        best.proven = True
+        return best
+    if inst.n == 0 or not inst.separable:
         # Conflicts beyond time overlaps (cross-queue pairs) leave the time bound out of
         # reach: the search could only burn its budget proving nothing, so greedy it is.
         return best
-    budget = node_budget_for(inst, time_budget_s)
-    if budget < inst.n:
-        return best  # too little to finish even one dive of the search
-    preorders = Preorders(inst)
-    # The bound first when the budget affords it: tight capacities prune hardest and, once
-    # a block splits the rest in time, the search solves the parts one by one, so the bound
-    # is often reached in a few dives (MiniMalloc C and F in under 6,000 nodes).
-    proven = False
-    if budget >= LB_FIRST_DIVES * DIVE_NODES * inst.n:
-        found, spent, proven = search_capacity(inst, preorders, lb, budget, DIVES_PER_CAPACITY)
-        budget -= spent
+    budget = int(time_budget_s * OPS_PER_SECOND)
+    if budget < inst.n * inst.n // 2 + inst.pair_count:
+        return best  # not even one dive (each node scans the blocks left) would finish
+    search = _Bisection(inst, best)
+    if exact:
+        first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))
+        left = search.run(first) + budget - first
+        at_bound = int(budget * EXACT_BOUND_SHARE)
+        left = search.attempt(lb, None, min(at_bound, left)) + max(left - at_bound, 0)
+        search.run(left)
+    else:
+        search.run(budget)
+    return search.best
+
+
+#: Where the bisection tries next, as a fraction of the way from the best peak down to the
+#: highest capacity given up on: short steps succeed far more often than halving.
+STEP = 0.25
+
+#: The first round's node limit per heuristic, in blocks (MiniMalloc: 2).
+FIRST_LIMIT = 2.0
+
+#: ``optimal``: one part in this many of the budget, at most ``EXACT_BISECTION_S``, goes
+#: to the bisection first (a good placement early), then up to ``EXACT_BOUND_SHARE`` of it
+#: to MiniMalloc's run at the bound, the rest back to the bisection (where the bound is
+#: out of reach, as on MiniMalloc D and J).
+EXACT_BISECTION_SHARE = 5
+EXACT_BISECTION_S = 0.5
+EXACT_BOUND_SHARE = 0.85
+
+
+class _Bisection:
+    """Capacities by bisection between the highest one given up on (``low``) and the best
+    peak, each tried with MiniMalloc's round robin for ``rounds`` rounds; once the
+    bisection closes, ``rounds`` grows by one and it starts again from the highest capacity
+    proven infeasible, the bound first. A placement found lowers the peak to its height
+    (often well below the capacity tried)."""
+
+    def __init__(self, inst: Instance, best: ClassResult):
+        self.inst, self.best, self.lb = inst, best, best.lower_bound
+        self.orders = [preorder(inst, h) for h in PREORDERINGS]
+        self.low = self.infeasible = self.lb - 1  # infeasible: the highest proven too small
+        self.rounds = 1
+
+    def attempt(self, capacity: int, rounds: int | None, budget: int) -> int:
+        """Try one capacity; returns the budget left."""
+        if self.best.proven or budget <= 0:
+            return budget
+        found, spent, proven = solve_capacity(self.inst, capacity, budget, rounds, self.orders, first_limit=FIRST_LIMIT)
         if found is not None:
-            return ClassResult(found, inst.peak(found), lb, f"search:{lb}")
-    # Bisection between the highest capacity given up on and the best peak found; once it
-    # closes, start again from the lower bound with twice the dives per capacity.
-    low, dives, infeasible = lb, DIVES_PER_CAPACITY, lb if proven else lb - 1  # infeasible: proven too small
-    while budget >= inst.n:
-        if best.peak - low <= max(best.peak // 1000, 1):
-            if best.peak - infeasible <= max(best.peak // 1000, 1):
-                break
-            low, dives = max(lb, infeasible), 2 * dives
-        capacity = (low + best.peak) // 2
-        found, spent, proven = search_capacity(inst, preorders, capacity, budget, dives)
-        budget -= spent
-        if found is None:
-            low = capacity
+            peak = self.inst.peak(found)
+            if peak < self.best.peak:
+                self.best = ClassResult(found, peak, self.lb, f"search:{capacity}")
+        elif proven or spent < budget:  # cut short by the budget: not given up, tried again later
+            self.low = max(self.low, capacity)
             if proven:
-                infeasible = max(infeasible, capacity)
-            continue
-        peak = inst.peak(found)
-        if peak < best.peak:
-            best = ClassResult(found, peak, lb, f"search:{capacity}")
-    return best
+                self.infeasible = max(self.infeasible, capacity)
+        if self.best.peak - 1 <= self.infeasible:
+            self.best.proven = True
+        return budget - spent
 
-
-def node_budget_for(inst: Instance, time_budget_s: float) -> int:
-    work_per_node = max(1.0, inst.n / 100)
-    return int(time_budget_s * NODES_PER_SECOND / work_per_node)
-
-
-def search_capacity(
-    inst: Instance, preorders: Preorders, capacity: int, node_budget: int, dives: int
-) -> tuple[list[int] | None, int, bool]:
-    """Up to ``dives`` dives of ``DIVE_NODES * n`` nodes, each under the next
-    preordering, until a placement within ``capacity`` is found or one dive proves that
-    none exists. Returns the offsets (or None), the nodes spent and whether it is proven."""
-    limit = int(DIVE_NODES * max(inst.n, 1))
-    spent = 0
-    for _ in range(dives):
-        if node_budget - spent <= 0:
-            break
-        run = CapacitySearch(inst, preorders.next(), capacity, min(limit, node_budget - spent))
-        found = run.run()
-        spent += max(run.work, 1)
-        if found is not None:
-            return found, spent, False
-        if not run.exhausted:
-            return None, spent, True
-    return None, spent, False
+    def run(self, budget: int) -> int:
+        """Bisect until proven or ``budget`` operations are spent; returns what is left."""
+        while budget > 0 and not self.best.proven:
+            peak = self.best.peak
+            if peak - self.low <= max(int(peak * CLOSE), 1):
+                self.low, self.rounds = self.infeasible, self.rounds + 1
+                capacity = self.infeasible + 1
+            else:
+                capacity = peak - max(int((peak - self.low - 1) * STEP), 1)
+            budget = self.attempt(capacity, self.rounds, budget)
+        return max(budget, 0)

@@ -104,6 +104,19 @@ class Instance:
         )
 
     @cached_property
+    def neg_width(self) -> list[int]:
+        """Minus each block's lifetime in passes (preorder sort keys, descending)."""
+        return [s - e - 1 for s, e in zip(self.start, self.end, strict=True)]
+
+    @cached_property
+    def neg_area(self) -> list[int]:
+        return [w * z for w, z in zip(self.neg_width, self.size, strict=True)]
+
+    @cached_property
+    def neg_size(self) -> list[int]:
+        return [-z for z in self.size]
+
+    @cached_property
     def members(self) -> np.ndarray:
         """``members[s, i]``: block ``i`` lives in section ``s``."""
         matrix = np.zeros((self.section_count, self.n), dtype=bool)

@@ -1,4 +1,4 @@
-"""Capacity search, perturbed preorderings and the search phase of ``aliased``."""
+"""Capacity search, MiniMalloc's round robin and the search phase of ``aliased``."""
 
 from __future__ import annotations
 
@@ -10,8 +10,7 @@ from hypothesis import strategies as st
 from rgraph.memory import Block, place
 from rgraph.memory.aliased import place_class
 from rgraph.memory.instance import Instance
-from rgraph.memory.restarts import Preorders, perturbed
-from rgraph.memory.search import CapacitySearch, preorder
+from rgraph.memory.search import PREORDERINGS, CapacitySearch, preorder, solve_capacity
 from rgraph.memory.verify import overlaps
 
 # Every pass has exactly 4 units live; the blocks must interlock to reach it.
@@ -73,33 +72,43 @@ def test_search_placements_fit_their_capacity(seed, count, slack):
         assert_valid(inst, found, capacity)
 
 
-def test_preorders_start_static_then_perturb_deterministically():
+def test_preorders_are_permutations_sorted_by_their_keys():
     inst = Instance.build(hard_trace(50, 1))
-    first, second = Preorders(inst), Preorders(inst)
-    orders = [first.next() for _ in range(8)]
-    assert orders == [second.next() for _ in range(8)]
-    assert orders[:3] == [preorder(inst, h) for h in ("WAT", "TAW", "TWA")]
-    assert all(sorted(o) == list(range(inst.n)) for o in orders)
-    assert orders[3] != orders[0]
+    for h in PREORDERINGS:
+        order = preorder(inst, h)
+        assert sorted(order) == list(range(inst.n))
+    widths = [inst.end[i] - inst.start[i] for i in preorder(inst, "WAT")]
+    assert widths == sorted(widths, reverse=True)
+    subset = [3, 1, 2]
+    assert sorted(preorder(inst, "TWA", subset)) == sorted(subset)
 
 
-def test_perturbation_moves_blocks_a_bounded_distance():
-    order = list(range(100))
-    shuffled = perturbed(order, random.Random(7), 0.1)
-    assert sorted(shuffled) == order and shuffled != order
-    assert all(abs(rank - block) <= 10 for rank, block in enumerate(shuffled))
+def test_round_robin_proves_below_the_bound_and_finds_above_it():
+    inst = Instance.build(hard_trace(40, 2))
+    lb = inst.lower_bound()
+    found, spent, proven = solve_capacity(inst, lb - 1, 10**9)
+    assert found is None and proven and spent >= 1
+    found, _, proven = solve_capacity(inst, 2 * lb, 10**9)
+    assert found is not None and not proven
+    assert_valid(inst, found, 2 * lb)
+
+
+def test_round_robin_stops_at_its_budget():
+    inst = Instance.build(hard_trace(120, 5))
+    found, spent, proven = solve_capacity(inst, inst.lower_bound(), 500)
+    assert found is None and not proven and spent <= 500 + 2 * inst.n
 
 
 def test_search_phase_improves_on_greedy_and_stays_valid_and_deterministic():
     blocks = hard_trace(120, 5)
     inst = Instance.build(blocks)
-    with_search = place_class(inst, 0.2)
+    with_search = place_class(inst, 0.5)
     greedy_only = place_class(inst, 0.0)
     assert with_search.how.startswith("search:"), with_search.how
     assert with_search.peak < greedy_only.peak
     assert_valid(inst, with_search.offsets, with_search.peak)
-    again = place_class(Instance.build(list(blocks)), 0.2)
+    again = place_class(Instance.build(list(blocks)), 0.5)
     assert again.offsets == with_search.offsets
-    placement = place(blocks, "aliased", time_budget_s=0.2)
+    placement = place(blocks, "aliased", time_budget_s=0.5)
     assert overlaps(blocks, placement) == []
     assert placement.stats.peak_bytes == with_search.peak

@@ -183,7 +183,13 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
 
 def classified_pixels(ids: np.ndarray, path: Path, size: tuple[int, int], camera: int) -> int:
     """Pixels whose visible surface reflects or refracts (the ones classify.comp would list)."""
-    from rgraph.passes.raytrace_hybrid import decode_visibility, instance_materials, needs_secondary_rays, prim_bits
+    from rgraph.passes.raytrace_hybrid import (
+        decode_visibility,
+        instance_materials,
+        needs_secondary_rays,
+        prim_bits,
+    )
+
     from rgraph.scene.build import load_scene_data
 
     data = load_scene_data(path, size, camera)

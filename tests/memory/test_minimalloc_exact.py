@@ -44,15 +44,20 @@ def brute_force_optimum(inst: Instance) -> int:
 
 
 @st.composite
-def tiny_instances(draw):
-    """Up to 6 blocks over 6 passes, sizes 0..4, alignments 1 or 2: brute force is cheap."""
-    count = draw(st.integers(1, 6))
+def block_lists(draw, count: int, last_start: int, longest: int, sizes: int, alignments: list[int], classes: str):
+    """1..count blocks starting at 0..last_start, lasting 0..longest passes, 0..sizes bytes."""
     blocks = []
-    for i in range(count):
-        start = draw(st.integers(0, 5))
-        end = start + draw(st.integers(0, 3))
-        blocks.append(Block(f"b{i}", start, end, draw(st.integers(0, 4)), draw(st.sampled_from([1, 1, 2])), "c"))
+    for i in range(draw(st.integers(1, count))):
+        start = draw(st.integers(0, last_start))
+        end = start + draw(st.integers(0, longest))
+        blocks.append(Block(f"b{i}", start, end, draw(st.integers(0, sizes)), draw(st.sampled_from(alignments)),
+                            draw(st.sampled_from(classes))))
     return blocks
+
+
+def tiny_instances():
+    """Up to 6 blocks over 6 passes, sizes 0..4, alignments 1 or 2: brute force is cheap."""
+    return block_lists(6, 5, 3, 4, [1, 1, 2], "c")
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -85,17 +90,9 @@ def test_round_robin_and_optimal_policy_reach_the_brute_force_optimum(blocks):
     assert overlaps(blocks, placement) == []
 
 
-@st.composite
-def traces(draw):
+def traces():
     """Up to 40 blocks with gaps in time (so decomposition splits), mixed alignments."""
-    count = draw(st.integers(1, 40))
-    blocks = []
-    for i in range(count):
-        start = draw(st.integers(0, 40))
-        end = start + draw(st.integers(0, 12))
-        size = draw(st.integers(0, 5000))
-        blocks.append(Block(f"b{i}", start, end, size, draw(st.sampled_from([1, 16, 256])), draw(st.sampled_from("xy"))))
-    return blocks
+    return block_lists(40, 40, 12, 5000, [1, 16, 256], "xy")
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -134,7 +134,10 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
     (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns).
     ``dump``: a folder for ``SCENE_CAMERA.npz`` (both colour images as float16, the visibility ids)."""
+    from rgraph.passes.raytrace_hybrid import prim_bits
+
     from rgraph.compiler.pipeline import compile_graph
+    from rgraph.scene.build import load_scene_data
 
     path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
     params = {"rt.max_depth": str(depth)}
@@ -152,14 +155,15 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     alone, hybrid = runs["alone"], runs["hybrid"]
     T = alone["timings"]["total_ms"]
     out = hybrid["outputs"]
+    data = load_scene_data(path, size, camera)  # the row's scene: classified pixels, primitive bits
     traced = int(np.frombuffer(out["ray_args"].tobytes()[:16], dtype=np.uint32)[3]) if "ray_args" in out else 0
     if not traced:  # in-thread (rt.wavefront 0): no pixel list; the pixels whose surface needs secondary rays
-        traced = classified_pixels(out["visibility"][..., 0], path, size, camera)
+        traced = classified_pixels(out["visibility"][..., 0], data)
     row = {"scene": scene, "camera": camera, "size": list(size), "frames": frames, "max_depth": depth,
            "hybrid_params": hybrid_params or {},
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
-           "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits_of(path, size, camera))}
+           "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits(data))}
     if dump is not None:
         dump.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(dump / f"{scene}_{camera}.npz", alone=alone["outputs"]["color"].astype(np.float16),
@@ -181,8 +185,9 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     return row
 
 
-def classified_pixels(ids: np.ndarray, path: Path, size: tuple[int, int], camera: int) -> int:
-    """Pixels whose visible surface reflects or refracts (the ones classify.comp would list)."""
+def classified_pixels(ids: np.ndarray, data: Any) -> int:
+    """Pixels whose visible surface reflects or refracts (the ones classify.comp would list);
+    ``data``: the row's ``SceneData``."""
     from rgraph.passes.raytrace_hybrid import (
         decode_visibility,
         instance_materials,
@@ -190,20 +195,9 @@ def classified_pixels(ids: np.ndarray, path: Path, size: tuple[int, int], camera
         prim_bits,
     )
 
-    from rgraph.scene.build import load_scene_data
-
-    data = load_scene_data(path, size, camera)
     inst, _prim = decode_visibility(ids, prim_bits(data))
     mask = needs_secondary_rays(data.materials)[instance_materials(data)]
     return int(mask[inst[inst >= 0]].sum())
-
-
-def prim_bits_of(path: Path, size: tuple[int, int], camera: int) -> int:
-    from rgraph.passes.raytrace_hybrid import prim_bits
-
-    from rgraph.scene.build import load_scene_data
-
-    return prim_bits(load_scene_data(path, size, camera))
 
 
 def boundary_share(ids: np.ndarray, bits: int) -> float:

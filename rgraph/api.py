@@ -238,8 +238,10 @@ class Executable:
         return decode_outputs(self.plan, self.read_back())
 
     def run_and_check(self, frames: int, *, check_data: bool, out_png: Path | None = None,
-                      read_outputs: bool = False, warmup_s: float | None = None) -> Any:
-        """Warm up (``warmup_s`` seconds; None: ``default_warmup_s`` of the device), run, read
+                      read_outputs: bool = False, warmup_s: float | None = None,
+                      warmup_frames: int | None = None) -> Any:
+        """Warm up (``warmup_s`` seconds, None: ``default_warmup_s`` of the device; or exactly
+        ``warmup_frames`` frames: ``warm_up``), run, read
         back when needed, check the probe's data (``rgraph.probe.check``), write the PNG and
         close this executable (the device stays open): an ``rgraph.vk.executor.RunResult``
         with the messages logged from load to close."""
@@ -252,7 +254,7 @@ class Executable:
         try:
             if out_png is not None and first_output_image(self.plan) is None:
                 raise ExecutionError("--out: the plan has no output image")
-            self.warm_up(self.gpu.default_warmup_s if warmup_s is None else warmup_s)
+            self.warm_up(self.gpu.default_warmup_s if warmup_s is None else warmup_s, frames=warmup_frames)
             summary = self.run(frames)
             result = RunResult([], summary.timings, None, self.gpu.name)
             if check_data or read_outputs or out_png is not None:

@@ -107,7 +107,7 @@ class PlanCache:
             self.hits += 1
             return entry.plan
         self.misses += 1
-        front = self._frontend(graph, scene_path, params, size)
+        front = self._frontend(key[:2], graph, scene_path, params, size)
         shape = structure(front.spec) if camera == 0 else None
         shape_key = None if shape is None else (shape, key[4:])  # policy, profile, provider, outputs, modes
         known = None if shape_key is None else self._by_structure.get(shape_key)
@@ -127,12 +127,11 @@ class PlanCache:
             self._entries.popitem(last=False)
         return plan
 
-    def _frontend(self, graph: str | Path, scene_path: str | Path | None, params: Mapping[str, str] | None,
-                  size: tuple[int, int]) -> Frontend:
+    def _frontend(self, key: tuple[str, str | None], graph: str | Path, scene_path: str | Path | None,
+                  params: Mapping[str, str] | None, size: tuple[int, int]) -> Frontend:
         """``frontend``, with the loaded graph and scene kept while their files are unchanged:
-        a changed param or size only specializes again."""
-        key = (str(Path(resolve_graph(str(graph))).resolve()),
-               None if scene_path is None else str(Path(scene_path).resolve()))
+        a changed param or size only specializes again. ``key``: the resolved graph and scene
+        paths (``plan``'s key starts with them)."""
         loaded = self._loaded.get(key)
         if loaded is None or not self._unchanged(loaded[0]):
             front = frontend(graph, scene_path, params, size)
@@ -173,7 +172,7 @@ def with_values(plan: Plan, spec: Spec) -> Plan:
     from rgraph.compiler.emit import _frozen
 
     by_name = {p.name: p for p in spec.passes}
-    passes = tuple(p if _frozen(by_name[p.name].params) == p.params else replace(p, params=_frozen(by_name[p.name].params))
+    passes = tuple(p if (values := _frozen(by_name[p.name].params)) == p.params else replace(p, params=values)
                    for p in plan.passes)
     return replace(plan, params=_frozen(spec.params), features=_frozen(spec.features),
                    passes=passes)

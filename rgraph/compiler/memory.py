@@ -58,17 +58,13 @@ _SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw"
 
 
 def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
-    out: dict[str, set[str]] = {}
-    for p in passes:
-        for a in p.accesses:
-            out.setdefault(a.resource, set()).add(a.usage)
-            if a.usage == "indirect" and p.kind == "raytrace":  # vkCmdTraceRaysIndirectKHR: a device address
-                out[a.resource].add("trace_indirect")
-    return out
+    """Per resource: the usages ``passes`` make of it (``usages_and_lifetimes``' first half)."""
+    return usages_and_lifetimes(passes)[0]
 
 
 def usages_and_lifetimes(passes: Sequence[PassSpec]) -> tuple[dict[str, set[str]], dict[str, tuple[int, int]]]:
-    """``usages_by_resource`` and ``lifetimes`` of ``passes`` in one walk."""
+    """Per resource: the usages of ``passes`` (raytrace indirect arguments also ``trace_indirect``)
+    and the first and last executed pass index."""
     used: dict[str, set[str]] = {}
     spans: dict[str, tuple[int, int]] = {}
     for i, p in enumerate(passes):
@@ -86,16 +82,6 @@ def usages_and_lifetimes(passes: Sequence[PassSpec]) -> tuple[dict[str, set[str]
             if raytrace and a.usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 used[name].add("trace_indirect")
     return used, spans
-
-
-def lifetimes(passes: Sequence[PassSpec]) -> dict[str, tuple[int, int]]:
-    """First and last executed pass index of each resource."""
-    out: dict[str, tuple[int, int]] = {}
-    for i, p in enumerate(passes):
-        for a in p.accesses:
-            first, _ = out.get(a.resource, (i, i))
-            out[a.resource] = (first, i)
-    return out
 
 
 def requirements(

@@ -22,22 +22,6 @@ from collections.abc import Collection, Sequence
 from rgraph.spec.specialize import PassSpec
 
 
-def direct_waits(passes: Sequence[PassSpec]) -> list[dict[str, int]]:
-    """Per pass: queue -> latest pass index it waits for in the dedicated plan."""
-    last: dict[tuple, tuple[str, int]] = {}
-    out: list[dict[str, int]] = []
-    for i, p in enumerate(passes):
-        waits: dict[str, int] = {}
-        for a in p.accesses:
-            for c in a.cells:
-                prev = last.get(c)
-                if prev is not None and prev[0] != p.queue and prev[1] != i:
-                    waits[prev[0]] = max(waits.get(prev[0], -1), prev[1])
-                last[c] = (p.queue, i)
-        out.append(waits)
-    return out
-
-
 def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str]) -> dict[str, set[str]]:
     """Pairs of ``candidates`` (symmetric) that may not share memory although one ends before
     the other starts: sharing would add a cross-queue wait. Empty for one-queue graphs."""

@@ -14,10 +14,9 @@ continues into the next frame.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
 
 from rgraph.compiler.usages import Sync
-from rgraph.spec.specialize import PassSpec, ResourceSpec
+from rgraph.spec.specialize import ResourceSpec
 
 # Not transfer_src: copies from GENERAL draw a validation performance warning (the layer
 # wants TRANSFER_SRC_OPTIMAL), so a copy keeps its own layout and transition.
@@ -25,7 +24,8 @@ GENERAL_READS = frozenset({"sampled", "storage_read"})
 
 
 class ReadGroups:
-    """The accesses ``unify_read_layouts`` looks at, noted one by one in executed order."""
+    """The accesses whose read layouts may be unified (mixed-layout read groups move to GENERAL),
+    noted one by one in executed order (``rgraph.compiler.sync_inputs``)."""
 
     def __init__(self, resources: Mapping[str, ResourceSpec]) -> None:
         self.resources = resources
@@ -69,24 +69,3 @@ class ReadGroups:
                     out += group
                 group = []
         return out
-
-
-def unify_read_layouts(
-    passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec], syncs: list[list[Sync]]
-) -> list[list[Sync]]:
-    """``syncs`` (per pass, per access) with mixed-layout read groups moved to GENERAL (a new
-    outer list; the inner lists of passes with a change are new too)."""
-    groups = ReadGroups(resources)
-    if groups.candidates:
-        for i, p in enumerate(passes):
-            for j, a in enumerate(p.accesses):
-                if a.resource in groups.candidates:
-                    groups.note(i, j, a)
-    out = list(syncs)
-    copied: set[int] = set()
-    for i, j in groups.to_general(syncs):
-        if i not in copied:
-            out[i] = list(out[i])
-            copied.add(i)
-        out[i][j] = replace(out[i][j], layout="GENERAL")
-    return out

@@ -22,14 +22,13 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from rgraph.compiler.alias_starts import PREVIOUS_FRAME, alias_state, with_partial_handoffs
-from rgraph.compiler.rectangles import BARRIER_ORDER, barriers_of, mip_layer_rectangles, rectangles
-from rgraph.compiler.sync_inputs import Use, access_syncs, sync_inputs
+from rgraph.compiler.rectangles import BARRIER_ORDER, barriers_of, rectangles
+from rgraph.compiler.sync_inputs import Use, sync_inputs
 from rgraph.compiler.sync_types import EMPTY, Barrier, BarrierKey, PassSync, State, SyncResult, Wait
 from rgraph.ir.graph import Cell
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
-__all__ = ["EMPTY", "Barrier", "BarrierKey", "PassSync", "State", "SyncResult", "Wait", "access_syncs",
-           "mip_layer_rectangles", "synchronize"]
+__all__ = ["EMPTY", "Barrier", "BarrierKey", "PassSync", "State", "SyncResult", "Wait", "synchronize"]
 
 PERSISTENT = ("persistent", "imported")
 _new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: twice the cost per value

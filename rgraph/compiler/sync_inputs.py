@@ -43,14 +43,8 @@ def format_flags(resources: Mapping[str, ResourceSpec]) -> dict[str, tuple[bool,
     out = {}
     for name, res in resources.items():
         fmt = res.format
-        out[name] = (res.kind == "image", bool(fmt and fmt.has_depth), bool(fmt and fmt.has_stencil))
+        out[name] = (res.is_image, bool(fmt and fmt.has_depth), bool(fmt and fmt.has_stencil))
     return out
-
-
-def access_syncs(p: PassSpec, flags: Mapping[str, tuple[bool, bool, bool]]) -> list[Sync]:
-    """The ``Sync`` of each of ``p``'s accesses (``flags``: ``format_flags``)."""
-    kind = p.kind
-    return [_sync(a.usage, kind, a.stages, *flags[a.resource], a.refit) for a in p.accesses]
 
 
 def sync_inputs(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> SyncInputs:

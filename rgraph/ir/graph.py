@@ -18,11 +18,6 @@ READ_WRITE_USAGES = frozenset({"color_attachment_blend", "depth_attachment", "st
 Cell = tuple[str, int, int]
 
 
-def cells(access: AccessSpec) -> tuple[Cell, ...]:
-    """The (resource, mip, layer) cells an access touches (``AccessSpec.cells``)."""
-    return access.cells
-
-
 def reads(access: AccessSpec) -> bool:
     return not access.write or access.usage in READ_WRITE_USAGES
 

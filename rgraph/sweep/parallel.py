@@ -163,7 +163,6 @@ class _Worker:
     process: Any
     conn: Any
     done: int = 0
-    busy: bool = False
 
 
 class ProcessBackend:
@@ -197,7 +196,7 @@ class ProcessBackend:
             process = self._ctx.Process(target=_child_main, args=(send, fn, arg), daemon=True)
             process.start()
             send.close()
-            return _Worker(process, recv, busy=True)
+            return _Worker(process, recv)
         worker = None
         while self._idle and worker is None:
             worker = self._idle.pop()
@@ -211,7 +210,6 @@ class ProcessBackend:
             process.start()
             theirs.close()
             worker = _Worker(process, mine)
-        worker.busy = True
         worker.conn.send((fn, arg))
         return worker
 
@@ -229,7 +227,7 @@ class ProcessBackend:
                     status, value = w.conn.recv()
             except (EOFError, OSError):
                 pass
-            w.busy, w.done = False, w.done + 1
+            w.done += 1
             if status != "lost" and self.tasks_per_worker > 1 and w.done < self.tasks_per_worker:
                 self._idle.append(w)  # it takes the next task
             else:

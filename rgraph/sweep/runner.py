@@ -221,12 +221,8 @@ def _render(request: SweepRequest, plan: dict, gpu: Any, timing: Any = None) -> 
     executable = gpu.load(plan)
     warm = warmup_frames(request, gpu)
     with timing or contextlib.nullcontext():
-        try:
-            executable.warm_up(0.0, frames=warm)
-        except BaseException:
-            executable.close()
-            raise
-        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True, warmup_s=0.0)
+        result = executable.run_and_check(request.frames, check_data=False, read_outputs=True, warmup_s=0.0,
+                                          warmup_frames=warm)
     arrays = image_io.output_arrays(result)
     outputs = image_io.output_image_resources(plan)
     ldr = hdr = None

@@ -99,7 +99,8 @@ class Executor:
         # host buffers reused by later read-backs and receives ((purpose, resource) -> buffer;
         # also in host_buffers for teardown): the staged multi-device path moves tiles every frame
         self.staging: dict[tuple[str, str], HostBuffer] = {}
-        self.barrier_batches_of: dict[int, list[BarrierBatch]] = {}  # per set: the structs its command buffers point into
+        # per set, per pass: (barrier batches before, after), the structs its command buffers point into
+        self.barrier_batches_of: dict[int, dict[int, tuple[list[BarrierBatch], list[BarrierBatch]]]] = {}
         self.frames_done = 0
         # frames_done at the first frame whose content is frame 0 (``Executable.warm_up`` moves it
         # past warm-up frames of a plan that carries no state between frames)

@@ -47,7 +47,12 @@ def record_set(ex: Any, s: int, buffers: list[Any] | None) -> list[Any]:
     recording = ex.recording
     plan_passes = ex.plan["passes"]
     deform_batch = scene_batch(ex)
-    keep: list[Any] = []  # the barrier structs the recorded calls point into
+    # per pass: (barrier batches before, after), built once per set; re-recording reuses them
+    structs = ex.barrier_batches_of.get(s)
+    if structs is None:
+        structs = ex.barrier_batches_of[s] = {
+            i: (barrier_batches(ex.resources, s, lowered.before), barrier_batches(ex.resources, s, lowered.after))
+            for i, lowered in enumerate(recording.passes)}
     per_batch = []
     for bi, batch in enumerate(recording.batches):
         if buffers is None:
@@ -75,18 +80,16 @@ def record_set(ex: Any, s: int, buffers: list[Any] | None) -> list[Any]:
                 v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, ex.query_pools[s], 2 * i)
             if bi == deform_batch and i == batch.passes[0]:  # counted in this pass's GPU time
                 ex.scene_gpu.record_frame(cb, s)
-            for barriers in barrier_batches(ex.resources, s, lowered.before):
-                keep.append(barriers)
+            before, after = structs[i]
+            for barriers in before:
                 v.vkCmdPipelineBarrier2(cb, barriers.dependency)
             ex.passes[i].record(ctx, s)
-            for releases in barrier_batches(ex.resources, s, lowered.after):
-                keep.append(releases)
+            for releases in after:
                 v.vkCmdPipelineBarrier2(cb, releases.dependency)
             if timestamps:
                 v.vkCmdWriteTimestamp2(cb, v.VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, ex.query_pools[s], 2 * i + 1)
             label_begin(dev, cb, None)
         v.vkEndCommandBuffer(cb)
-    ex.barrier_batches_of[s] = keep
     return per_batch
 
 

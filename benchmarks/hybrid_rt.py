@@ -133,7 +133,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
     (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns).
-    ``dump``: a folder for ``SCENE_CAMERA.npz`` (both colour images as float16, the visibility ids)."""
+    ``dump``: a folder for ``SCENE_CAMERA.npz`` (the colour images as float16, the visibility ids)."""
     from rgraph.passes.raytrace_hybrid import prim_bits
 
     from rgraph.compiler.pipeline import compile_graph
@@ -166,8 +166,9 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits(data))}
     if dump is not None:
         dump.mkdir(parents=True, exist_ok=True)
+        more = {"async": runs["async"]["outputs"]["color"].astype(np.float16)} if async_shade else {}
         np.savez_compressed(dump / f"{scene}_{camera}.npz", alone=alone["outputs"]["color"].astype(np.float16),
-                            hybrid=out["color"].astype(np.float16), visibility=out["visibility"][..., 0])
+                            hybrid=out["color"].astype(np.float16), visibility=out["visibility"][..., 0], **more)
     lists = [np.frombuffer(out[name].tobytes()[:16], dtype=np.uint32) for name in levels if name in out]
     row.update(level_rays=[traced] + [int(a[0]) for a in lists], level_overflow=any(bool(a[3]) for a in lists))
     if "vis_jobs" in out:  # the compute visibility buffer's tile jobs (overflow: the slow in-thread fallback ran)

@@ -60,12 +60,9 @@ void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m) {
     }
 }
 
-// One node of the ray tree: ray r's closest hit; adds its own radiance (the sky where it misses,
-// else the weighted opaque part) to `color` and pushes its children on the stack. The hybrid's
-// wavefront passes (hybrid_wave.rgen) run it once per listed ray.
-void visit(Ray r, inout vec3 color) {
-    Hit h = trace_closest(r.o, r.d);
-    if (h.t < 0.0) { color += r.w * sample_sky(r.d); return; }
+// Ray r's hit h (found by tracing or, for the hybrid's camera rays, from the visibility
+// buffer): its weighted opaque radiance added to `color`, its children pushed on the stack.
+void shade_hit(Ray r, Hit h, inout vec3 color) {
     vec3 p = r.o + h.t * r.d;
     vec3 ng, ns; uint m;
     surface(h, r.d, ng, ns, m);
@@ -75,6 +72,15 @@ void visit(Ray r, inout vec3 color) {
     float opaque = 1.0 - k.x - k.y;
     if (opaque > 0.0) color += r.w * opaque * shade_local(p, ngf, nsf, r.d, m);
     push_children(r, p, ngf, nsf, entering, m);
+}
+
+// One node of the ray tree: ray r's closest hit; adds its own radiance (the sky where it misses,
+// else the weighted opaque part) to `color` and pushes its children on the stack. The hybrid's
+// wavefront passes (hybrid_wave.rgen) run it once per listed ray.
+void visit(Ray r, inout vec3 color) {
+    Hit h = trace_closest(r.o, r.d);
+    if (h.t < 0.0) { color += r.w * sample_sky(r.d); return; }
+    shade_hit(r, h, color);
 }
 
 // Radiance of every ray on the stack and of their descendants.

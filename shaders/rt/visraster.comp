@@ -57,11 +57,17 @@ void main() {
         // Boxes of at most CULL_TILES tiles (slivers: long thin triangles cross few of their
         // box's tiles) get jobs only for the tiles the triangle may cover: the tile pass's own
         // corner test, done here once instead of a job per tile.
+        // covered[k / 32] bit k % 32: tile k (row-major in the box) may be covered.
         bool cull = n <= CULL_TILES;
+        uint covered[(CULL_TILES + 31u) / 32u];
         if (cull) {
             n = 0u;
+            for (uint w = 0u; w < (CULL_TILES + 31u) / 32u; ++w) covered[w] = 0u;
             for (int ty = 0; ty < tiles.y; ++ty)
-                for (int tx = 0; tx < tiles.x; ++tx) n += tile_may_cover(tri, ivec2(tx, ty)) ? 1u : 0u;
+                for (int tx = 0; tx < tiles.x; ++tx) {
+                    uint k = uint(ty * tiles.x + tx);
+                    if (tile_may_cover(tri, ivec2(tx, ty))) { covered[k >> 5] |= 1u << (k & 31u); ++n; }
+                }
             if (n == 0u) return;  // no pixel centre covered
         }
         uint rec = atomicAdd(tri_count, 1u);  // a record slot past the capacity is never written
@@ -72,7 +78,8 @@ void main() {
                 uint k = first;
                 for (int ty = 0; ty < tiles.y; ++ty)
                     for (int tx = 0; tx < tiles.x; ++tx)
-                        if (!cull || tile_may_cover(tri, ivec2(tx, ty))) jobs[k++] = uvec2(rec, (uint(ty) << 16) | uint(tx));
+                        if (!cull || (covered[uint(ty * tiles.x + tx) >> 5] & (1u << (uint(ty * tiles.x + tx) & 31u))) != 0u)
+                            jobs[k++] = uvec2(rec, (uint(ty) << 16) | uint(tx));
                 atomicMax(args.groups, (first + n + JOBS_PER_GROUP - 1u) / JOBS_PER_GROUP);
                 return;
             }

@@ -130,12 +130,16 @@ class Executor:
 
 
 # ------------------------------------------------------------------ local processes
-def _child_main(conn: Any, fn: Callable[[Any], Any], arg: Any) -> None:
-    result = call(fn, arg)
+def _answer(conn: Any, result: Any) -> None:
+    """Send :func:`call`'s ``result`` back, or an error naming why it could not be sent."""
     try:
         conn.send(result)
     except Exception as exc:  # noqa: BLE001 - e.g. an unpicklable result
         conn.send(("error", f"result could not be sent back: {describe(exc)}"))
+
+
+def _child_main(conn: Any, fn: Callable[[Any], Any], arg: Any) -> None:
+    _answer(conn, call(fn, arg))
     conn.close()
 
 
@@ -150,11 +154,7 @@ def _serve(conn: Any, tasks: int) -> None:
             break
         if job is None:
             break
-        result = call(*job)
-        try:
-            conn.send(result)
-        except Exception as exc:  # noqa: BLE001 - e.g. an unpicklable result
-            conn.send(("error", f"result could not be sent back: {describe(exc)}"))
+        _answer(conn, call(*job))
     conn.close()
 
 

@@ -139,7 +139,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     from rgraph.compiler.pipeline import compile_graph
     from rgraph.scene.build import load_scene_data
 
-    path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
+    path = scene_file(scene)
     params = {"rt.max_depth": str(depth)}
     levels = tuple(f"rays_{k}_args" for k in range(1, WAVE_LEVELS + 1))
     graphs = {"alone": ("rt_standalone", ()), "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs", *levels))}
@@ -215,9 +215,14 @@ def boundary_share(ids: np.ndarray, bits: int) -> float:
     return float(differs.mean())
 
 
+def scene_file(scene: str) -> Path:
+    """A bundled scene's name (``graphs/scenes/NAME.yaml``) or a scene file's path (``*.yaml``)."""
+    return Path(scene).resolve() if scene.endswith(".yaml") else ROOT / "graphs" / "scenes" / f"{scene}.yaml"
+
+
 def depth_sweep(scene: str, camera: int, size: tuple[int, int], frames: int) -> list[dict[str, Any]]:
     """Stand-alone and hybrid at rt.max_depth 1..8 against the stand-alone depth-16 image."""
-    path = ROOT / "graphs" / "scenes" / f"{scene}.yaml"
+    path = scene_file(scene)
     _t, ref = _run("rt_standalone", path, camera, size, 1, {"rt.max_depth": "16"})
     reference = ref["color"][..., :3].astype(np.float64)
     rows = []

@@ -279,6 +279,9 @@ def pass_table(rows: list[dict[str, Any]]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from rgraph.resources import builtin_passes
+
+    builtin_passes()  # rgraph.passes from a checkout without an install (the GPU machine)
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--size", default="full", help="full (1280x720), small (64x36) or WxH")
     parser.add_argument("--frames", type=int, default=None, help="timed frames per plan (default 50; small: 2)")

@@ -127,6 +127,9 @@ def lighting_test(gpu: Any, size: tuple[int, int], frames: int) -> dict[str, Any
 
 
 def main(argv: list[str] | None = None) -> int:
+    from rgraph.resources import builtin_passes
+
+    builtin_passes()  # rgraph.passes from a checkout without an install (the GPU machine)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1920x1080")
     parser.add_argument("--counts", default=",".join(map(str, COUNTS)))

@@ -1,9 +1,13 @@
 """GPU-driven drawing (``draw.mode=gpu``, ``rgraph.vk.scene_modes``): ``draw_reset`` and ``draw_cull``.
 
-The graph buffer ``draw_args`` (``16 + ${scene.draws} * 20`` bytes) holds the draw count at
-offset 0 and VkDrawIndexedIndirectCommands from offset 16. ``draw_reset`` (one thread) zeroes
-the count; ``draw_cull`` (one thread per instance, ``shaders/scene/cull.comp``) appends a
-command for every instance whose bounding sphere meets some view's frustum; the raster passes
+The graph buffer ``draw_args`` holds the draw count at offset 0 and VkDrawIndexedIndirectCommands
+from offset 16. ``draw_reset`` (one workgroup) zeroes the count; ``draw_cull`` (one thread per
+instance, ``shaders/scene/cull.comp``) emits a command for every instance whose bounding sphere
+meets some view's frustum. Param ``draw.order``: ``none`` appends them in atomic order
+(``16 + ${scene.draws} * 20`` bytes suffice); ``front_to_back`` orders them by distance bucket,
+nearest first (``16 + ${scene.draws} * 28 + 1024`` bytes: the buckets' counts and each
+instance's bucket and rank after the commands; NumPy reference ``rgraph.scene.instances.draw_buckets``).
+The raster passes
 read ``draw_args`` as ``indirect`` and draw it with one ``vkCmdDrawIndexedIndirectCount``
 (``SceneGPU.draw(..., args=...)``). In the other draw modes both record nothing. NumPy
 reference: ``rgraph.scene.instances.visible``.
@@ -29,6 +33,27 @@ def draw_args(setup: PassSetup, frame_set: int) -> Any:
     return setup.buffer("draw_args", frame_set)[0]
 
 
+ORDERS = ("none", "front_to_back")
+BUCKETS = 256  # cull.comp's distance buckets (draw.order=front_to_back)
+GROUP = 256  # cull.comp's workgroup size
+ORDERED_SCRATCH_BYTES = 4 * BUCKETS  # the buckets' counts
+ORDERED_BYTES_PER_DRAW = COMMAND_BYTES + 8  # command, bucket, rank
+
+
+def draw_order(setup: PassSetup) -> str:
+    order = str(setup.param("draw.order", "none"))
+    if order not in ORDERS:
+        raise ExecutionError(f"pass {setup.name!r}: draw.order must be one of {', '.join(ORDERS)}, got {order!r}")
+    return order
+
+
+def command_capacity(size: int, order: str) -> int:
+    """Commands a ``draw_args`` buffer of ``size`` bytes holds under ``order``."""
+    if order == "none":
+        return (size - HEADER_BYTES) // COMMAND_BYTES
+    return max(0, size - HEADER_BYTES - ORDERED_SCRATCH_BYTES) // ORDERED_BYTES_PER_DRAW
+
+
 class _DrawArgsPass(PassImpl):
     reset = 0
 
@@ -36,23 +61,26 @@ class _DrawArgsPass(PassImpl):
         super().__init__(setup)
         self.scene = setup.scene
         self.active = self.scene.mode == "gpu"
+        order = draw_order(setup)
         _handle, size = setup.buffer("draw_args", 0)
-        self.capacity = (size - HEADER_BYTES) // COMMAND_BYTES
+        self.capacity = command_capacity(size, order)
         if self.active and self.capacity < self.scene.draw_count:
+            need = "16 + ${scene.draws} * 20" if order == "none" else "16 + ${scene.draws} * 28 + 1024"
             raise ExecutionError(f"pass {setup.name!r}: draw_args holds {self.capacity} commands, the scene has "
-                                 f"{self.scene.draw_count} draws (size it 16 + ${{scene.draws}} * 20)")
+                                 f"{self.scene.draw_count} draws (size it {need} for draw.order={order})")
         if not self.active:
             return
         self.sets = setup.descriptors([Binding(0, "storage_buffer", "draw_args")])
         self.pipeline = setup.compute_pipeline("scene/cull.comp", [self.scene.set_layout, self.sets.layout],
-                                               defines={"RESET": self.reset}, push_constant_bytes=8)
+                                               defines={"RESET": self.reset, "ORDERED": int(order != "none")},
+                                               push_constant_bytes=8)
 
     def record(self, rec, frame_set: int) -> None:
         if not self.active:
             return
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
         rec.push(self.pipeline, pack("2I", self.scene.draw_count, self.capacity))
-        rec.dispatch(1 if self.reset else max(1, -(-self.scene.draw_count // 64)), 1, 1)
+        rec.dispatch(1 if self.reset else max(1, -(-self.scene.draw_count // GROUP)), 1, 1)
 
 
 @register("draw_reset")

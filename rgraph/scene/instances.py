@@ -87,6 +87,26 @@ def visible(scene: SceneData, camera_position: np.ndarray, view_projs: list[np.n
     return keep
 
 
+#: Distance buckets of draw.order=front_to_back (shaders/scene/cull.comp BUCKETS).
+DRAW_BUCKETS = 256
+
+
+def draw_buckets(scene: SceneData, frame: int = 0) -> np.ndarray:
+    """(draws,) distance bucket of every instance under draw.order=front_to_back, as
+    ``cull.comp`` computes it in float32: the nearest point of its bounding sphere, log-spaced
+    over [near, far side of the scene bounds] (the Frame's ``scene_bounds``)."""
+    cam = scene.camera(frame)
+    pts = scene.bounds_rel(cam.position)
+    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
+    far_side = float(np.linalg.norm(centre) + np.linalg.norm(pts - centre, axis=1).max())
+    near = max(float(cam.near), 1e-6)
+    far_side = max(far_side, 2.0 * near)
+    t, c, radius = instance_arrays(scene)
+    d = np.maximum(np.linalg.norm(t - cam.position + c, axis=1) - radius, near)
+    u = np.log(d / near) / np.log(far_side / near)
+    return np.minimum((np.maximum(u, 0.0) * DRAW_BUCKETS).astype(np.int64), DRAW_BUCKETS - 1)
+
+
 def mesh_rows(calls: list) -> bytes:
     """The ``Meshes`` table: per scene mesh (index count, first index, vertex offset, 0)."""
     rows = np.zeros((max(len(calls), 1), 4), dtype=np.uint32)

@@ -2,27 +2,34 @@
 #extension GL_GOOGLE_include_directive : require
 // GPU frustum culling (draw.mode=gpu): one thread per instance tests its bounding sphere
 // against every view's frustum (reversed-Z, infinite far: 5 planes from view_proj's rows) and
-// appends a VkDrawIndexedIndirectCommand (instanceCount 1, firstInstance = the instance id)
+// emits a VkDrawIndexedIndirectCommand (instanceCount 1, firstInstance = the instance id)
 // for each visible one; the count at offset 0 feeds vkCmdDrawIndexedIndirectCount.
-// RESET=1: the one-thread variant that zeroes the count (draw_reset, before draw_cull).
-// NumPy reference: rgraph/scene/instances.py visible().
+// RESET=1: the variant that zeroes the count, the order's counters (draw_reset, before draw_cull).
+// ORDERED=0 (draw.order=none): each visible instance appends its command (atomic order).
+// ORDERED=1 (draw.order=front_to_back): each visible instance counts itself into one of
+// BUCKETS distance buckets (log-spaced from the near plane to the far side of the scene bounds,
+// by the nearest point of its sphere) and notes (bucket, rank); the last workgroup to finish
+// scans the bucket counts and writes every command at its bucket's offset + rank, so the
+// commands run near to far (in atomic order within a bucket): early depth rejection for the
+// raster passes. Layout of draw_args in 32-bit words: count, groups done, 2 pad, then
+// commands[capacity] (5 words each), bucket counts[BUCKETS], bucket_of[capacity], rank_of[capacity].
+// NumPy reference: rgraph/scene/instances.py visible() and draw_buckets().
 #include "scene/scene.glsl"
 
-layout(local_size_x = 64) in;
+#ifndef ORDERED
+#define ORDERED 0
+#endif
+#define BUCKETS 256u
+#define GROUP 256u
+#define CULLED 0xFFFFFFFFu
 
-struct DrawCommand {
-    uint index_count;
-    uint instance_count;
-    uint first_index;
-    int vertex_offset;
-    uint first_instance;
-};
+layout(local_size_x = 256) in;
 
-// the graph buffer draw_args: count, 3 words of padding, then the commands
-layout(set = 1, binding = 0, std430) buffer DrawArgs {
+layout(set = 1, binding = 0, std430) coherent buffer DrawArgs {
     uint draw_count;
-    uint pad0, pad1, pad2;
-    DrawCommand commands[];
+    uint groups_done;
+    uint pad0, pad1;
+    uint words[];
 };
 
 layout(push_constant) uniform Push { uint instance_count; uint capacity; } pc;
@@ -40,22 +47,84 @@ bool sphere_in_frustum(vec3 c, float r, mat4 m) {
     return true;
 }
 
+void write_command(uint slot, uint i) {
+    uvec4 mesh = meshes[instances[i].info.y];
+    uint base = 5u * slot;
+    words[base] = mesh.x;
+    words[base + 1u] = 1u;
+    words[base + 2u] = mesh.y;
+    words[base + 3u] = mesh.z;  // vertexOffset (int32 bits)
+    words[base + 4u] = i;
+}
+
+// Distance bucket of a sphere (camera-relative centre c, radius r): log-spaced over
+// [near, far side of the scene bounds], the nearest point of the sphere.
+uint bucket_of_sphere(vec3 c, float r) {
+    float near_plane = max(frame.time.z, 1e-6);
+    float far_side = max(length(frame.scene_bounds.xyz) + frame.scene_bounds.w, near_plane * 2.0);
+    float d = max(length(c) - r, near_plane);
+    float u = log(d / near_plane) / log(far_side / near_plane);
+    return min(uint(max(u, 0.0) * float(BUCKETS)), BUCKETS - 1u);
+}
+
+#if ORDERED
+shared bool last_group;
+shared uint offsets[BUCKETS];
+#endif
+
 void main() {
+    uint t = gl_LocalInvocationIndex;
 #if RESET
-    if (gl_GlobalInvocationID.x == 0u) draw_count = 0u;
+    if (t == 0u) { draw_count = 0u; groups_done = 0u; }
+#if ORDERED
+    if (t < BUCKETS) words[5u * pc.capacity + t] = 0u;
+#endif
 #else
     uint i = gl_GlobalInvocationID.x;
-    if (i >= pc.instance_count) return;
-    uvec4 info = instances[i].info;
-    if ((info.z & 1u) != 0u) return;  // deformable meshes are drawn directly
-    vec3 c = scene_translation(i) + instances[i].sphere.xyz;
-    float r = instances[i].sphere.w;
     bool keep = false;
-    for (uint v = 0u; v < uint(RGRAPH_VIEWS); ++v) keep = keep || sphere_in_frustum(c, r, scene_view_proj(v));
-    if (!keep) return;
-    uint slot = atomicAdd(draw_count, 1u);
-    if (slot >= pc.capacity) return;
-    uvec4 mesh = meshes[info.y];
-    commands[slot] = DrawCommand(mesh.x, 1u, mesh.y, int(mesh.z), i);
+    vec3 c = vec3(0.0);
+    float r = 0.0;
+    if (i < pc.instance_count && (instances[i].info.z & 1u) == 0u) {  // deformable meshes are drawn directly
+        c = scene_translation(i) + instances[i].sphere.xyz;
+        r = instances[i].sphere.w;
+        for (uint v = 0u; v < uint(RGRAPH_VIEWS); ++v) keep = keep || sphere_in_frustum(c, r, scene_view_proj(v));
+    }
+#if !ORDERED
+    if (keep) {
+        uint slot = atomicAdd(draw_count, 1u);
+        if (slot < pc.capacity) write_command(slot, i);
+    }
+#else
+    uint counts = 5u * pc.capacity, bucket_at = counts + BUCKETS, rank_at = bucket_at + pc.capacity;
+    if (i < pc.instance_count) {
+        uint b = CULLED;
+        if (keep) {
+            b = bucket_of_sphere(c, r);
+            words[rank_at + i] = atomicAdd(words[counts + b], 1u);
+        }
+        words[bucket_at + i] = b;
+    }
+    // The last workgroup to get here sees every other group's notes (their writes made
+    // available before their groups_done increment; coherent buffer).
+    memoryBarrierBuffer();
+    barrier();
+    if (t == 0u) last_group = atomicAdd(groups_done, 1u) == gl_NumWorkGroups.x - 1u;
+    barrier();
+    if (last_group) {
+        memoryBarrierBuffer();
+        offsets[t] = atomicAdd(words[counts + t], 0u);  // GROUP == BUCKETS: a count per thread
+        barrier();
+        if (t == 0u) {
+            uint total = 0u;
+            for (uint k = 0u; k < BUCKETS; ++k) { uint n = offsets[k]; offsets[k] = total; total += n; }
+            draw_count = total;
+        }
+        barrier();
+        for (uint j = t; j < pc.instance_count; j += GROUP) {
+            uint b = words[bucket_at + j];
+            if (b != CULLED) write_command(offsets[b] + words[rank_at + j], j);
+        }
+    }
+#endif
 #endif
 }

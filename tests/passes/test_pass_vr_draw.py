@@ -9,6 +9,8 @@
   CPU culling, one draw per object) equals draw.mode=cpu within one 8-bit code;
 - views=2: layer 0 equals the mono image rendered from the left eye's camera, layer 1 the right
   eye's, each within one code, and the two layers differ;
+- draw.order=front_to_back: the same commands, in non-decreasing distance bucket
+  (rgraph.scene.instances.draw_buckets, within one bucket of float32 rounding), and the same image;
 - instances moved after loading (SceneGPU.refresh_instances: one upload, not per frame) are
   drawn where they are.
 """
@@ -20,7 +22,7 @@ import pytest
 from clustered_helpers import graph_with_outputs, render, scene_file, srgb_codes
 
 from rgraph.scene.build import load_scene_data
-from rgraph.scene.instances import eye_offsets, eye_view_projs, visible
+from rgraph.scene.instances import draw_buckets, eye_offsets, eye_view_projs, visible
 
 SIZE = (64, 48)
 LIGHTS = """  - {type: directional, direction: [-0.3, -1, -0.2], intensity: 1.5}
@@ -42,9 +44,9 @@ CAMERA = "camera: {position: [0, 2, 3], look_at: [1, 0.5, -4], fov_y: 50, near: 
 HAIR = 1e-4
 
 
-def _commands(outputs: dict) -> tuple[int, np.ndarray]:
+def _commands(outputs: dict, draws: int) -> tuple[int, np.ndarray]:
     raw = np.frombuffer(bytes(outputs["draw_args"]), dtype=np.uint32)
-    return int(raw[0]), raw[4:].reshape(-1, 5)
+    return int(raw[0]), raw[4:4 + 5 * draws].reshape(-1, 5)
 
 
 def _expected(scene, projs) -> tuple[np.ndarray, np.ndarray]:
@@ -67,14 +69,14 @@ def _expected(scene, projs) -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.mark.vulkan
-@pytest.mark.parametrize("views", [1, 2])
-def test_gpu_culling_matches_the_numpy_frustum_test(tmp_path, views):
+@pytest.mark.parametrize("views,order", [(1, "none"), (2, "none"), (1, "front_to_back"), (2, "front_to_back")])
+def test_gpu_culling_matches_the_numpy_frustum_test(tmp_path, views, order):
     scene_path = scene_file(tmp_path, LIGHTS, camera=CAMERA, meshes=MESHES)
     graph = graph_with_outputs(tmp_path, ("draw_args",))
-    params = {"views": str(views), "views.ipd": "2.0"}  # wide eyes: the union differs from either eye
+    params = {"views": str(views), "views.ipd": "2.0", "draw.order": order}  # wide eyes: the union differs
     _plan, out = render(scene_path, size=SIZE, graph=graph, params=params)
     scene = load_scene_data(scene_path, SIZE)
-    count, cmds = _commands(out)
+    count, cmds = _commands(out, scene.draw_count)
     drawn = cmds[:count]
     ids = drawn[:, 4]
     assert len(np.unique(ids)) == count, "an instance was drawn twice"
@@ -95,6 +97,11 @@ def test_gpu_culling_matches_the_numpy_frustum_test(tmp_path, views):
     for row in drawn:
         index_count, first = offsets[int(mesh_of[row[4]])]
         assert (row[0], row[1], row[2]) == (index_count, 1, first)
+    if order == "front_to_back":
+        buckets = draw_buckets(scene)[ids]
+        assert np.all(np.diff(buckets) >= -1), "commands not near to far"
+        assert len(np.unique(buckets)) > 10  # the test has teeth: many buckets ...
+        assert np.any(np.diff(ids.astype(np.int64)) < 0)  # ... and an order other than the instances'
     if views > 1:  # the union of both eyes is more than either eye alone
         left = visible(scene, scene.camera(0).position, projs[:1])
         right = visible(scene, scene.camera(0).position, projs[1:])
@@ -106,11 +113,11 @@ def test_draw_modes_render_the_same_image(tmp_path):
     scene_path = scene_file(tmp_path, LIGHTS, camera=CAMERA, meshes=MESHES)
     images = {}
     for label, params in (("cpu", {"draw.mode": "cpu"}), ("gpu", {}), ("gpu32", {"draw.float64": "false"}),
-                          ("naive", {"draw.mode": "naive"})):
+                          ("sorted", {"draw.order": "front_to_back"}), ("naive", {"draw.mode": "naive"})):
         _plan, out = render(scene_path, size=SIZE, params=params)
         images[label] = srgb_codes(out)
     assert images["cpu"].std() > 5  # a real picture
-    for label in ("gpu", "gpu32", "naive"):
+    for label in ("gpu", "gpu32", "sorted", "naive"):
         diff = np.abs(images[label] - images["cpu"])
         assert diff.max() <= 1, f"{label}: max diff {diff.max()} codes"
 

@@ -47,7 +47,7 @@ def test_the_vr_scenes_have_the_studys_object_counts():
     assert load_scene_data(SCENES / "vr_instanced.yaml").draw_count == 32768
     unique = load_scene_data(SCENES / "vr_unique.yaml")
     assert sum(1 for m in unique.meshes if m.name.startswith("0:box#")) == 4096
-    assert frontend("clustered", SCENES / "vr_unique.yaml").spec.resources["draw_args"].bytes == 16 + 4097 * 20
+    assert frontend("clustered", SCENES / "vr_unique.yaml").spec.resources["draw_args"].bytes == 16 + 4097 * 28 + 1024
 
 
 def test_instance_table_holds_float64_translations_and_ids():

@@ -41,7 +41,7 @@ ORDERED_BYTES_PER_DRAW = COMMAND_BYTES + 8  # command, bucket, rank
 
 
 def draw_order(setup: PassSetup) -> str:
-    order = str(setup.param("draw.order", "none"))
+    order = str(setup.param("draw.order", "none"))  # graphs without the param keep the old buffer size
     if order not in ORDERS:
         raise ExecutionError(f"pass {setup.name!r}: draw.order must be one of {', '.join(ORDERS)}, got {order!r}")
     return order

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from rgraph.compiler.alias_starts import PREVIOUS_FRAME, alias_state, with_partial_handoffs
+from rgraph.compiler.alias_starts import alias_state, with_partial_handoffs
 from rgraph.compiler.plan_values import get_state, make_barrier, plan_state, subresource
 from rgraph.compiler.rectangles import mip_layer_rectangles
 from rgraph.compiler.sync_types import EMPTY, StateKey, SyncResult, Wait
@@ -39,8 +39,8 @@ PERSISTENT = ("persistent", "imported")
 EMPTY2 = (EMPTY, EMPTY)
 
 #: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
-#: is (pass, stages, write access) or None, reads the (pass, stages) since it, visible the dst
-#: scope (stages, access) of the barriers since it.
+#: is (stages, write access) of the last write or None, reads the stages of each read since it,
+#: visible the dst scope (stages, access) of the barriers since it.
 CellEnd = tuple
 #: A barrier's key: (src state, dst state, aliases); cells of one resource and pass with equal
 #: keys (and release pass) share one barrier rectangle.
@@ -101,8 +101,7 @@ def synchronize(
             for c, uses in cells:
                 lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
                                                                  (), (), False, None, c, None)
-                start = (lay, queue, (PREVIOUS_FRAME, write[1], write[2]) if write else None,
-                         [(PREVIOUS_FRAME, stages) for _, stages in reads], last, visible)
+                start = (lay, queue, write, list(reads), last, visible)
                 starts[c] = _state(start)
                 end = _walk(uses, image, start, (), (), True, sink, c, sub)
                 finals[c] = st = _state(end)
@@ -115,7 +114,7 @@ def synchronize(
             if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
                 stages, access, queue, last, aliases, alias_waits = alias_state(
                     preds, [end for pred in preds for end in ends.get(pred, ())], r.first)
-                write = (PREVIOUS_FRAME, stages, access) if stages or access else None
+                write = (stages, access) if stages or access else None
             for c, uses in cells:
                 start = (layout, queue, write, [], last, EMPTY2)
                 starts[c] = _state(start)
@@ -134,9 +133,9 @@ def _state(end: CellEnd) -> StateKey:
     """What later accesses must wait for: the reads since the write, else the write."""
     layout, queue, write, reads, _, _ = end
     if reads:
-        return (reads[0][1] if len(reads) == 1 else EMPTY.union(*[s for _, s in reads]), EMPTY, layout, queue)
+        return (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, queue)
     if write:
-        return (write[1], write[2], layout, queue)
+        return (write[0], write[1], layout, queue)
     return (EMPTY, EMPTY, layout, queue)
 
 
@@ -153,37 +152,38 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
         bars, rels, waits, multi = sink
     covered_until = -1  # index in ``uses`` of the last read already covered by a barrier
     for k, (i, s, w, queue, pos) in enumerate(uses):
-        cross = cq is not None and cq != queue
-        if alias_waits:  # aliased memory used on another queue
-            wait_on = [(q, j) for q, j in alias_waits if q != queue]
-        elif cross:
-            wait_on = []
-        else:
-            wait_on = ()
-        transfer = False
-        release_at = None
-        if cross:
-            if last_pass is not None and not last_prev:
-                wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
-            if image:
-                transfer = layout not in (None, "UNDEFINED")
+        if alias_waits or (cq != queue and cq is not None):
+            if alias_waits:  # aliased memory used on another queue
+                wait_on = [(q, j) for q, j in alias_waits if q != queue]
             else:
-                transfer = not aliases and (write is not None or bool(reads))
-            if transfer:
-                release_at = last_pass
-        src_queue = cq if transfer else queue
+                wait_on = []
+            transfer = False
+            release_at = None
+            if cq != queue and cq is not None:
+                if last_pass is not None and not last_prev:
+                    wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
+                if image:
+                    transfer = layout not in (None, "UNDEFINED")
+                else:
+                    transfer = not aliases and (write is not None or bool(reads))
+                if transfer:
+                    release_at = last_pass
+            src_queue = cq if transfer else queue
+        else:  # the same queue as the cell's last use (or its first use), nothing to wait for
+            wait_on = ()
+            transfer = False
+            release_at = None
+            src_queue = queue
         new_layout = s.layout
-        layout_change = new_layout != layout
         key = None
-        if w or layout_change:
+        if w or new_layout != layout:
             if reads:
-                src = (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]), EMPTY, layout,
-                       src_queue)
+                src = (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, src_queue)
             elif write:
-                src = (write[1], write[2], layout, src_queue)
+                src = (write[0], write[1], layout, src_queue)
             else:
                 src = (EMPTY, EMPTY, layout, src_queue)
-            if src[0] or src[1] or layout_change or transfer:
+            if src[0] or src[1] or new_layout != layout or transfer:
                 if w:
                     key = (src, (s.stages, s.access, new_layout, queue), aliases)
                 else:  # a transition for a read group: cover the whole group
@@ -191,28 +191,27 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                     visible = (dst_stages, dst_access)
                     key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
             if w:
-                write = (i, s.stages, s.writes)
+                write = s.write_scope
                 reads = []
                 covered_until = k
                 visible = EMPTY2
             else:  # a layout change: a transition is a write; from UNDEFINED it happens once, at creation
-                write = (i, s.stages, EMPTY) if layout != "UNDEFINED" else None
-                reads = [(i, s.stages)]
+                write = (s.stages, EMPTY) if layout != "UNDEFINED" else None
+                reads = [s.stages]
         else:  # a read in the current layout
             if transfer or (write and k > covered_until
                             and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
                 if reads:  # the write is already available: chain through the reads
-                    src = (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]), EMPTY, layout,
-                           src_queue)
+                    src = (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, src_queue)
                 elif write:
-                    src = (write[1], write[2], layout, src_queue)
+                    src = (write[0], write[1], layout, src_queue)
                 else:
                     src = (EMPTY, EMPTY, layout, src_queue)
                 dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
                 visible = (dst_stages, dst_access)
                 if transfer or src[0] or src[1]:
                     key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
-            reads.append((i, s.stages))
+            reads.append(s.stages)
         layout = new_layout
         cq = queue
         last_pass = i
@@ -281,9 +280,15 @@ def _rectangles(res: str, found: list[tuple[int, int, Cell, Key, int | None]], b
         else:
             groups[group] = (pos, [(c[1], c[2])])
     for (i, (src, dst, names), release_at), (first, cells) in groups.items():
-        ps, pd = plan_state(src), plan_state(dst)
-        entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
-                   for mips, layers in sorted(mip_layer_rectangles(cells))]
+        ps = get_state(src) or plan_state(src)
+        pd = get_state(dst) or plan_state(dst)
+        if len(cells) == 1:
+            ((mip, layer),) = cells
+            mips, layers = (mip, mip + 1), (layer, layer + 1)
+            entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))]
+        else:
+            entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
+                       for mips, layers in mip_layer_rectangles(cells)]
         if bars[i] is None:
             bars[i] = entries
         else:

@@ -11,7 +11,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from rgraph.compiler import sync as csync
-from rgraph.compiler.plan_values import get_subresource, names, plan_state, subresource
+from rgraph.compiler.plan_values import get_state, get_subresource, names, plan_state, subresource
 from rgraph.compiler.usages import Sync
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
@@ -35,7 +35,8 @@ def _end_state(lifetime: str, states: Mapping[Any, csync.StateKey] | None) -> pm
     if not states:
         return None
     if len(states) == 1:
-        return plan_state(next(iter(states.values())))
+        for st in states.values():
+            return get_state(st) or plan_state(st)
     distinct = set(states.values())
     if len(distinct) == 1:
         return plan_state(next(iter(distinct)))
@@ -99,24 +100,27 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
 
 
 def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
-    spec, sync, placement = c.spec, c.sync, c.placement
+    spec, sync, placement, memory = c.spec, c.sync, c.placement, c.memory
     assert sync is not None and placement is not None
     out = []
     outputs = set(c.spec.outputs)
-    for name in sorted(c.memory):
-        res, mem = spec.resources[name], c.memory[name]
-        heap, offset = placement.offsets[name]
+    initial, final, offsets = sync.initial, sync.final, placement.offsets
+    for name in sorted(memory):
+        res, mem = spec.resources[name], memory[name]
+        heap, offset = offsets[name]
         lifetime = "output" if (name in outputs and res.lifetime == "transient") else res.lifetime
-        image = res.is_image
-        out.append(_Resource(
-            name=name, kind=res.kind, format=res.format.vk_name if res.format else None, bytes=mem.bytes,
-            size_bytes=None if image else res.bytes, alignment=mem.alignment, memory_type_bits=mem.memory_type_bits,
-            memory_class=mem.memory_class, usages=mem.usages, lifetime=lifetime, first=mem.first, last=mem.last,
-            heap=heap, offset=offset,
-            initial=_end_state(lifetime, sync.initial.get(name)), final=_end_state(lifetime, sync.final.get(name)),
-            extent=tuple(res.extent) if image else None, mips=res.mips if image else None,
-            layers=res.layers if image else None, samples=res.samples if image else None,
-            accel=_frozen_json(res.accel.as_plan()) if res.accel is not None else None, scratch_of=res.scratch_of,
+        fmt = res.format
+        accel = res.accel
+        if res.kind == "image":
+            size_bytes, extent, mips, layers, samples = None, tuple(res.extent), res.mips, res.layers, res.samples
+        else:
+            size_bytes, extent, mips, layers, samples = res.bytes, None, None, None, None
+        out.append(_Resource(  # positional, in PlanResource's field order (a keyword call costs more)
+            name, res.kind, fmt.vk_name if fmt else None, mem.bytes, size_bytes, mem.alignment, mem.memory_type_bits,
+            mem.memory_class, mem.usages, lifetime, mem.first, mem.last, heap, offset,
+            _end_state(lifetime, initial.get(name)), _end_state(lifetime, final.get(name)),
+            extent, mips, layers, samples, _frozen_json(accel.as_plan()) if accel is not None else None,
+            res.scratch_of,
         ))
     return tuple(out)
 

@@ -15,6 +15,7 @@ from typing import Protocol
 
 from rgraph.errors import RGraphError
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats
+from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
 Requirements = tuple[int, int, int]
@@ -51,6 +52,8 @@ class ResourceMemory:
     first: int  # executed pass indices
     last: int
 
+
+_requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  # one per used resource
 
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
 _SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw",
@@ -109,7 +112,7 @@ def requirements(
                 tiling = "linear"
         except RGraphError as err:
             raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None
-        out[name] = Requirement(size, align, bits, tiling)
+        out[name] = _requirement(size, align, bits, tiling)
     return out
 
 
@@ -131,7 +134,7 @@ def resource_memory(
     """Requirements, classes, usages and lifetimes of the used resources, in name order."""
     classes = memory_classes(reqs)
     return {
-        name: ResourceMemory(r.bytes, r.alignment, r.memory_type_bits, classes[name], tuple(sorted(used[name])),
+        name: _resource_memory(r.bytes, r.alignment, r.memory_type_bits, classes[name], tuple(sorted(used[name])),
                              spans[name][0], spans[name][1])
         for name, r in reqs.items()
     }

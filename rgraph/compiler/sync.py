@@ -269,36 +269,43 @@ def _rectangles(res: str, found: list[tuple[int, int, Cell, Key, int | None]], b
     """A resource of several cells: per pass, its cells with one key and release pass merged into
     mip x layer rectangles (an acquire's rectangles equal its release's: the layer pairs
     ownership transfers by exact subresource range)."""
-    groups: dict[tuple[int, Key, int | None], tuple[int, list[tuple[int, int]]]] = {}
+    # per pass: [key, release pass, first cell position, cells]; a pass has few keys per
+    # resource, compared in a list (hashing a key, nested tuples, costs more)
+    by_pass: dict[int, list[list]] = {}
     for i, pos, c, key, release_at in found:
-        group = (i, key, release_at)
-        if group in groups:
-            first, cells = groups[group]
-            cells.append((c[1], c[2]))
-            if pos < first:
-                groups[group] = (pos, cells)
+        groups = by_pass.get(i)
+        if groups is None:
+            by_pass[i] = [[key, release_at, pos, [(c[1], c[2])]]]
+            continue
+        for group in groups:
+            if group[1] == release_at and group[0] == key:
+                group[3].append((c[1], c[2]))
+                if pos < group[2]:
+                    group[2] = pos
+                break
         else:
-            groups[group] = (pos, [(c[1], c[2])])
-    for (i, (src, dst, names), release_at), (first, cells) in groups.items():
-        ps = get_state(src) or plan_state(src)
-        pd = get_state(dst) or plan_state(dst)
-        if len(cells) == 1:
-            ((mip, layer),) = cells
-            mips, layers = (mip, mip + 1), (layer, layer + 1)
-            entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))]
-        else:
-            entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
-                       for mips, layers in mip_layer_rectangles(cells)]
-        if bars[i] is None:
-            bars[i] = entries
-        else:
-            bars[i] += entries
-        if release_at is not None:
-            made = tuple(e[3] for e in entries)
-            if rels[release_at] is None:
-                rels[release_at] = [(i, res, first, made)]
+            groups.append([key, release_at, pos, [(c[1], c[2])]])
+    for i, groups in by_pass.items():
+        for (src, dst, names), release_at, first, cells in groups:
+            ps = get_state(src) or plan_state(src)
+            pd = get_state(dst) or plan_state(dst)
+            if len(cells) == 1:
+                ((mip, layer),) = cells
+                mips, layers = (mip, mip + 1), (layer, layer + 1)
+                entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))]
             else:
-                rels[release_at].append((i, res, first, made))
+                entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
+                           for mips, layers in mip_layer_rectangles(cells)]
+            if bars[i] is None:
+                bars[i] = entries
+            else:
+                bars[i] += entries
+            if release_at is not None:
+                made = tuple([e[3] for e in entries])
+                if rels[release_at] is None:
+                    rels[release_at] = [(i, res, first, made)]
+                else:
+                    rels[release_at].append((i, res, first, made))
 
 
 def _gather(bars: list, rels: list, waits: list, trace: Trace, final: dict, initial: dict) -> SyncResult:

@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from rgraph.compiler.sync_types import StateKey
 from rgraph.spec.specialize import ResourceSpec
 
+
 def with_partial_handoffs(
     alias_sources: Mapping[str, Sequence[str]], touched: Mapping[str, int], resources: Mapping[str, ResourceSpec],
     ranges: Mapping[str, tuple[int, int, int]] | None = None,

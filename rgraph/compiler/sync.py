@@ -80,7 +80,7 @@ def synchronize(
     # ends before it starts, so it is walked before it
     for name, r in trace.resources.items():
         res = resources[name]
-        image = res.is_image
+        image = res.kind == "image"
         layout = "UNDEFINED" if image else None
         cells = r.cells
         starts: dict[Cell, StateKey] = {}
@@ -115,9 +115,10 @@ def synchronize(
                 stages, access, queue, last, aliases, alias_waits = alias_state(
                     preds, [end for pred in preds for end in ends.get(pred, ())], r.first)
                 write = (stages, access) if stages or access else None
+            first_state = _state((layout, queue, write, (), last, EMPTY2))  # every cell starts alike
             for c, uses in cells:
                 start = (layout, queue, write, [], last, EMPTY2)
-                starts[c] = _state(start)
+                starts[c] = first_state
                 end = _walk(uses, image, start, aliases, alias_waits, False, sink, c, sub)
                 finals[c] = st = _state(end)
                 if kept is not None:
@@ -151,6 +152,7 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
     if sink is not None:
         bars, rels, waits, multi = sink
     covered_until = -1  # index in ``uses`` of the last read already covered by a barrier
+    end = len(uses) - 1
     for k, (i, s, w, queue, pos) in enumerate(uses):
         if alias_waits or (cq != queue and cq is not None):
             if alias_waits:  # aliased memory used on another queue
@@ -187,7 +189,10 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                 if w:
                     key = (src, (s.stages, s.access, new_layout, queue), aliases)
                 else:  # a transition for a read group: cover the whole group
-                    dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                    if k == end or (u := uses[k + 1])[2] or u[1].layout != new_layout or u[3] != queue:
+                        dst_stages, dst_access, covered_until = s.stages, s.access, k  # a group of one
+                    else:
+                        dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
                     visible = (dst_stages, dst_access)
                     key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
             if w:
@@ -207,7 +212,10 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                     src = (write[0], write[1], layout, src_queue)
                 else:
                     src = (EMPTY, EMPTY, layout, src_queue)
-                dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                if k == end or (u := uses[k + 1])[2] or u[1].layout != new_layout or u[3] != queue:
+                    dst_stages, dst_access, covered_until = s.stages, s.access, k  # a group of one
+                else:
+                    dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
                 visible = (dst_stages, dst_access)
                 if transfer or src[0] or src[1]:
                     key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
@@ -320,9 +328,11 @@ def _gather(bars: list, rels: list, waits: list, trace: Trace, final: dict, init
     for i in range(count):
         found = bars[i]
         if found is not None:
-            if len(found) > 1:
+            if len(found) == 1:
+                barriers[i] = (found[0][-1],)
+            else:
                 found.sort()  # (resource, [mips, layers]) never tie within a pass: barriers not compared
-            barriers[i] = tuple([e[-1] for e in found])
+                barriers[i] = tuple([e[-1] for e in found])
         found = rels[i]
         if found is not None:
             if len(found) > 1:

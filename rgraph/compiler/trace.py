@@ -16,6 +16,7 @@ from dataclasses import dataclass, replace
 from rgraph.compiler.read_layouts import to_general
 from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell
+from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
 #: One pass's use of a cell: (executed pass index, merged sync, written, queue, position of the
@@ -39,6 +40,9 @@ class ResourceTrace:
     group: list[tuple[int, int, bool, str]] | None  # read_layouts candidates: (pass, access, write, usage)
 
 
+_new_trace = builder(ResourceTrace)
+
+
 @dataclass
 class Trace:
     syncs: list[list[Sync]]  # per pass, per declared access
@@ -48,9 +52,14 @@ class Trace:
     waits: dict[int, dict[str, int]]
 
 
-def _code(res: ResourceSpec) -> int:
+def _start(res: ResourceSpec, i: int, usage: str) -> ResourceTrace:
+    """A resource's trace at its first use (pass ``i``, ``usage``)."""
     fmt = res.format
-    return res.is_image + 2 * bool(fmt and fmt.has_depth) + 4 * bool(fmt and fmt.has_stencil)
+    image = res.kind == "image"
+    depth, stencil = bool(fmt and fmt.has_depth), bool(fmt and fmt.has_stencil)
+    # read_layouts' candidates: transient colour images
+    group = [] if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil else None
+    return _new_trace({usage}, i, i, [], image + 2 * depth + 4 * stencil, group)
 
 
 def _scope(key: tuple) -> Sync:
@@ -60,13 +69,6 @@ def _scope(key: tuple) -> Sync:
     found = _SCOPES[key] = sync_of(usage, kind, explicit_stages=stages, is_image=bool(code & 1),
                                    depth_format=bool(code & 2), stencil_format=bool(code & 4), refit=refit)
     return found
-
-
-def _group_candidate(res: ResourceSpec) -> bool:
-    """``read_layouts``: transient colour images."""
-    fmt = res.format
-    return res.is_image and res.lifetime == "transient" and fmt is not None and not fmt.has_depth \
-        and not fmt.has_stencil
 
 
 def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> Trace:
@@ -89,11 +91,9 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
             r = get_info(name)
             if r is None:
                 res = resources[name]
-                group = None
-                if _group_candidate(res):
-                    group = []
+                r = info[name] = _start(res, i, usage)
+                if r.group is not None:
                     full[name] = ((0, res.mips), (0, res.layers))
-                r = info[name] = ResourceTrace({usage}, i, i, [], _code(res), group)
             else:
                 r.usages.add(usage)
                 r.last = i

@@ -165,7 +165,10 @@ def _drop_unproduced_reads(
 def _drop_optional_reads(spec: Spec) -> tuple[list[PassSpec], list[DroppedRead], list[Culled]]:
     """``_drop_unproduced_reads`` when the scene removed no pass: no producer is lost, so no
     pass is removed and only optional reads of cells nothing wrote are dropped. A pass's
-    writes are noted as they come (they overlap none of its reads: ``specialize`` checks it)."""
+    writes are noted as they come (they overlap none of its reads: ``specialize`` checks it).
+    Without optional reads (one scan finds them) nothing is dropped: no walk."""
+    if not any(a.optional for p in spec.passes for a in p.accesses):
+        return list(spec.passes), [], []
     produced: set[tuple[str, int, int]] = set()
     kept: list[PassSpec] = []
     dropped: list[DroppedRead] = []

@@ -61,30 +61,20 @@ _SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw"
 
 
 def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
-    """Per resource: the usages ``passes`` make of it (``usages_and_lifetimes``' first half)."""
-    return usages_and_lifetimes(passes)[0]
-
-
-def usages_and_lifetimes(passes: Sequence[PassSpec]) -> tuple[dict[str, set[str]], dict[str, tuple[int, int]]]:
-    """Per resource: the usages of ``passes`` (raytrace indirect arguments also ``trace_indirect``)
-    and the first and last executed pass index."""
+    """Per resource: the usages ``passes`` make of it (raytrace indirect arguments also
+    ``trace_indirect``), as ``rgraph.compiler.trace`` records them for the executed passes."""
     used: dict[str, set[str]] = {}
-    spans: dict[str, tuple[int, int]] = {}
-    for i, p in enumerate(passes):
+    for p in passes:
         raytrace = p.kind == "raytrace"
         for a in p.accesses:
-            name = a.resource
-            found = used.get(name)
+            found = used.get(a.resource)
             if found is None:
-                used[name] = {a.usage}
-                spans[name] = (i, i)
+                found = used[a.resource] = {a.usage}
             else:
                 found.add(a.usage)
-                first = spans[name][0]
-                spans[name] = (first, i)
             if raytrace and a.usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
-                used[name].add("trace_indirect")
-    return used, spans
+                found.add("trace_indirect")
+    return used
 
 
 def requirements(

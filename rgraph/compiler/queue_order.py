@@ -10,8 +10,8 @@ pairs of transients, disjoint in pass index, where it would not be: the placemen
 them as overlapping in time, so aliasing never adds a semaphore wait the ``dedicated``
 policy lacks (tests/compile/test_alias_queues.py checks it on random multi-queue graphs).
 
-The dedicated plan's waits are recomputed here the way ``sync`` derives them: a cell whose
-previous use was on another queue waits for that use.
+The dedicated plan's waits come from the trace (``rgraph.compiler.trace``), derived the way
+``sync`` derives them: a cell whose previous use was on another queue waits for that use.
 """
 
 from __future__ import annotations

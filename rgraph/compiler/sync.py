@@ -5,8 +5,8 @@ its layout, owning queue, last write and the reads since. Each cell touched by a
 at most one barrier there; cells with identical barriers are merged into mip/layer
 rectangles, so a pass has one batch. Cells do not affect each other's barriers, so each
 cell's timeline (``rgraph.compiler.trace``) is walked in one go (``_walk``: its state in local
-variables), resources in the order of their first pass. A resource with one cell (every
-buffer) gets its plan barriers in the walk; the cells of the others are merged into
+variables), resources in the order of their first pass. A resource with one touched cell
+(every buffer) gets its plan barriers in the walk; the cells of the others are merged into
 rectangles once the resource is walked. The barriers are the plan's values
 (``rgraph.plan.model.Barrier``): emit does not rebuild them.
 

@@ -39,7 +39,7 @@ def test_rectangles_merge_runs_and_equal_consecutive_mips(cells: set[tuple[int, 
     for (m0, m1), layers in rects:
         assert all(layers in by_mip[m] for m in range(m0, m1))
     # a rectangle's mips are not extendable: the next mip has other runs (or no cells)
-    for (m0, m1), layers in rects:
+    for (m0, m1), _ in rects:
         assert by_mip.get(m1) != by_mip[m0]
         assert m0 == 0 or by_mip.get(m0 - 1) != by_mip[m0]
 

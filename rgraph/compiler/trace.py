@@ -133,8 +133,13 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                 pos += 1
         syncs.append(row)
     moved = to_general({name: r.group for name, r in info.items() if r.group is not None}, syncs)
+    general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
     for i, j in moved:
-        syncs[i][j] = replace(syncs[i][j], layout="GENERAL")
+        scope = syncs[i][j]
+        found = general.get(id(scope))
+        if found is None:
+            found = general[id(scope)] = (scope, replace(scope, layout="GENERAL"))
+        syncs[i][j] = found[1]
     for i, j in moved:
         _repatch(passes[i], i, passes[i].accesses[j].cells, syncs[i], timeline)
     return Trace(syncs, info, waits)

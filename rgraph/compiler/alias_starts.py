@@ -12,10 +12,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from rgraph.compiler.sync_types import State
+from rgraph.compiler.sync_types import StateKey
 from rgraph.spec.specialize import ResourceSpec
-
-PREVIOUS_FRAME = -1
 
 
 def with_partial_handoffs(
@@ -59,7 +57,7 @@ def _share_bytes(ranges: Mapping[str, tuple[int, int, int]], a: str, b: str) -> 
     return ha == hb and lo_a < hi_b and lo_b < hi_a
 
 
-def alias_state(preds: Sequence[str], ends: Sequence[tuple[State, int | None]], at: int):
+def alias_state(preds: Sequence[str], ends: Sequence[tuple[StateKey, int | None]], at: int):
     """Union of the last accesses of an aliased resource's predecessors (``ends``: the end state
     and last pass of each of their cells, each last used before pass ``at``): (stages, write
     access, queue and pass of the latest, sorted names, sorted (queue, last pass) pairs)."""
@@ -67,14 +65,14 @@ def alias_state(preds: Sequence[str], ends: Sequence[tuple[State, int | None]], 
     access: set[str] = set()
     last: tuple[int, str | None] = (-1, None)
     waits: set[tuple[str, int]] = set()
-    for s, last_pass in ends:
+    for (s_stages, s_access, _, s_queue), last_pass in ends:
         assert last_pass is None or last_pass < at, "an earlier occupant outlives its successor's start"
-        stages |= s.stages
-        access |= s.access
+        stages |= s_stages
+        access |= s_access
         if last_pass is not None and last_pass > last[0]:
-            last = (last_pass, s.queue)
-        if last_pass is not None and s.queue is not None:
-            waits.add((s.queue, last_pass))
+            last = (last_pass, s_queue)
+        if last_pass is not None and s_queue is not None:
+            waits.add((s_queue, last_pass))
     return (
         frozenset(stages), frozenset(access), last[1], last[0] if last[0] >= 0 else None, tuple(sorted(preds)),
         tuple(sorted(waits)),

@@ -7,11 +7,12 @@ plan (and ``rgraph.plan.dump`` the same bytes).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from functools import lru_cache
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from rgraph.compiler import sync as csync
+from rgraph.compiler.plan_values import get_state, get_subresource, names, plan_state, subresource
+from rgraph.compiler.usages import Sync
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
@@ -22,29 +23,20 @@ if TYPE_CHECKING:
 
 SIGNAL_STAGES = ("ALL_COMMANDS",)
 
-# The plan values built per access, barrier, pass and resource (rgraph.plan.builders).
-_Access, _Barrier, _Pass, _Resource = (builder(c) for c in (pm.Access, pm.Barrier, pm.PlanPass, pm.PlanResource))
+# The plan values built per access, pass and resource (rgraph.plan.builders); barriers come
+# from the sync phase as plan values.
+_Access, _Pass, _Resource = (builder(c) for c in (pm.Access, pm.PlanPass, pm.PlanResource))
 _Wait, _Signal, _Culled = (builder(c) for c in (pm.Wait, pm.Signal, pm.Culled))
 
 
-@lru_cache(maxsize=4096)
-def _names(values: frozenset[str]) -> tuple[str, ...]:
-    """A set of stage or access names as the plan's sorted tuple (frozensets cache their hash)."""
-    return tuple(sorted(values))
-
-
-@lru_cache(maxsize=65536)
-def plan_state(st: csync.State) -> pm.State:
-    return pm.State(_names(st.stages), _names(st.access), st.layout, st.queue)
-
-
-def _end_state(lifetime: str, states: Mapping[Any, csync.State] | None) -> pm.EndState:
+def _end_state(lifetime: str, states: Mapping[Any, csync.StateKey] | None) -> pm.EndState:
     """One state when every cell agrees. Otherwise: None for transients (nothing outlives the
     frame), a per-cell list for the others (docs/plan.md)."""
     if not states:
         return None
     if len(states) == 1:
-        return plan_state(next(iter(states.values())))
+        for st in states.values():
+            return get_state(st) or plan_state(st)
     distinct = set(states.values())
     if len(distinct) == 1:
         return plan_state(next(iter(distinct)))
@@ -67,70 +59,68 @@ def _frozen_json(value: Any) -> Any:
     return value
 
 
+def _scope_names(s: Sync) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """An access scope's stage and access names as the plan lists them."""
+    return names(s.stages), names(s.access)
+
+
 def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
-    resources, passes, sync = c.spec.resources, c.passes, c.sync
+    passes, sync = c.passes, c.sync
     assert sync is not None
-    signal_values = _signal_values(passes, sync)
-    images = {name for name, res in resources.items() if res.is_image}
-    subresources: dict[tuple, pm.Subresource] = {}  # (mips, layers) -> one immutable object per pair
-    state = plan_state
-    builder_ = _Barrier
-
-    def barriers(bs: list[csync.Barrier]) -> tuple[pm.Barrier, ...]:
-        out = []
-        for res, mips, layers, key in bs:
-            if res in images:
-                sub = subresources.get((mips, layers))
-                if sub is None:
-                    sub = subresources[(mips, layers)] = pm.Subresource(mips, layers)
-            else:
-                sub = None
-            out.append(builder_(res, sub, state(key.src), state(key.dst), key.aliases))
-        return tuple(out)
-
+    signals = sync.signals
+    signal_values = _signal_values(passes, signals)
+    scope_names: dict[int, tuple[tuple[str, ...], tuple[str, ...]]] = {}  # id(scope): the scopes live in sync
+    get_names = scope_names.get
+    access, get_sub = _Access, get_subresource
+    barriers, releases, waits = sync.barriers, sync.releases, sync.waits
     out = []
-    for i, p in enumerate(passes):
-        ps = sync.passes[i]
+    for i, (p, row) in enumerate(zip(passes, sync.access_sync, strict=True)):
         accesses = []
-        for a, s in zip(p.accesses, sync.access_sync[i], strict=True):
+        for a, s in zip(p.accesses, row, strict=True):
             mips = a.mips
             if mips is None:  # buffers and accels
                 sub = None
             else:
-                sub = subresources.get((mips, a.layers))
+                sub = get_sub((mips, a.layers))
                 if sub is None:
-                    sub = subresources[(mips, a.layers)] = pm.Subresource(mips, a.layers)
-            accesses.append(_Access(a.resource, sub, a.usage, _names(s.stages), _names(s.access), s.layout, a.write))
+                    sub = subresource(mips, a.layers)
+            found = get_names(id(s))
+            if found is None:
+                found = scope_names[id(s)] = _scope_names(s)
+            accesses.append(access(a.resource, sub, a.usage, found[0], found[1], s.layout, a.write))
+        pw = waits[i]
+        params = p.params
         out.append(_Pass(
-            p.name, i, 0, p.queue, p.kind, p.impl, _frozen(p.params), tuple(accesses),
-            barriers(ps.barriers) if ps.barriers else (),
-            barriers(ps.releases) if ps.releases else (),
-            tuple([_Wait(w.queue, signal_values[w.signal_pass], _names(w.stages)) for w in ps.waits])
-            if ps.waits else (),
-            (_Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if ps.signal else (),
+            p.name, i, 0, p.queue, p.kind, p.impl, _frozen(params) if params else pm.EMPTY, tuple(accesses),
+            barriers[i], releases[i],
+            tuple([_Wait(w.queue, signal_values[w.signal_pass], names(w.stages)) for w in pw]) if pw else (),
+            (_Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if signals[i] else (),
         ))
     return tuple(out)
 
 
 def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
-    spec, sync, placement = c.spec, c.sync, c.placement
+    spec, sync, placement, memory = c.spec, c.sync, c.placement, c.memory
     assert sync is not None and placement is not None
     out = []
     outputs = set(c.spec.outputs)
-    for name in sorted(c.memory):
-        res, mem = spec.resources[name], c.memory[name]
-        heap, offset = placement.offsets[name]
+    initial, final, offsets = sync.initial, sync.final, placement.offsets
+    for name in sorted(memory):
+        res, mem = spec.resources[name], memory[name]
+        heap, offset = offsets[name]
         lifetime = "output" if (name in outputs and res.lifetime == "transient") else res.lifetime
-        image = res.is_image
-        out.append(_Resource(
-            name=name, kind=res.kind, format=res.format.vk_name if res.format else None, bytes=mem.bytes,
-            size_bytes=None if image else res.bytes, alignment=mem.alignment, memory_type_bits=mem.memory_type_bits,
-            memory_class=mem.memory_class, usages=mem.usages, lifetime=lifetime, first=mem.first, last=mem.last,
-            heap=heap, offset=offset,
-            initial=_end_state(lifetime, sync.initial.get(name)), final=_end_state(lifetime, sync.final.get(name)),
-            extent=tuple(res.extent) if image else None, mips=res.mips if image else None,
-            layers=res.layers if image else None, samples=res.samples if image else None,
-            accel=_frozen_json(res.accel.as_plan()) if res.accel is not None else None, scratch_of=res.scratch_of,
+        fmt = res.format
+        accel = res.accel
+        if res.kind == "image":
+            size_bytes, extent, mips, layers, samples = None, tuple(res.extent), res.mips, res.layers, res.samples
+        else:
+            size_bytes, extent, mips, layers, samples = res.bytes, None, None, None, None
+        out.append(_Resource(  # positional, in PlanResource's field order (a keyword call costs more)
+            name, res.kind, fmt.vk_name if fmt else None, mem.bytes, size_bytes, mem.alignment, mem.memory_type_bits,
+            mem.memory_class, mem.usages, lifetime, mem.first, mem.last, heap, offset,
+            _end_state(lifetime, initial.get(name)), _end_state(lifetime, final.get(name)),
+            extent, mips, layers, samples, _frozen_json(accel.as_plan()) if accel is not None else None,
+            res.scratch_of,
         ))
     return tuple(out)
 
@@ -168,12 +158,12 @@ def _culled(name: str, reason: str, p: PassSpec, c: Compilation, used: Mapping[s
     return _Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
 
 
-def _signal_values(passes: Sequence[PassSpec], sync: csync.SyncResult) -> dict[int, int]:
+def _signal_values(passes: Sequence[PassSpec], signals: Sequence[bool]) -> dict[int, int]:
     """Timeline values per queue, 1, 2, ... in plan order."""
     counters: dict[str, int] = {}
     values: dict[int, int] = {}
     for i, p in enumerate(passes):
-        if sync.passes[i].signal:
+        if signals[i]:
             counters[p.queue] = counters.get(p.queue, 0) + 1
             values[i] = counters[p.queue]
     return values

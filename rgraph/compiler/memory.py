@@ -15,6 +15,7 @@ from typing import Protocol
 
 from rgraph.errors import RGraphError
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats
+from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
 Requirements = tuple[int, int, int]
@@ -52,36 +53,28 @@ class ResourceMemory:
     last: int
 
 
+_requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  # one per used resource
+
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
 _SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw",
                      "accel_build": "accel_storage", "accel_read": "accel_storage"}
 
 
 def usages_by_resource(passes: Sequence[PassSpec]) -> dict[str, set[str]]:
-    """Per resource: the usages ``passes`` make of it (``usages_and_lifetimes``' first half)."""
-    return usages_and_lifetimes(passes)[0]
-
-
-def usages_and_lifetimes(passes: Sequence[PassSpec]) -> tuple[dict[str, set[str]], dict[str, tuple[int, int]]]:
-    """Per resource: the usages of ``passes`` (raytrace indirect arguments also ``trace_indirect``)
-    and the first and last executed pass index."""
+    """Per resource: the usages ``passes`` make of it (raytrace indirect arguments also
+    ``trace_indirect``), as ``rgraph.compiler.trace`` records them for the executed passes."""
     used: dict[str, set[str]] = {}
-    spans: dict[str, tuple[int, int]] = {}
-    for i, p in enumerate(passes):
+    for p in passes:
         raytrace = p.kind == "raytrace"
         for a in p.accesses:
-            name = a.resource
-            found = used.get(name)
+            found = used.get(a.resource)
             if found is None:
-                used[name] = {a.usage}
-                spans[name] = (i, i)
+                found = used[a.resource] = {a.usage}
             else:
                 found.add(a.usage)
-                first = spans[name][0]
-                spans[name] = (first, i)
             if raytrace and a.usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
-                used[name].add("trace_indirect")
-    return used, spans
+                found.add("trace_indirect")
+    return used
 
 
 def requirements(
@@ -109,7 +102,7 @@ def requirements(
                 tiling = "linear"
         except RGraphError as err:
             raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None
-        out[name] = Requirement(size, align, bits, tiling)
+        out[name] = _requirement(size, align, bits, tiling)
     return out
 
 
@@ -131,7 +124,7 @@ def resource_memory(
     """Requirements, classes, usages and lifetimes of the used resources, in name order."""
     classes = memory_classes(reqs)
     return {
-        name: ResourceMemory(r.bytes, r.alignment, r.memory_type_bits, classes[name], tuple(sorted(used[name])),
+        name: _resource_memory(r.bytes, r.alignment, r.memory_type_bits, classes[name], tuple(sorted(used[name])),
                              spans[name][0], spans[name][1])
         for name, r in reqs.items()
     }

@@ -1,6 +1,6 @@
 """The compiler's phases: one ``Compilation`` value through a visible list of pure functions.
 
-    PHASES = cull -> schedule -> size_accels -> measure -> place -> synchronize -> emit
+    PHASES = cull -> schedule -> size_accels -> trace -> measure -> place -> synchronize -> emit
 
 Each phase takes a ``Compilation`` and returns a new one with its fields filled in
 (``dataclasses.replace``); none mutates its input or the ``Spec``. Only ``measure`` calls
@@ -29,6 +29,8 @@ from rgraph.compiler.emit import emit as emit_plan
 from rgraph.compiler.queue_order import cross_queue_conflicts
 from rgraph.compiler.sync import SyncResult
 from rgraph.compiler.sync import synchronize as synchronize_passes
+from rgraph.compiler.trace import Trace
+from rgraph.compiler.trace import trace as trace_passes
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.errors import RGraphError
 from rgraph.ir.cull import Culling
@@ -55,6 +57,7 @@ class Compilation:
     schedule: str = DEFAULT_SCHEDULE  # rgraph.ir.schedule mode (``--schedule``)
     culling: Culling | None = None
     passes: tuple[PassSpec, ...] = ()  # scheduled (executed) order
+    trace: Trace | None = None  # scopes, usages, lifetimes and cell timelines of ``passes``
     memory: Mapping[str, memory.ResourceMemory] = field(default_factory=dict)  # used resources, name order
     culled_bytes: Mapping[str, int] = field(default_factory=dict)  # resources only culled passes use
     placement: Placement | None = None
@@ -93,11 +96,19 @@ def size_accels(c: Compilation) -> Compilation:
     return replace(c, spec=spec, passes=tuple(size(spec, list(c.passes), c.provider)))
 
 
+def trace(c: Compilation) -> Compilation:
+    """One walk over the executed accesses (``rgraph.compiler.trace``): each access's sync2
+    scope, each resource's usages and lifetime, each cell's timeline, the cross-queue waits."""
+    return replace(c, trace=trace_passes(c.passes, c.spec.resources))
+
+
 def measure(c: Compilation) -> Compilation:
     """Sizes, alignments and memory classes of the used resources (and of culled-only ones)."""
-    assert c.culling is not None
+    assert c.culling is not None and c.trace is not None
     spec = c.spec
-    used, spans = memory.usages_and_lifetimes(c.passes)
+    traced = c.trace.resources
+    used = {name: r.usages for name, r in traced.items()}
+    spans = {name: (r.first, r.last) for name, r in traced.items()}
     reqs = memory.requirements(spec.resources, used, spec.outputs, c.provider)
     culled = {x.pass_name for x in c.culling.culled}
     culled_used = {r: u for r, u in memory.usages_by_resource([p for p in spec.passes if p.name in culled]).items()
@@ -111,7 +122,8 @@ def place(c: Compilation) -> Compilation:
     """Heaps and offsets: transients by the allocator policy (may alias), others dedicated."""
     try:
         aliasable = [n for n in c.memory if c.spec.resources[n].lifetime == "transient"]
-        conflicts = cross_queue_conflicts(c.passes, aliasable)
+        assert c.trace is not None
+        conflicts = cross_queue_conflicts(c.passes, c.trace, aliasable)
         placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs, conflicts)
     except ValueError as exc:
         raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
@@ -120,9 +132,9 @@ def place(c: Compilation) -> Compilation:
 
 def synchronize(c: Compilation) -> Compilation:
     """Barriers, queue-ownership releases, semaphore waits and signals per pass."""
-    assert c.placement is not None
+    assert c.placement is not None and c.trace is not None
     ranges = {n: (heap, off, off + c.memory[n].bytes) for n, (heap, off) in c.placement.offsets.items()}
-    return replace(c, sync=synchronize_passes(list(c.passes), c.spec.resources, c.aliases, ranges))
+    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, c.aliases, ranges))
 
 
 def emit(c: Compilation) -> Compilation:
@@ -132,7 +144,8 @@ def emit(c: Compilation) -> Compilation:
 
 Phase = Callable[[Compilation], Compilation]
 PHASES: tuple[tuple[str, Phase], ...] = (
-    ("cull", cull), ("schedule", schedule), ("size_accels", size_accels), ("measure", measure), ("place", place),
+    ("cull", cull), ("schedule", schedule), ("size_accels", size_accels), ("trace", trace),
+    ("measure", measure), ("place", place),
     ("synchronize", synchronize), ("emit", emit),
 )
 

@@ -1,6 +1,6 @@
 """Graph file + scene + params -> plan: the front end, then the compiler's phases.
 
-    load -> specialize -> [cull -> schedule -> measure -> place -> synchronize -> emit]
+    load -> specialize -> [cull -> schedule -> size_accels -> trace -> measure -> place -> synchronize -> emit]
 
 The bracketed phases are ``rgraph.compiler.phases.PHASES``: each a pure function of one
 ``Compilation`` value. The ``Spec`` is not changed after specialization (extra outputs

@@ -10,8 +10,8 @@ pairs of transients, disjoint in pass index, where it would not be: the placemen
 them as overlapping in time, so aliasing never adds a semaphore wait the ``dedicated``
 policy lacks (tests/compile/test_alias_queues.py checks it on random multi-queue graphs).
 
-The dedicated plan's waits are recomputed here the way ``sync`` derives them: a cell whose
-previous use was on another queue waits for that use.
+The dedicated plan's waits come from the trace (``rgraph.compiler.trace``), derived the way
+``sync`` derives them: a cell whose previous use was on another queue waits for that use.
 """
 
 from __future__ import annotations
@@ -19,70 +19,51 @@ from __future__ import annotations
 from bisect import bisect_left, bisect_right
 from collections.abc import Collection, Sequence
 
+from rgraph.compiler.trace import Trace
 from rgraph.spec.specialize import PassSpec
 
 
-def cross_queue_conflicts(passes: Sequence[PassSpec], candidates: Collection[str]) -> dict[str, set[str]]:
+def cross_queue_conflicts(passes: Sequence[PassSpec], trace: Trace, candidates: Collection[str]) -> dict[str, set[str]]:
     """Pairs of ``candidates`` (symmetric) that may not share memory although one ends before
-    the other starts: sharing would add a cross-queue wait. Empty for one-queue graphs."""
+    the other starts: sharing would add a cross-queue wait. Empty for one-queue graphs.
+    ``trace``: the passes' (``rgraph.compiler.trace``), whose ``waits`` are the dedicated plan's."""
     if len({p.queue for p in passes}) < 2:
         return {}
-    wanted = set(candidates)
+    waits = trace.waits
     firsts: dict[str, set[tuple[int, str]]] = {}  # resource -> (first pass of a cell, its queue)
-    span: dict[str, list[int]] = {}
-    last: dict[tuple, tuple[str, int]] = {}  # cell -> (queue, last pass)
-    waits: list[dict[str, int]] = []  # ``direct_waits``, in the same walk
-    for i, p in enumerate(passes):
-        queue = p.queue
-        pass_waits: dict[str, int] = {}
-        for a in p.accesses:
-            name = a.resource
-            want = name in wanted
-            if want:
-                s = span.get(name)
-                if s is None:
-                    span[name] = [i, i]
-                else:
-                    s[1] = i
-            for c in a.cells:
-                prev = last.get(c)
-                if prev is None:
-                    if want:
-                        if name in firsts:
-                            firsts[name].add((i, queue))
-                        else:
-                            firsts[name] = {(i, queue)}
-                elif prev[0] != queue and prev[1] != i and pass_waits.get(prev[0], -1) < prev[1]:
-                    pass_waits[prev[0]] = prev[1]
-                last[c] = (queue, i)
-        waits.append(pass_waits)
-    lasts: dict[str, dict[str, int]] = {}  # resource -> queue -> last pass of a cell ending there
-    for c, (q, i) in last.items():
-        if c[0] in wanted:
-            per = lasts.setdefault(c[0], {})
-            if per.get(q, -1) < i:
-                per[q] = i
     # Per queue q: the resources with a cell last used on q, by that last use. Sharing with a
     # later r adds a wait iff some cell of r first used on another queue does not already
     # wait for q at or after it: a range of this order, found by bisection.
     by_queue: dict[str, list[tuple[int, str]]] = {}
-    for name, per in lasts.items():
+    resources = trace.resources
+    for name in candidates:
+        r = resources[name]
+        firsts[name] = {(uses[0][0], uses[0][3]) for _, uses in r.cells}
+        per: dict[str, int] = {}  # queue -> last pass of a cell ending there
+        for _, uses in r.cells:
+            _, _, _, q, _ = end = uses[-1]
+            if per.get(q, -1) < end[0]:
+                per[q] = end[0]
         for q, j in per.items():
-            by_queue.setdefault(q, []).append((j, name))
+            if q in by_queue:
+                by_queue[q].append((j, name))
+            else:
+                by_queue[q] = [(j, name)]
     for rows in by_queue.values():
         rows.sort()
     keys = {q: [j for j, _ in rows] for q, rows in by_queue.items()}
     out: dict[str, set[str]] = {}
-    for r in sorted(span):
-        r_first = span[r][0]
+    none: dict[str, int] = {}
+    for r in sorted(candidates):
+        r_first = resources[r].first
         r_firsts = firsts[r]
         for q, rows in by_queue.items():
-            have = [waits[v].get(q, -1) for v, qv in r_firsts if qv != q]
+            have = [waits.get(v, none).get(q, -1) for v, qv in r_firsts if qv != q]
             if not have:
                 continue  # r starts on q only: a pipeline barrier orders it
             lo, hi = bisect_right(keys[q], min(have)), bisect_left(keys[q], r_first)
             for _, p in rows[lo:hi]:
-                if span[p][1] < r_first:
+                if resources[p].last < r_first:
                     if r in out:
                         out[r].add(p)
                     else:

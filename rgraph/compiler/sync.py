@@ -4,8 +4,11 @@ State is tracked per subresource cell (resource, mip, layer; a buffer is one cel
 its layout, owning queue, last write and the reads since. Each cell touched by a pass gets
 at most one barrier there; cells with identical barriers are merged into mip/layer
 rectangles, so a pass has one batch. Cells do not affect each other's barriers, so each
-cell's timeline is walked in one go (``_walk``: its state in local variables), resources in
-the order of their first pass, and the barriers and waits are then gathered per pass.
+cell's timeline (``rgraph.compiler.trace``) is walked in one go (``_walk``: its state in local
+variables), resources in the order of their first pass. A resource with one touched cell
+(every buffer) gets its plan barriers in the walk; the cells of the others are merged into
+rectangles once the resource is walked. The barriers are the plan's values
+(``rgraph.plan.model.Barrier``): emit does not rebuild them.
 
 Rules (DESIGN.md invariants): srcAccess holds writes only; a layout transition is a write;
 read-after-read in one layout needs nothing; the first read after a write gets one
@@ -21,185 +24,202 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from rgraph.compiler.alias_starts import PREVIOUS_FRAME, alias_state, with_partial_handoffs
-from rgraph.compiler.rectangles import BARRIER_ORDER, barriers_of, rectangles
-from rgraph.compiler.sync_inputs import Use, sync_inputs
-from rgraph.compiler.sync_types import EMPTY, Barrier, BarrierKey, PassSync, State, SyncResult, Wait
+from rgraph.compiler.alias_starts import alias_state, with_partial_handoffs
+from rgraph.compiler.plan_values import get_state, make_barrier, plan_state, subresource
+from rgraph.compiler.rectangles import mip_layer_rectangles
+from rgraph.compiler.sync_types import EMPTY, StateKey, SyncResult, Wait
+from rgraph.compiler.trace import Trace, Use
 from rgraph.ir.graph import Cell
+from rgraph.plan import model as pm
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
-__all__ = ["EMPTY", "Barrier", "BarrierKey", "PassSync", "State", "SyncResult", "Wait", "synchronize"]
+__all__ = ["EMPTY", "StateKey", "SyncResult", "Wait", "synchronize"]
 
 PERSISTENT = ("persistent", "imported")
-_new = tuple.__new__  # a named tuple's own ``__new__`` is a Python function: twice the cost per value
+EMPTY2 = (EMPTY, EMPTY)
 
 #: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
-#: is (pass, stages, write access) or None, reads the (pass, stages) since it, visible the dst
-#: scope (stages, access) of the barriers since it.
+#: is (stages, write access) of the last write or None, reads the stages of each read since it,
+#: visible the dst scope (stages, access) of the barriers since it.
 CellEnd = tuple
-#: What a pass gets from one of its cells: (position in the pass's cells, cell, barrier key or
-#: None, release pass or None, [(queue, pass)] to wait for, the wait's stages, and the barrier
-#: itself when the cell is its resource's only one, else None).
-Event = tuple
+#: A barrier's key: (src state, dst state, aliases); cells of one resource and pass with equal
+#: keys (and release pass) share one barrier rectangle.
+Key = tuple
+#: Where the walk puts what it finds, per executed pass: (barriers as (resource, [mips, layers,]
+#: plan barrier) sort entries, releases as (acquiring pass, resource, cell position, barriers),
+#: waits as queue -> (pass, stages), and for a resource of several cells its list of
+#: (pass, cell position, cell, key, release pass), else None).
+Sink = tuple
 
 
 def synchronize(
     passes: Sequence[PassSpec],
     resources: Mapping[str, ResourceSpec],
+    trace: Trace,
     alias_sources: Mapping[str, Sequence[str]] | None = None,
     ranges: Mapping[str, tuple[int, int, int]] | None = None,
 ) -> SyncResult:
-    """Barriers and semaphores for ``passes`` (executed order).
+    """Barriers and semaphores for ``passes`` (executed order; ``trace``: theirs).
 
     ``alias_sources`` maps a transient resource to the resources whose memory it reuses
     (all of them ended before it starts); ``ranges`` gives (heap, first byte, end byte) of
     the placed resources, so that older occupants reached through a partial hand-off count
     only where their bytes overlap.
     """
-    inputs = sync_inputs(passes, resources)
-    first_pass = inputs.first_pass
-    sources = with_partial_handoffs(alias_sources or {}, inputs.touched, resources, ranges)
-    cells_of: dict[str, list[tuple[Cell, list[Use]]]] = {}
-    for c, uses in inputs.timeline.items():
-        if c[0] in cells_of:
-            cells_of[c[0]].append((c, uses))
-        else:
-            cells_of[c[0]] = [(c, uses)]
-    events: list[list[Event] | None] = [None] * len(passes)
-    initial: dict[str, dict[Cell, State]] = {}
-    final: dict[str, dict[Cell, State]] = {}
-    ends: dict[str, list[tuple[State, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
+    count = len(passes)
+    touched = {name: len(r.cells) for name, r in trace.resources.items()}
+    sources = with_partial_handoffs(alias_sources or {}, touched, resources, ranges)
+    bars: list[list | None] = [None] * count
+    rels: list[list | None] = [None] * count
+    waits: list[dict | None] = [None] * count
+    initial: dict[str, dict[Cell, StateKey]] = {}
+    final: dict[str, dict[Cell, StateKey]] = {}
+    ends: dict[str, list[tuple[StateKey, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
     wanted = {pred for preds in sources.values() for pred in preds}
-    # every earlier occupant of a resource's memory ends before its first pass: walked before it
-    for name in sorted(cells_of, key=first_pass.__getitem__):
+    # resources in the order of their first pass: every earlier occupant of a resource's memory
+    # ends before it starts, so it is walked before it
+    for name, r in trace.resources.items():
         res = resources[name]
-        image = res.is_image
+        image = res.kind == "image"
         layout = "UNDEFINED" if image else None
-        starts: dict[Cell, State] = {}
-        finals: dict[Cell, State] = {}
-        kept: list[tuple[State, int | None]] | None = None
+        cells = r.cells
+        starts: dict[Cell, StateKey] = {}
+        finals: dict[Cell, StateKey] = {}
+        kept: list[tuple[StateKey, int | None]] | None = None
         if name in wanted:
             kept = ends[name] = []
         preds = sources.get(name)
-        single = len(cells_of[name]) == 1
+        multi: list | None = None
+        sub = None  # the one cell's subresource
+        if len(cells) > 1:
+            multi = []
+        elif image:
+            (_, mip, layer), _ = cells[0]
+            sub = subresource((mip, mip + 1), (layer, layer + 1))
+        sink = (bars, rels, waits, multi)
         if res.lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
-            for c, uses in cells_of[name]:
+            for c, uses in cells:
                 lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
-                                                                 (), (), False, None, c)
-                start = (lay, queue, (PREVIOUS_FRAME, write[1], write[2]) if write else None,
-                         [(PREVIOUS_FRAME, stages) for _, stages in reads], last, visible)
+                                                                 (), (), False, None, c, None)
+                start = (lay, queue, write, list(reads), last, visible)
                 starts[c] = _state(start)
-                end = _walk(uses, image, start, (), (), True, events, c, single)
+                end = _walk(uses, image, start, (), (), True, sink, c, sub)
                 finals[c] = st = _state(end)
                 if kept is not None:
                     kept.append((st, end[4]))
         else:
             aliases: tuple[str, ...] = ()
-            waits: tuple[tuple[str, int], ...] = ()
+            alias_waits: tuple[tuple[str, int], ...] = ()
             queue = write = last = None
             if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
-                stages, access, queue, last, aliases, waits = alias_state(
-                    preds, [end for pred in preds for end in ends.get(pred, ())], first_pass[name])
-                write = (PREVIOUS_FRAME, stages, access) if stages or access else None
-            for c, uses in cells_of[name]:
+                stages, access, queue, last, aliases, alias_waits = alias_state(
+                    preds, [end for pred in preds for end in ends.get(pred, ())], r.first)
+                write = (stages, access) if stages or access else None
+            first_state = _state((layout, queue, write, (), last, EMPTY2))  # every cell starts alike
+            for c, uses in cells:
                 start = (layout, queue, write, [], last, EMPTY2)
-                starts[c] = _state(start)
-                end = _walk(uses, image, start, aliases, waits, False, events, c, single)
+                starts[c] = first_state
+                end = _walk(uses, image, start, aliases, alias_waits, False, sink, c, sub)
                 finals[c] = st = _state(end)
                 if kept is not None:
                     kept.append((st, end[4]))
+        if multi:
+            _rectangles(name, multi, bars, rels)
         initial[name] = starts
         final[name] = finals
-    return SyncResult(_gather(events), inputs.syncs, final, initial)
+    return _gather(bars, rels, waits, trace, final, initial)
 
 
-EMPTY2 = (EMPTY, EMPTY)
-
-
-def _state(end: CellEnd) -> State:
+def _state(end: CellEnd) -> StateKey:
     """What later accesses must wait for: the reads since the write, else the write."""
     layout, queue, write, reads, _, _ = end
     if reads:
-        return _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[s for _, s in reads]), EMPTY, layout,
-                            queue))
+        return (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, queue)
     if write:
-        return _new(State, (write[1], write[2], layout, queue))
-    return _new(State, (EMPTY, EMPTY, layout, queue))
+        return (write[0], write[1], layout, queue)
+    return (EMPTY, EMPTY, layout, queue)
 
 
 def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...],
-          alias_waits: tuple[tuple[str, int], ...], last_prev: bool, events: list | None, c: Cell,
-          single: bool = False) -> CellEnd:
-    """Walk one cell through its uses from ``start``; append each pass's ``Event`` to
-    ``events[pass]`` (None: end state only). ``aliases``/``alias_waits``: the earlier occupants
-    of its memory (and (queue, last pass) of each) that its first use hands over and waits for;
-    ``last_prev``: the start state is the previous frame's; ``single``: the cell is its
-    resource's only one (its barriers need no merging into rectangles)."""
+          alias_waits: tuple[tuple[str, int], ...], last_prev: bool, sink: Sink | None, c: Cell,
+          sub: pm.Subresource | None) -> CellEnd:
+    """Walk one cell through its uses from ``start``; put what each pass gets into ``sink``
+    (None: end state only). ``aliases``/``alias_waits``: the earlier occupants of its memory
+    (and (queue, last pass) of each) that its first use hands over and waits for;
+    ``last_prev``: the start state is the previous frame's; ``sub``: the subresource of a
+    resource's only cell (its barriers are built here)."""
     layout, cq, write, reads, last_pass, visible = start
+    if sink is not None:
+        bars, rels, waits, multi = sink
     covered_until = -1  # index in ``uses`` of the last read already covered by a barrier
+    end = len(uses) - 1
     for k, (i, s, w, queue, pos) in enumerate(uses):
-        cross = cq is not None and cq != queue
-        if alias_waits:  # aliased memory used on another queue
-            wait_on = [(q, j) for q, j in alias_waits if q != queue]
-        elif cross:
-            wait_on = []
-        else:
+        if alias_waits or (cq != queue and cq is not None):
+            if alias_waits:  # aliased memory used on another queue
+                wait_on = [(q, j) for q, j in alias_waits if q != queue]
+            else:
+                wait_on = []
+            transfer = False
+            release_at = None
+            if cq != queue and cq is not None:
+                if last_pass is not None and not last_prev:
+                    wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
+                if image:
+                    transfer = layout not in (None, "UNDEFINED")
+                else:
+                    transfer = not aliases and (write is not None or bool(reads))
+                if transfer:
+                    release_at = last_pass
+            src_queue = cq if transfer else queue
+        else:  # the same queue as the cell's last use (or its first use), nothing to wait for
             wait_on = ()
-        transfer = False
-        release_at = None
-        if cross:
-            if last_pass is not None and not last_prev:
-                wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
-            if image:
-                transfer = layout not in (None, "UNDEFINED")
-            else:
-                transfer = not aliases and (write is not None or bool(reads))
-            if transfer:
-                release_at = last_pass
-        src_queue = cq if transfer else queue
+            transfer = False
+            release_at = None
+            src_queue = queue
         new_layout = s.layout
-        layout_change = new_layout != layout
         key = None
-        if w or layout_change:
+        if w or new_layout != layout:
             if reads:
-                src = _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]), EMPTY,
-                                   layout, src_queue))
+                src = (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, src_queue)
             elif write:
-                src = _new(State, (write[1], write[2], layout, src_queue))
+                src = (write[0], write[1], layout, src_queue)
             else:
-                src = _new(State, (EMPTY, EMPTY, layout, src_queue))
-            if src[0] or src[1] or layout_change or transfer:
+                src = (EMPTY, EMPTY, layout, src_queue)
+            if src[0] or src[1] or new_layout != layout or transfer:
                 if w:
-                    key = _new(BarrierKey, (src, _new(State, (s.stages, s.access, new_layout, queue)), aliases))
+                    key = (src, (s.stages, s.access, new_layout, queue), aliases)
                 else:  # a transition for a read group: cover the whole group
-                    dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                    if k == end or (u := uses[k + 1])[2] or u[1].layout != new_layout or u[3] != queue:
+                        dst_stages, dst_access, covered_until = s.stages, s.access, k  # a group of one
+                    else:
+                        dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
                     visible = (dst_stages, dst_access)
-                    key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, new_layout, queue)), aliases))
+                    key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
             if w:
-                write = (i, s.stages, s.writes)
+                write = s.write_scope
                 reads = []
                 covered_until = k
                 visible = EMPTY2
-            elif layout_change:  # a transition is a write; from UNDEFINED it happens once, at creation
-                write = (i, s.stages, EMPTY) if layout != "UNDEFINED" else None
-                reads = [(i, s.stages)]
-            else:
-                reads.append((i, s.stages))
+            else:  # a layout change: a transition is a write; from UNDEFINED it happens once, at creation
+                write = (s.stages, EMPTY) if layout != "UNDEFINED" else None
+                reads = [s.stages]
         else:  # a read in the current layout
             if transfer or (write and k > covered_until
                             and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
                 if reads:  # the write is already available: chain through the reads
-                    src = _new(State, (reads[0][1] if len(reads) == 1 else EMPTY.union(*[x for _, x in reads]),
-                                       EMPTY, layout, src_queue))
+                    src = (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, src_queue)
                 elif write:
-                    src = _new(State, (write[1], write[2], layout, src_queue))
+                    src = (write[0], write[1], layout, src_queue)
                 else:
-                    src = _new(State, (EMPTY, EMPTY, layout, src_queue))
-                dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
+                    src = (EMPTY, EMPTY, layout, src_queue)
+                if k == end or (u := uses[k + 1])[2] or u[1].layout != new_layout or u[3] != queue:
+                    dst_stages, dst_access, covered_until = s.stages, s.access, k  # a group of one
+                else:
+                    dst_stages, dst_access, covered_until = _group(uses, k, new_layout, queue)
                 visible = (dst_stages, dst_access)
                 if transfer or src[0] or src[1]:
-                    key = _new(BarrierKey, (src, _new(State, (dst_stages, dst_access, new_layout, queue)), aliases))
-            reads.append((i, s.stages))
+                    key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
+            reads.append(s.stages)
         layout = new_layout
         cq = queue
         last_pass = i
@@ -207,84 +227,123 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
             aliases = ()
             alias_waits = ()
             last_prev = False
-        if events is not None and (key is not None or wait_on):
-            wait_stages = EMPTY
-            if wait_on:
-                wait_stages = s.stages
-                if key is not None and src_queue == queue:
-                    # A semaphore wait orders only its own stages, and a barrier chains after it
-                    # only through its source stages: they must meet (the swapchain-acquire pattern).
-                    if not key[0][0]:
-                        key = key._replace(src=key[0]._replace(stages=s.stages))
-                    wait_stages = wait_stages | key[0][0]
-            if key is None:
-                event = (pos, c, None, None, wait_on, wait_stages, None)
-            else:
-                event = (pos, c, key, release_at, wait_on, wait_stages,
-                         _new(Barrier, (c[0], (c[1], c[1] + 1), (c[2], c[2] + 1), key)) if single else None)
-            found = events[i]
+        if sink is None or (key is None and not wait_on):
+            continue
+        if wait_on:
+            wait_stages = s.stages
+            if key is not None and src_queue == queue:
+                # A semaphore wait orders only its own stages, and a barrier chains after it
+                # only through its source stages: they must meet (the swapchain-acquire pattern).
+                src = key[0]
+                if not src[0]:
+                    src = (s.stages, src[1], src[2], src[3])
+                    key = (src, key[1], key[2])
+                wait_stages = wait_stages | src[0]
+            found = waits[i]
             if found is None:
-                events[i] = [event]
+                found = waits[i] = {}
+            for q, j in wait_on:
+                prev = found.get(q)
+                found[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
+        if key is None:
+            continue
+        if multi is not None:
+            multi.append((i, pos, c, key, release_at))
+            continue
+        src, dst, names = key
+        ps = get_state(src)
+        if ps is None:
+            ps = plan_state(src)
+        pd = get_state(dst)
+        if pd is None:
+            pd = plan_state(dst)
+        res = c[0]
+        barrier = make_barrier(res, sub, ps, pd, names)
+        found = bars[i]
+        if found is None:
+            bars[i] = [(res, barrier)]
+        else:
+            found.append((res, barrier))
+        if release_at is not None:
+            found = rels[release_at]
+            if found is None:
+                rels[release_at] = [(i, res, pos, (barrier,))]
             else:
-                found.append(event)
+                found.append((i, res, pos, (barrier,)))
     return layout, cq, write, reads, last_pass, visible
 
 
-def _gather(events: list[list[Event] | None]) -> list[PassSync]:
-    """Each pass's barriers, the releases it owes later acquires, its waits and signal."""
-    out = [PassSync() for _ in events]
-    for i, found in enumerate(events):
-        if found is None:
+def _rectangles(res: str, found: list[tuple[int, int, Cell, Key, int | None]], bars: list, rels: list) -> None:
+    """A resource of several cells: per pass, its cells with one key and release pass merged into
+    mip x layer rectangles (an acquire's rectangles equal its release's: the layer pairs
+    ownership transfers by exact subresource range)."""
+    # per pass: [key, release pass, first cell position, cells]; a pass has few keys per
+    # resource, compared in a list (hashing a key, nested tuples, costs more)
+    by_pass: dict[int, list[list]] = {}
+    for i, pos, c, key, release_at in found:
+        groups = by_pass.get(i)
+        if groups is None:
+            by_pass[i] = [[key, release_at, pos, [(c[1], c[2])]]]
             continue
-        ready: list[Barrier] = []  # one-cell resources' barriers
-        merged: list[tuple[Cell, BarrierKey, int | None]] = []  # cells of resources with several
-        # acquires grouped by their release pass too, so that each acquire's rectangles equal
-        # its release's (the layer pairs ownership transfers by exact subresource range)
-        release_groups: dict[tuple[int, str, BarrierKey], tuple[int, list[Cell]]] | None = None
-        waits: dict[str, tuple[int, frozenset[str]]] | None = None
-        for pos, c, key, release_at, wait_on, wait_stages, barrier in found:
-            if key is not None:
-                if barrier is not None:
-                    ready.append(barrier)
+        for group in groups:
+            if group[1] == release_at and group[0] == key:
+                group[3].append((c[1], c[2]))
+                if pos < group[2]:
+                    group[2] = pos
+                break
+        else:
+            groups.append([key, release_at, pos, [(c[1], c[2])]])
+    for i, groups in by_pass.items():
+        for (src, dst, names), release_at, first, cells in groups:
+            ps = get_state(src) or plan_state(src)
+            pd = get_state(dst) or plan_state(dst)
+            if len(cells) == 1:
+                ((mip, layer),) = cells
+                mips, layers = (mip, mip + 1), (layer, layer + 1)
+                entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))]
+            else:
+                entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
+                           for mips, layers in mip_layer_rectangles(cells)]
+            if bars[i] is None:
+                bars[i] = entries
+            else:
+                bars[i] += entries
+            if release_at is not None:
+                made = tuple([e[3] for e in entries])
+                if rels[release_at] is None:
+                    rels[release_at] = [(i, res, first, made)]
                 else:
-                    merged.append((c, key, release_at))
-                if release_at is not None:
-                    if release_groups is None:
-                        release_groups = {}
-                    group = (release_at, c[0], key)
-                    if group in release_groups:
-                        first, cs = release_groups[group]
-                        cs.append(c)
-                        if pos < first:
-                            release_groups[group] = (pos, cs)
-                    else:
-                        release_groups[group] = (pos, [c])
-            if wait_on:
-                if waits is None:
-                    waits = {}
-                for q, j in wait_on:
-                    prev = waits.get(q)
-                    waits[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
-        if merged:
-            ready += barriers_of(merged)
-        if ready:
-            if len(ready) > 1:
-                ready.sort(key=BARRIER_ORDER)
-            out[i].barriers = ready
-        if release_groups:
-            # by release pass and resource, then in the order the pass touches the cells
-            for (j, res, key), (_, cs) in sorted(release_groups.items(), key=_release_order):
-                out[j].releases.extend(rectangles(res, key, cs))
-        if waits:
-            for q, (j, stages) in sorted(waits.items()):
-                out[i].waits.append(Wait(q, j, frozenset(stages)))
-                out[j].signal = True
-    return out
+                    rels[release_at].append((i, res, first, made))
 
 
-def _release_order(item: tuple) -> tuple[int, str, int]:
-    (j, res, _), (first, _) = item
-    return j, res, first
+def _gather(bars: list, rels: list, waits: list, trace: Trace, final: dict, initial: dict) -> SyncResult:
+    """Each pass's barriers in (resource, mips, layers) order, the releases it owes later
+    acquires (by acquiring pass, resource, then the order that pass touches the cells), its
+    waits by queue and whether it signals."""
+    count = len(bars)
+    barriers: list[tuple[pm.Barrier, ...]] = [()] * count
+    releases: list[tuple[pm.Barrier, ...]] = [()] * count
+    pass_waits: list[tuple[Wait, ...]] = [()] * count
+    signals = [False] * count
+    for i in range(count):
+        found = bars[i]
+        if found is not None:
+            if len(found) == 1:
+                barriers[i] = (found[0][-1],)
+            else:
+                found.sort()  # (resource, [mips, layers]) never tie within a pass: barriers not compared
+                barriers[i] = tuple([e[-1] for e in found])
+        found = rels[i]
+        if found is not None:
+            if len(found) > 1:
+                found.sort()  # (acquiring pass, resource, cell position) never tie
+            releases[i] = tuple([b for e in found for b in e[3]])
+        found = waits[i]
+        if found is not None:
+            pass_waits[i] = tuple([Wait(q, j, stages) for q, (j, stages) in sorted(found.items())])
+            for _, (j, _) in found.items():
+                signals[j] = True
+    return SyncResult(barriers, releases, pass_waits, signals, trace.syncs, final, initial)
 
 
 def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:

@@ -2,36 +2,19 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import NamedTuple
 
 from rgraph.compiler.usages import Sync
 from rgraph.ir.graph import Cell
+from rgraph.plan import model as pm
 
 EMPTY: frozenset[str] = frozenset()
 
-
-class State(NamedTuple):
-    """Where a cell stands: stages/access of the last accesses that later ones must wait for.
-    (A named tuple: hashed and compared in C, as barrier group keys are many.)"""
-
-    stages: frozenset[str]
-    access: frozenset[str]  # writes only
-    layout: str | None
-    queue: str | None
-
-
-class BarrierKey(NamedTuple):
-    src: State
-    dst: State
-    aliases: tuple[str, ...] = ()
-
-
-class Barrier(NamedTuple):
-    resource: str
-    mips: tuple[int, int] | None
-    layers: tuple[int, int] | None
-    key: BarrierKey
+#: Where a cell stands: (stages, access, layout, queue) of the last accesses that later ones
+#: must wait for (access: writes only), stages and access frozensets; a plain tuple, hashed and
+#: compared in C (``rgraph.compiler.plan_values.plan_state`` gives the plan's ``State``).
+StateKey = tuple
 
 
 class Wait(NamedTuple):
@@ -40,17 +23,12 @@ class Wait(NamedTuple):
     stages: frozenset[str]
 
 
-@dataclass(slots=True)
-class PassSync:
-    barriers: list[Barrier] = field(default_factory=list)
-    releases: list[Barrier] = field(default_factory=list)
-    waits: list[Wait] = field(default_factory=list)
-    signal: bool = False
-
-
 @dataclass
 class SyncResult:
-    passes: list[PassSync]
+    barriers: list[tuple[pm.Barrier, ...]]  # per pass: before it
+    releases: list[tuple[pm.Barrier, ...]]  # per pass: queue-family releases after it
+    waits: list[tuple[Wait, ...]]  # per pass, by queue
+    signals: list[bool]  # per pass: a later pass waits for it
     access_sync: list[list[Sync]]  # per pass, per declared access
-    final: dict[str, dict[Cell, State]]  # per resource: end-of-frame state per cell
-    initial: dict[str, dict[Cell, State]]
+    final: dict[str, dict[Cell, StateKey]]  # per resource: end-of-frame state per cell
+    initial: dict[str, dict[Cell, StateKey]]

@@ -95,6 +95,11 @@ class Sync:
     def writes(self) -> frozenset[str]:
         return self.access & WRITE_ACCESS
 
+    @cached_property
+    def write_scope(self) -> tuple[frozenset[str], frozenset[str]]:
+        """(stages, write access): what a later access waits for after this one writes."""
+        return self.stages, self.writes
+
 
 @lru_cache(maxsize=4096)
 def sync_of(

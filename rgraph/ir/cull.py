@@ -60,7 +60,9 @@ def cull(spec: Spec) -> Culling:
 def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
     """``raw_ancestors(dependencies(kept), _roots(spec, kept))`` as one backwards walk:
     ``wanted`` holds the cells that live passes read and whose producer is not met yet,
-    ``claimed`` the cells of kept resources that a later pass writes last."""
+    ``claimed`` the cells of kept resources that a later pass writes last. (Within a pass,
+    a write's cells overlap no other access's: ``specialize`` checks it. So a live pass's
+    writes and reads update ``wanted`` in one loop, a read-write access as a read.)"""
     keep = {n for n, r in spec.resources.items() if r.lifetime in ("persistent", "imported", "output")}
     keep.update(spec.outputs)
     wanted: set[Cell] = set()
@@ -73,19 +75,19 @@ def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
         for access in accesses:
             if access.write:
                 cs = access.cells
-                kept_resource = access.resource in keep
-                if not live and (not wanted.isdisjoint(cs) or (kept_resource and not claimed.issuperset(cs))):
-                    live = True
-                if kept_resource:
+                if access.resource in keep:
+                    if not live and (not claimed.issuperset(cs) or not wanted.isdisjoint(cs)):
+                        live = True
                     claimed.update(cs)
+                elif not live and not wanted.isdisjoint(cs):
+                    live = True
         if not live:
             continue
         alive.add(p.name)
         for access in accesses:
-            if access.write:
+            if access.write and access.usage not in rw:
                 wanted.difference_update(access.cells)
-        for access in accesses:
-            if not access.write or access.usage in rw:  # ``reads(access)``
+            else:  # ``reads(access)``
                 wanted.update(access.cells)
     return alive
 
@@ -102,6 +104,8 @@ def _drop_unproduced_reads(
     spec: Spec, removed_reason: dict[str, str]
 ) -> tuple[list[PassSpec], list[DroppedRead], list[Culled]]:
     """Forward walk in program order: who produced each cell, given the removals so far."""
+    if not removed_reason:
+        return _drop_optional_reads(spec)
     producer: dict[tuple[str, int, int], str | None] = {}
     lost: dict[tuple[str, int, int], str] = {}  # cell -> removed pass that would have written it
     kept: list[PassSpec] = []
@@ -156,3 +160,30 @@ def _drop_unproduced_reads(
         if not removed:
             kept.append(replace(p, accesses=tuple(new_accesses)) if new_accesses is not None else p)
     return kept, dropped, cascade
+
+
+def _drop_optional_reads(spec: Spec) -> tuple[list[PassSpec], list[DroppedRead], list[Culled]]:
+    """``_drop_unproduced_reads`` when the scene removed no pass: no producer is lost, so no
+    pass is removed and only optional reads of cells nothing wrote are dropped. A pass's
+    writes are noted as they come (they overlap none of its reads: ``specialize`` checks it).
+    Without optional reads (one scan finds them) nothing is dropped: no walk."""
+    if not any(a.optional for p in spec.passes for a in p.accesses):
+        return list(spec.passes), [], []
+    produced: set[tuple[str, int, int]] = set()
+    kept: list[PassSpec] = []
+    dropped: list[DroppedRead] = []
+    persistent = {n for n, r in spec.resources.items() if r.lifetime in ("persistent", "imported")}
+    for p in spec.passes:
+        new_accesses = None  # the accesses kept once one is dropped
+        for k, access in enumerate(p.accesses):
+            if access.write:
+                produced.update(access.cells)
+            elif access.optional and access.resource not in persistent and not produced.issuperset(access.cells):
+                dropped.append(DroppedRead(p.name, access.resource, "optional read with no producer"))
+                if new_accesses is None:
+                    new_accesses = list(p.accesses[:k])
+                continue
+            if new_accesses is not None:
+                new_accesses.append(access)
+        kept.append(replace(p, accesses=tuple(new_accesses)) if new_accesses is not None else p)
+    return kept, dropped, []

@@ -2,9 +2,13 @@
 
 A frozen dataclass's ``__init__`` sets every field through ``object.__setattr__``; the emit
 phase builds thousands of ``Access``, ``Barrier`` and ``PlanPass`` values per compile. A
-builder has the same signature (fields, defaults) and returns an equal object, but stores
-the fields with the slots' own descriptors: about twice as fast. Only for classes without
-``__post_init__`` (none of the plan's have one).
+builder has the same signature (fields, defaults) and returns an equal object of the same
+class, built as an instance of a plain (mutable) twin class with the same slots, its fields
+set by ordinary attribute stores, and then given the frozen class (``__class__``
+assignment: CPython allows it between classes of one object layout, and checks it). That is
+about half the cost of the ``__init__``'s, or of setting each slot through its descriptor
+(the fallback, for a class whose slots are spread over several bases). Only for classes
+without ``__post_init__`` (none of the plan's have one).
 """
 
 from __future__ import annotations
@@ -16,14 +20,29 @@ from typing import Any, TypeVar
 T = TypeVar("T")
 
 
+def _twin(cls: type) -> type | None:
+    """A plain class with ``cls``'s object layout (its slots, in one class), or None."""
+    with_slots = [k for k in cls.__mro__ if vars(k).get("__slots__")]
+    if len(with_slots) != 1:
+        return None
+    twin = type(f"_Mutable{cls.__name__}", (), {"__slots__": tuple(with_slots[0].__slots__)})
+    probe = object.__new__(twin)
+    try:
+        probe.__class__ = cls
+    except TypeError:
+        return None
+    return twin
+
+
 def builder(cls: type[T]) -> Callable[..., T]:
     """A function ``f(*fields)`` (keywords and defaults as the class's ``__init__``) that
     returns ``cls(*fields)``."""
     if not dataclasses.is_dataclass(cls) or hasattr(cls, "__post_init__") or "__slots__" not in vars(cls):
         raise TypeError(f"{cls.__name__}: a slots dataclass without __post_init__ expected")
     fields = dataclasses.fields(cls)
-    scope: dict[str, Any] = {"_new": object.__new__, "_cls": cls}
-    params, body = [], ["    o = _new(_cls)"]
+    twin = _twin(cls)
+    scope: dict[str, Any] = {"_new": object.__new__, "_cls": cls, "_twin": twin}
+    params, body = [], [f"    o = _new({'_twin' if twin else '_cls'})"]
     for k, f in enumerate(fields):
         if f.default_factory is not dataclasses.MISSING:
             raise TypeError(f"{cls.__name__}.{f.name}: default_factory is not supported")
@@ -32,8 +51,13 @@ def builder(cls: type[T]) -> Callable[..., T]:
         else:
             scope[f"_d{k}"] = f.default
             params.append(f"{f.name}=_d{k}")
-        scope[f"_s{k}"] = getattr(cls, f.name).__set__
-        body.append(f"    _s{k}(o, {f.name})")
+        if twin:
+            body.append(f"    o.{f.name} = {f.name}")
+        else:
+            scope[f"_s{k}"] = getattr(cls, f.name).__set__
+            body.append(f"    _s{k}(o, {f.name})")
+    if twin:
+        body.append("    o.__class__ = _cls")
     source = f"def build({', '.join(params)}):\n" + "\n".join(body) + "\n    return o\n"
     exec(source, scope)  # noqa: S102 - generated from the dataclass's own field names
     fn = scope["build"]

@@ -52,3 +52,27 @@ def test_walk_keeps_the_last_writer_of_each_cell(tmp_path: Path) -> None:
     path.write_text(PARTIAL)
     walk, edges = both(frontend(path, size=(16, 16)).spec)
     assert walk == edges == {"both_mips", "mip0_again"}
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(0, 10**6), passes=st.integers(2, 60))
+def test_forward_walk_without_removals_equals_the_general_walk(tmp_path: Path, seed: int, passes: int) -> None:
+    """With no pass removed by the scene, ``_drop_unproduced_reads`` takes a one-loop path
+    (``_drop_optional_reads``); the general walk, made to run by a removal of no pass, agrees."""
+    path = tmp_path / f"g_{seed}_{passes}.yaml"
+    path.write_text(to_yaml(random_graph(seed, passes)))
+    spec = frontend(path, size=(16, 16)).spec
+    if spec.removed:
+        return
+    assert _drop_unproduced_reads(spec, {}) == _drop_unproduced_reads(spec, {"<no such pass>": "test"})
+
+
+def test_forward_walk_drops_an_optional_read_nothing_writes() -> None:
+    """forward_noao.yaml: nothing writes ``ao``; both walks drop the optional read alike."""
+    from locations import TESTS
+
+    spec = frontend(TESTS / "pass_graphs" / "forward_noao.yaml", size=(32, 32)).spec
+    assert not spec.removed
+    fast = _drop_unproduced_reads(spec, {})
+    assert [(d.pass_name, d.resource) for d in fast[1]] == [("forward", "ao")]
+    assert fast == _drop_unproduced_reads(spec, {"<no such pass>": "test"})

@@ -21,7 +21,7 @@ def _start(tmp_path, seed: int, passes: int) -> Compilation:
 
 
 def test_the_phases_in_order():
-    assert [name for name, _ in PHASES] == ["cull", "schedule", "size_accels", "measure", "place",
+    assert [name for name, _ in PHASES] == ["cull", "schedule", "size_accels", "trace", "measure", "place",
                                              "synchronize", "emit"]
 
 

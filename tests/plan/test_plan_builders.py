@@ -34,3 +34,31 @@ def test_builders_equal_the_dataclass_constructors() -> None:
 def test_builder_refuses_classes_it_cannot_build() -> None:
     with pytest.raises(TypeError):
         builder(pm.Plan)  # no slots, default_factory fields
+
+
+def test_every_built_class_takes_the_twin_path() -> None:
+    """The emitted classes are built through a mutable twin of their layout (the fast path),
+    and an object of the twin becomes one of the class."""
+    from rgraph.plan.builders import _twin
+
+    for cls in (pm.Access, pm.Barrier, pm.PlanPass, pm.PlanResource, pm.Wait, pm.Signal, pm.Culled):
+        twin = _twin(cls)
+        assert twin is not None, cls
+        assert set(twin.__slots__) == {f.name for f in dataclasses.fields(cls)}
+
+
+def test_builder_without_a_twin_still_builds_equal_objects() -> None:
+    """A class whose slots are spread over two classes falls back to the slots' descriptors."""
+    from rgraph.plan.builders import _twin
+
+    @dataclasses.dataclass(frozen=True, slots=True)
+    class Base:
+        a: int
+
+    @dataclasses.dataclass(frozen=True, slots=True)
+    class Child(Base):
+        b: int = 2
+
+    assert _twin(Child) is None
+    made = builder(Child)(1)
+    assert type(made) is Child and made == Child(1, 2)

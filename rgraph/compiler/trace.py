@@ -1,0 +1,160 @@
+"""The trace phase: one walk over the executed passes' accesses, for every later phase.
+
+It gives each access its sync2 scope (``usages.sync_of``; read groups moved to GENERAL by
+``read_layouts``), each resource its usages, its first and last pass and the timeline of
+each of its cells (``Use``: the accesses of one pass to one cell merged into one), and each
+pass the other queues it already waits for (a cell whose previous use was on another
+queue). ``measure`` reads the usages and lifetimes, ``place`` the cross-queue waits
+(``queue_order``), ``synchronize`` the scopes and timelines: each access is visited once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+from rgraph.compiler.read_layouts import to_general
+from rgraph.compiler.usages import Sync, merge, sync_of
+from rgraph.ir.graph import Cell
+from rgraph.plan.builders import builder
+from rgraph.spec.specialize import PassSpec, ResourceSpec
+
+#: One pass's use of a cell: (executed pass index, merged sync, written, queue, position of the
+#: cell in the pass's cell list); a plain tuple (one per cell per pass: a named tuple costs twice
+#: as much to build).
+Use = tuple[int, Sync, bool, str, int]
+
+_SCOPES: dict[tuple, Sync] = {}  # sync_of by (usage, kind, stages, format code, refit)
+
+
+@dataclass(slots=True)
+class ResourceTrace:
+    """One used resource: its usages (raytrace indirect arguments also ``trace_indirect``), its
+    first and last executed pass, and its cells with their uses, in first-touch order."""
+
+    usages: set[str]
+    first: int
+    last: int
+    cells: list[tuple[Cell, list[Use]]]
+    code: int  # format part of the scope's key: image + 2 * depth + 4 * stencil
+    group: list[tuple[int, int, bool, str]] | None  # read_layouts candidates: (pass, access, write, usage)
+
+
+_new_trace = builder(ResourceTrace)
+
+
+@dataclass
+class Trace:
+    syncs: list[list[Sync]]  # per pass, per declared access
+    resources: dict[str, ResourceTrace]  # used resources, in the order of their first use
+    #: per pass (only those that have one): queue -> the latest pass on that queue that a cell's
+    #: previous use was, i.e. the semaphore waits the dedicated plan has there
+    waits: dict[int, dict[str, int]]
+
+
+def _start(res: ResourceSpec, i: int, usage: str) -> ResourceTrace:
+    """A resource's trace at its first use (pass ``i``, ``usage``)."""
+    fmt = res.format
+    image = res.kind == "image"
+    depth, stencil = bool(fmt and fmt.has_depth), bool(fmt and fmt.has_stencil)
+    # read_layouts' candidates: transient colour images
+    group = [] if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil else None
+    return _new_trace({usage}, i, i, [], image + 2 * depth + 4 * stencil, group)
+
+
+def _scope(key: tuple) -> Sync:
+    usage, kind, stages, code, refit = key
+    if len(_SCOPES) > 4096:
+        _SCOPES.clear()
+    found = _SCOPES[key] = sync_of(usage, kind, explicit_stages=stages, is_image=bool(code & 1),
+                                   depth_format=bool(code & 2), stencil_format=bool(code & 4), refit=refit)
+    return found
+
+
+def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> Trace:
+    """Scopes, usages, lifetimes, timelines and cross-queue waits in one walk; the reads
+    ``read_layouts`` moves to GENERAL are patched in afterwards (a few per graph)."""
+    syncs: list[list[Sync]] = []
+    info: dict[str, ResourceTrace] = {}
+    full: dict[str, tuple] = {}  # read-group candidates: (0, mips), (0, layers)
+    timeline: dict[Cell, list[Use]] = {}
+    waits: dict[int, dict[str, int]] = {}
+    scopes = _SCOPES
+    get_info, get_uses, get_scope = info.get, timeline.get, scopes.get
+    for i, p in enumerate(passes):
+        queue, kind = p.queue, p.kind
+        raytrace = kind == "raytrace"
+        row: list[Sync] = []
+        pos = 0
+        for j, a in enumerate(p.accesses):
+            name, usage, w = a.resource, a.usage, a.write
+            r = get_info(name)
+            if r is None:
+                res = resources[name]
+                r = info[name] = _start(res, i, usage)
+                if r.group is not None:
+                    full[name] = ((0, res.mips), (0, res.layers))
+            else:
+                r.usages.add(usage)
+                r.last = i
+            if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
+                r.usages.add("trace_indirect")
+            key = (usage, kind, a.stages, r.code, a.refit)
+            s = get_scope(key)
+            if s is None:
+                s = _scope(key)
+            row.append(s)
+            group = r.group
+            if group is not None:
+                whole = full[name]
+                if a.mips != whole[0] or a.layers != whole[1]:  # not the whole image: never unified
+                    r.group = None
+                else:
+                    group.append((i, j, w, usage))
+            for c in a.cells:
+                uses = get_uses(c)
+                if uses is None:
+                    timeline[c] = uses = [(i, s, w, queue, pos)]
+                    r.cells.append((c, uses))
+                    pos += 1
+                    continue
+                prev = uses[-1]
+                if prev[0] == i:  # a second access to the cell in this pass: one merged use
+                    uses[-1] = (i, merge(prev[1], s), prev[2] or w, queue, prev[4])
+                    continue
+                q = prev[3]
+                if q != queue:  # the dedicated plan waits for that use
+                    found = waits.get(i)
+                    if found is None:
+                        waits[i] = {q: prev[0]}
+                    elif found.get(q, -1) < prev[0]:
+                        found[q] = prev[0]
+                uses.append((i, s, w, queue, pos))
+                pos += 1
+        syncs.append(row)
+    moved = to_general({name: r.group for name, r in info.items() if r.group is not None}, syncs)
+    general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
+    for i, j in moved:
+        scope = syncs[i][j]
+        found = general.get(id(scope))
+        if found is None:
+            found = general[id(scope)] = (scope, replace(scope, layout="GENERAL"))
+        syncs[i][j] = found[1]
+    for i, j in moved:
+        _repatch(passes[i], i, passes[i].accesses[j].cells, syncs[i], timeline)
+    return Trace(syncs, info, waits)
+
+
+def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], timeline: dict[Cell, list[Use]]) -> None:
+    """Pass ``i``'s use of ``cells`` with its accesses' (changed) syncs merged again."""
+    for c in cells:
+        merged = None
+        for a, s in zip(p.accesses, row, strict=True):
+            if c in a.cells:
+                merged = s if merged is None else merge(merged, s)
+        uses = timeline[c]
+        for k in range(len(uses) - 1, -1, -1):
+            if uses[k][0] == i:
+                _, _, w, queue, pos = uses[k]
+                uses[k] = (i, merged, w, queue, pos)
+                break

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rgraph.memory.elastic import improve
 from rgraph.memory.greedy import best_fit, orderings
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block
@@ -97,17 +98,29 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
         return best
     budget = int(time_budget_s * OPS_PER_SECOND)
     if budget < inst.n * inst.n // 2 + inst.pair_count:
-        return best  # not even one dive (each node scans the blocks left) would finish
+        return best  # not even one dive (each step scans the blocks left) would finish
     search = _Bisection(inst, best)
     if exact:
         first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))
-        left = search.run(first) + budget - first
+        left = search.elastic(first) + budget - first
         at_bound = int(budget * EXACT_BOUND_SHARE)
         left = search.attempt(lb, None, min(at_bound, left)) + max(left - at_bound, 0)
         search.run(left)
     else:
-        search.run(budget)
+        first = int(budget * FIRST_BISECTION_SHARE)
+        left = search.run(first) + budget - first
+        search.run(search.elastic(left))
     return search.best
+
+
+#: ``aliased``: the share of the budget for a first bisection (it settles small instances,
+#: proving them optimal) before the elastic dives (``rgraph.memory.elastic``) get the rest;
+#: what the dives leave (they stop at the bound or when they stall) goes back to the
+#: bisection. The dives find far lower peaks than the search above the bound.
+FIRST_BISECTION_SHARE = 0.1
+
+#: The order of the elastic dives' squeaky-wheel chains (the first preorders dived first).
+ELASTIC_ORDERS = ("TAW", "TWA", "WAT")
 
 
 #: Where the bisection tries next, as a fraction of the way from the best peak down to the
@@ -138,6 +151,20 @@ class _Bisection:
         self.orders = [preorder(inst, h) for h in PREORDERINGS]
         self.low = self.infeasible = self.lb - 1  # infeasible: the highest proven too small
         self.rounds = 1
+
+    def elastic(self, budget: int) -> int:
+        """Elastic dives (``rgraph.memory.elastic.improve``) for up to ``budget`` operations;
+        returns what is left."""
+        if self.best.proven or budget <= 0:
+            return max(budget, 0)
+        orders = {h: o for h, o in zip(PREORDERINGS, self.orders, strict=True)}
+        found = improve(self.inst, [orders.get(h) or preorder(self.inst, h) for h in ELASTIC_ORDERS],
+                        self.best.peak, budget)
+        if found.offsets is not None:
+            self.best = ClassResult(found.offsets, found.peak, self.lb, f"elastic:{found.dives}")
+            if found.peak <= self.lb:
+                self.best.proven = True
+        return budget - found.ops
 
     def attempt(self, capacity: int, rounds: int | None, budget: int) -> int:
         """Try one capacity; returns the budget left."""

@@ -2,12 +2,15 @@
 
 1. Greedy best fit under several orderings (size, area, lifetime, start, contention), keep
    the lowest peak: fast and already within a few percent on typical render graphs.
-2. If the peak is above the lower bound, MiniMalloc's solver (``rgraph.memory.search``)
-   decides capacities by bisection between the bound (tried first) and the best peak
-   found, each with MiniMalloc's round robin over its three preorderings; when the
-   bisection closes it starts again with one more (doubled) round. Any placement it finds
-   replaces the greedy one; it stops at the bound or when a capacity just below the peak
-   is proven infeasible.
+2. If the peak is above the lower bound: elastic dives (``rgraph.memory.elastic``:
+   MiniMalloc's search from the bound, raising the capacity where it would backtrack,
+   squeaky-wheel chains over three preorders) until the bound, the budget, or they stall.
+3. With what the dives left, MiniMalloc's solver (``rgraph.memory.search``) decides
+   capacities by bisection between the bound (tried first) and the best peak found, each
+   with MiniMalloc's round robin over its three preorderings; when the bisection closes it
+   starts again with one more (doubled) round. Any placement it finds replaces the best
+   one; it stops at the bound or when a capacity just below the peak is proven infeasible.
+   ``optimal`` runs the dives first, then MiniMalloc's own run at the bound, then this.
 
 The time budget is turned into an operation count (``OPS_PER_SECOND``) so that results are
 the same on every machine; the real time taken varies with the machine.
@@ -73,10 +76,10 @@ class ClassResult:
 
 
 def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> ClassResult:
-    """Greedy, then (above the bound) the search within ``time_budget_s``. ``exact``
-    (the ``optimal`` policy): after a first share of bisection, most of the budget goes to
-    MiniMalloc's own run at the bound (round robin with no round limit), the rest back to
-    the bisection."""
+    """Greedy, then (above the bound) elastic dives and the search within
+    ``time_budget_s``. ``exact`` (the ``optimal`` policy): after a first share of elastic
+    dives, most of the budget goes to MiniMalloc's own run at the bound (round robin with no
+    round limit), the rest to the bisection."""
     lb = inst.lower_bound()
     best: ClassResult | None = None
     for name, order in orderings(inst):
@@ -101,23 +104,15 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
         return best  # not even one dive (each step scans the blocks left) would finish
     search = _Bisection(inst, best)
     if exact:
-        first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))
+        first = min(budget // EXACT_ELASTIC_SHARE, int(EXACT_ELASTIC_S * OPS_PER_SECOND))
         left = search.elastic(first) + budget - first
         at_bound = int(budget * EXACT_BOUND_SHARE)
         left = search.attempt(lb, None, min(at_bound, left)) + max(left - at_bound, 0)
         search.run(left)
     else:
-        first = int(budget * FIRST_BISECTION_SHARE)
-        left = search.run(first) + budget - first
-        search.run(search.elastic(left))
+        search.run(search.elastic(budget))
     return search.best
 
-
-#: ``aliased``: the share of the budget for a first bisection (it settles small instances,
-#: proving them optimal) before the elastic dives (``rgraph.memory.elastic``) get the rest;
-#: what the dives leave (they stop at the bound or when they stall) goes back to the
-#: bisection. The dives find far lower peaks than the search above the bound.
-FIRST_BISECTION_SHARE = 0.1
 
 #: The order of the elastic dives' squeaky-wheel chains (the first preorders dived first).
 ELASTIC_ORDERS = ("TAW", "TWA", "WAT")
@@ -130,12 +125,12 @@ STEP = 0.25
 #: The first round's node limit per heuristic, in blocks (MiniMalloc: 2).
 FIRST_LIMIT = 2.0
 
-#: ``optimal``: one part in this many of the budget, at most ``EXACT_BISECTION_S``, goes
-#: to the bisection first (a good placement early), then up to ``EXACT_BOUND_SHARE`` of it
-#: to MiniMalloc's run at the bound, the rest back to the bisection (where the bound is
-#: out of reach, as on MiniMalloc D and J).
-EXACT_BISECTION_SHARE = 5
-EXACT_BISECTION_S = 0.5
+#: ``optimal``: one part in this many of the budget, at most ``EXACT_ELASTIC_S``, goes
+#: to elastic dives first (a good placement early; often the bound itself), then up to
+#: ``EXACT_BOUND_SHARE`` of it to MiniMalloc's run at the bound, the rest to the bisection
+#: (where the bound is out of reach, as on MiniMalloc D and J).
+EXACT_ELASTIC_SHARE = 5
+EXACT_ELASTIC_S = 0.5
 EXACT_BOUND_SHARE = 0.85
 
 

@@ -260,7 +260,8 @@ def improve(inst: Instance, orders: Sequence[Sequence[int]], incumbent: int, ops
         seen[c].add(key)
         k += 1
         found = dive(inst, chains[c], bound, ops_budget - spent, give_up_at=peak)
-        if found is None:
+        if found is None:  # out of operations: they were spent
+            spent = ops_budget
             break
         spent += found.ops
         dives += 1

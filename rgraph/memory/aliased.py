@@ -30,9 +30,11 @@ from rgraph.memory.model import Block
 from rgraph.memory.search import PREORDERINGS, preorder, solve_capacity
 
 #: Search operations (blocks scanned per node, neighbours and sections per placement:
-#: ``CapacitySearch.ops``) granted per second of budget, about what this 2-core machine
-#: does (2.3-6 M/s measured on the MiniMalloc traces). The budget is counted in operations,
-#: so results are the same on every machine; the real time taken varies with the machine.
+#: ``CapacitySearch.ops``; the elastic dives charge theirs in the same unit, see
+#: ``rgraph.memory.elastic.STEP_OPS``) granted per second of budget, about what this 2-core
+#: machine does (search 2.3-6 M/s, dives 4.5-7.7 M/s measured on the MiniMalloc traces).
+#: The budget is counted in operations, so results are the same on every machine; the real
+#: time taken varies with the machine.
 OPS_PER_SECOND = 4_000_000
 
 #: The greedy orderings cost about linearly in the pairs of blocks alive at the same time
@@ -79,7 +81,7 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
     """Greedy, then (above the bound) elastic dives and the search within
     ``time_budget_s``. ``exact`` (the ``optimal`` policy): after a first share of elastic
     dives, most of the budget goes to MiniMalloc's own run at the bound (round robin with no
-    round limit), the rest to the bisection."""
+    round limit), the rest to more dives and the bisection."""
     lb = inst.lower_bound()
     best: ClassResult | None = None
     for name, order in orderings(inst):
@@ -108,7 +110,7 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
         left = search.elastic(first) + budget - first
         at_bound = int(budget * EXACT_BOUND_SHARE)
         left = search.attempt(lb, None, min(at_bound, left)) + max(left - at_bound, 0)
-        search.run(left)
+        search.run(search.elastic(left // 2) + left - left // 2)
     else:
         search.run(search.elastic(budget))
     return search.best
@@ -127,8 +129,8 @@ FIRST_LIMIT = 2.0
 
 #: ``optimal``: one part in this many of the budget, at most ``EXACT_ELASTIC_S``, goes
 #: to elastic dives first (a good placement early; often the bound itself), then up to
-#: ``EXACT_BOUND_SHARE`` of it to MiniMalloc's run at the bound, the rest to the bisection
-#: (where the bound is out of reach, as on MiniMalloc D and J).
+#: ``EXACT_BOUND_SHARE`` of it to MiniMalloc's run at the bound, the rest half to more
+#: dives, half to the bisection (where the bound is out of reach, as on MiniMalloc D and J).
 EXACT_ELASTIC_SHARE = 5
 EXACT_ELASTIC_S = 0.5
 EXACT_BOUND_SHARE = 0.85

@@ -14,10 +14,9 @@ needs it, so the peak lands close to what the packing of the lower sections allo
 
 ``improve`` repeats dives, each time moving the blocks that were still to place in the
 sections that forced a raise to the front of the preorder (squeaky wheel: they get the
-low offsets next time), round robin over MiniMalloc's three preorders.
+low offsets next time), round robin over chains started from different preorders.
 
-Work is counted in the same operations as the search (blocks scanned per step, neighbours
-and sections per candidate tried, blocks scanned when a section's floor is looked up), so
+Work is counted in the search's unit of operations (weighted: :data:`STEP_OPS`), so
 results do not depend on the machine.
 """
 
@@ -46,15 +45,11 @@ ROW_SHARE = 8
 @dataclass
 class Dive:
     offsets: list[int] | None  # None: given up (the peak would reach ``give_up_at``)
-    peak: int
+    peak: int  # of the placement; when given up, the capacity reached
     #: Blocks still to place, at a raise, in the sections that set the new capacity, in the
     #: order met (duplicates possible): the squeaky wheel's input.
     blamed: list[int]
     ops: int
-
-
-class _OutOfOps(Exception):
-    pass
 
 
 def dive(inst: Instance, order: Sequence[int], capacity: int, ops_limit: int | None = None,

@@ -39,7 +39,10 @@ def shared_dir() -> Path:
 def instances(quick: bool) -> list[tuple[str, str, list[Block]]]:
     """(group, name, blocks) for every instance."""
     found = []
-    for path in sorted((shared_dir() / "data/minimalloc").glob("*.csv")):
+    traces = shared_dir() / "data/minimalloc"
+    if not traces.is_dir():
+        print(f"note: no MiniMalloc traces at {traces} (set RGRAPH_SHARED): left out", file=sys.stderr)
+    for path in sorted(traces.glob("*.csv")):
         found.append(("minimalloc", path.stem, read_trace(path)))
     for name, blocks in graph_instances():
         found.append(("graphs", name, blocks))

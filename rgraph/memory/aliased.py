@@ -2,12 +2,15 @@
 
 1. Greedy best fit under several orderings (size, area, lifetime, start, contention), keep
    the lowest peak: fast and already within a few percent on typical render graphs.
-2. If the peak is above the lower bound, MiniMalloc's solver (``rgraph.memory.search``)
-   decides capacities by bisection between the bound (tried first) and the best peak
-   found, each with MiniMalloc's round robin over its three preorderings; when the
-   bisection closes it starts again with one more (doubled) round. Any placement it finds
-   replaces the greedy one; it stops at the bound or when a capacity just below the peak
-   is proven infeasible.
+2. If the peak is above the lower bound: elastic dives (``rgraph.memory.elastic``:
+   MiniMalloc's search from the bound, raising the capacity where it would backtrack,
+   squeaky-wheel chains over three preorders) until the bound, the budget, or they stall.
+3. With what the dives left, MiniMalloc's solver (``rgraph.memory.search``) decides
+   capacities by bisection between the bound (tried first) and the best peak found, each
+   with MiniMalloc's round robin over its three preorderings; when the bisection closes it
+   starts again with one more (doubled) round. Any placement it finds replaces the best
+   one; it stops at the bound or when a capacity just below the peak is proven infeasible.
+   ``optimal`` runs the dives first, then MiniMalloc's own run at the bound, then this.
 
 The time budget is turned into an operation count (``OPS_PER_SECOND``) so that results are
 the same on every machine; the real time taken varies with the machine.
@@ -20,15 +23,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rgraph.memory.elastic import improve
 from rgraph.memory.greedy import best_fit, orderings
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block
 from rgraph.memory.search import PREORDERINGS, preorder, solve_capacity
 
 #: Search operations (blocks scanned per node, neighbours and sections per placement:
-#: ``CapacitySearch.ops``) granted per second of budget, about what this 2-core machine
-#: does (2.3-6 M/s measured on the MiniMalloc traces). The budget is counted in operations,
-#: so results are the same on every machine; the real time taken varies with the machine.
+#: ``CapacitySearch.ops``; the elastic dives charge theirs in the same unit, see
+#: ``rgraph.memory.elastic.STEP_OPS``) granted per second of budget, about what this 2-core
+#: machine does (search 2.3-6 M/s, dives 4.5-7.7 M/s measured on the MiniMalloc traces).
+#: The budget is counted in operations, so results are the same on every machine; the real
+#: time taken varies with the machine.
 OPS_PER_SECOND = 4_000_000
 
 #: The greedy orderings cost about linearly in the pairs of blocks alive at the same time
@@ -72,10 +78,10 @@ class ClassResult:
 
 
 def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> ClassResult:
-    """Greedy, then (above the bound) the search within ``time_budget_s``. ``exact``
-    (the ``optimal`` policy): after a first share of bisection, most of the budget goes to
-    MiniMalloc's own run at the bound (round robin with no round limit), the rest back to
-    the bisection."""
+    """Greedy, then (above the bound) elastic dives and the search within
+    ``time_budget_s``. ``exact`` (the ``optimal`` policy): after a first share of elastic
+    dives, most of the budget goes to MiniMalloc's own run at the bound (round robin with no
+    round limit), the rest to more dives and the bisection."""
     lb = inst.lower_bound()
     best: ClassResult | None = None
     for name, order in orderings(inst):
@@ -97,17 +103,21 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
         return best
     budget = int(time_budget_s * OPS_PER_SECOND)
     if budget < inst.n * inst.n // 2 + inst.pair_count:
-        return best  # not even one dive (each node scans the blocks left) would finish
+        return best  # not even one dive (each step scans the blocks left) would finish
     search = _Bisection(inst, best)
     if exact:
-        first = min(budget // EXACT_BISECTION_SHARE, int(EXACT_BISECTION_S * OPS_PER_SECOND))
-        left = search.run(first) + budget - first
+        first = min(budget // EXACT_ELASTIC_SHARE, int(EXACT_ELASTIC_S * OPS_PER_SECOND))
+        left = search.elastic(first) + budget - first
         at_bound = int(budget * EXACT_BOUND_SHARE)
         left = search.attempt(lb, None, min(at_bound, left)) + max(left - at_bound, 0)
-        search.run(left)
+        search.run(search.elastic(left // 2) + left - left // 2)
     else:
-        search.run(budget)
+        search.run(search.elastic(budget))
     return search.best
+
+
+#: The order of the elastic dives' squeaky-wheel chains (the first preorders dived first).
+ELASTIC_ORDERS = ("TAW", "TWA", "WAT")
 
 
 #: Where the bisection tries next, as a fraction of the way from the best peak down to the
@@ -117,12 +127,12 @@ STEP = 0.25
 #: The first round's node limit per heuristic, in blocks (MiniMalloc: 2).
 FIRST_LIMIT = 2.0
 
-#: ``optimal``: one part in this many of the budget, at most ``EXACT_BISECTION_S``, goes
-#: to the bisection first (a good placement early), then up to ``EXACT_BOUND_SHARE`` of it
-#: to MiniMalloc's run at the bound, the rest back to the bisection (where the bound is
-#: out of reach, as on MiniMalloc D and J).
-EXACT_BISECTION_SHARE = 5
-EXACT_BISECTION_S = 0.5
+#: ``optimal``: one part in this many of the budget, at most ``EXACT_ELASTIC_S``, goes
+#: to elastic dives first (a good placement early; often the bound itself), then up to
+#: ``EXACT_BOUND_SHARE`` of it to MiniMalloc's run at the bound, the rest half to more
+#: dives, half to the bisection (where the bound is out of reach, as on MiniMalloc D and J).
+EXACT_ELASTIC_SHARE = 5
+EXACT_ELASTIC_S = 0.5
 EXACT_BOUND_SHARE = 0.85
 
 
@@ -138,6 +148,20 @@ class _Bisection:
         self.orders = [preorder(inst, h) for h in PREORDERINGS]
         self.low = self.infeasible = self.lb - 1  # infeasible: the highest proven too small
         self.rounds = 1
+
+    def elastic(self, budget: int) -> int:
+        """Elastic dives (``rgraph.memory.elastic.improve``) for up to ``budget`` operations;
+        returns what is left."""
+        if self.best.proven or budget <= 0:
+            return max(budget, 0)
+        orders = {h: o for h, o in zip(PREORDERINGS, self.orders, strict=True)}
+        found = improve(self.inst, [orders.get(h) or preorder(self.inst, h) for h in ELASTIC_ORDERS],
+                        self.best.peak, budget)
+        if found.offsets is not None:
+            self.best = ClassResult(found.offsets, found.peak, self.lb, f"elastic:{found.dives}")
+            if found.peak <= self.lb:
+                self.best.proven = True
+        return budget - found.ops
 
     def attempt(self, capacity: int, rounds: int | None, budget: int) -> int:
         """Try one capacity; returns the budget left."""

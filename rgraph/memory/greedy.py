@@ -111,12 +111,17 @@ def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:
     """The static orderings tried by the heuristic, in turn (all deterministic, ties by
     index); each is sorted only when asked for, so a caller that stops early pays less."""
     n = range(inst.n)
-    s, e, z = inst.start, inst.end, inst.size
-    yield "size", sorted(n, key=lambda i: (-z[i], s[i], i))
-    yield "area", sorted(n, key=lambda i: (-z[i] * (e[i] - s[i] + 1), i))
-    yield "length", sorted(n, key=lambda i: (-(e[i] - s[i]), -z[i], i))
-    yield "start", sorted(n, key=lambda i: (s[i], -z[i], i))
+    s = inst.start
+    neg_size, neg_area, neg_width = inst.neg_size, inst.neg_area, inst.neg_width
+
+    def by(*columns: Iterable[int]) -> list[int]:
+        return [i for *_, i in sorted(zip(*columns, n, strict=True))]
+
+    yield "size", by(neg_size, s)
+    yield "area", by(neg_area)
+    yield "length", by(neg_width, neg_size)  # width - 1 = end - start: the same order
+    yield "start", by(s, neg_size)
     totals = inst.section_totals()
-    contention = [max(totals[inst.sec_lo[i] : inst.sec_hi[i]], default=0) for i in n]
-    yield "contention", sorted(n, key=lambda i: (-contention[i], -z[i] * (e[i] - s[i] + 1), i))
-    yield "contention_size", sorted(n, key=lambda i: (-contention[i], -z[i], i))
+    neg_contention = [-max(totals[lo:hi]) for lo, hi in zip(inst.sec_lo, inst.sec_hi, strict=True)]
+    yield "contention", by(neg_contention, neg_area)
+    yield "contention_size", by(neg_contention, neg_size)

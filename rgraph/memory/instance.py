@@ -24,12 +24,11 @@ def time_neighbors(start: Sequence[int], end: Sequence[int]) -> list[list[int]]:
     if n < SWEEP_FROM:
         starts = np.asarray(start, dtype=np.int64)
         ends = np.asarray(end, dtype=np.int64)
-        rows = []
-        for i in range(n):
-            row = (starts <= end[i]) & (ends >= start[i])
-            row[i] = False
-            rows.append(np.flatnonzero(row).tolist())
-        return rows
+        overlap = (starts[:, None] <= ends[None, :]) & (ends[:, None] >= starts[None, :])
+        np.fill_diagonal(overlap, False)
+        columns = np.nonzero(overlap)[1].tolist()  # row by row, ascending within a row
+        bounds = np.concatenate(([0], np.cumsum(overlap.sum(axis=1)))).tolist()
+        return [columns[bounds[i] : bounds[i + 1]] for i in range(n)]
     neighbors: list[list[int]] = [[] for _ in range(n)]
     active: list[tuple[int, int]] = []  # heap of (end, block) of blocks begun so far
     live: set[int] = set()
@@ -83,9 +82,14 @@ class Instance:
         if conflicts:
             index = {b.name: k for k, b in enumerate(blocks)}
             for k, b in enumerate(blocks):
-                extra = {index[o] for o in conflicts.get(b.name, ()) if o in index} - set(neighbors[k])
+                names = conflicts.get(b.name)
+                if not names:
+                    continue
+                s, e = start[k], end[k]
+                # conflicts apart in time (those overlapping it are neighbours already)
+                extra = {j for j in map(index.get, names) if j is not None and (start[j] > e or end[j] < s)}
                 if extra:
-                    neighbors[k] = sorted(set(neighbors[k]) | extra)
+                    neighbors[k] = sorted(neighbors[k] + list(extra))
                     separable = False
         coords = sorted(set(start) | {e + 1 for e in end})
         sec_lo = [bisect_left(coords, s) for s in start]

@@ -54,7 +54,7 @@ def preorder(inst: Instance, heuristic: str, blocks: Sequence[int] | None = None
     columns = []
     for c in heuristic:
         if c == "T":
-            columns.append([-max(totals[lo[i] : hi[i]], default=0) for i in blocks])
+            columns.append([-max(totals[lo[i] : hi[i]]) for i in blocks])  # every block spans a section
         else:
             field = {"W": inst.neg_width, "A": inst.neg_area, "Z": inst.neg_size}[c]
             columns.append([field[i] for i in blocks])
@@ -87,6 +87,8 @@ class CapacitySearch:
         self.offsets = [0 if inst.size[i] == 0 else -1 for i in range(inst.n)]
         self.min_off = [0] * inst.n
         self.total = inst.section_totals()
+        # witness[s]: a block of section s that passed its floor check last (a hint only).
+        self.witness = [row[0] if row else 0 for row in inst.section_blocks]
         # cuts[s]: unplaced blocks living in both section s and s + 1.
         self.cuts = [0] * max(inst.section_count - 1, 0)
         for i in self.order:
@@ -130,7 +132,8 @@ class CapacitySearch:
             if not part:
                 continue
             if reorder:
-                part = preorder(self.inst, self.heuristic, part, self.total)  # type: ignore[arg-type]
+                if len(part) > 1:
+                    part = preorder(self.inst, self.heuristic, part, self.total)  # type: ignore[arg-type]
                 for r, i in enumerate(part):
                     self.rank[i] = r
             if not self._dfs(part, bounds[k], bounds[k + 1], 0, -1):
@@ -159,7 +162,7 @@ class CapacitySearch:
         candidates.sort(key=mins.__getitem__)  # stable: ties keep preorder rank
         # Monotonic floor: everything left goes at or above the offset placed next.
         headroom = capacity - max(total[plo:phi])
-        rows = inst.section_blocks
+        rows, witness = inst.section_blocks, self.witness
         for i in candidates:
             off = mins[i]
             if off > headroom:
@@ -202,8 +205,12 @@ class CapacitySearch:
                     left = total[s]
                     if left:
                         threshold = capacity - left
+                        w = witness[s]  # the block that passed this section last, if still low enough
+                        if offsets[w] < 0 and mins[w] <= threshold:
+                            continue
                         for j in rows[s]:
                             if offsets[j] < 0 and mins[j] <= threshold:
+                                witness[s] = j
                                 break
                         else:
                             ok = False

@@ -41,7 +41,7 @@ F32 = np.float32
 REBIAS = np.float32(2.0 ** -112)  # float32 exponent bias 127 -> half bias 15
 ROOT_SCALE_MAX = 1.01  # Animator: the root breathes 1 +- 1%
 ROOT_BOB = 0.02  # and bobs up to 2 cm
-PIECE = 32  # bones per piece of a depth level
+PIECE = 16  # bones per piece of a depth level
 OUT_OF = (0, 1, 2, 4, 5, 6, 7)  # the packed component of each row of ``world`` (t.xyz, q.xyzw); s is 3
 
 
@@ -97,11 +97,11 @@ class StateKernel:
         self.half = np.empty((b, c), F32)
         self.local_q = np.empty((4, b, c), F32)
         self.world = np.empty((7, b, c), F32)  # rows t.xyz, q.xyzw (object space)
-        self.gathered = np.empty((7, widest, c), F32)  # a piece's parents when they are not one range
-        self.cross = np.empty((3, widest, c), F32)
-        self.tmp = np.empty((2, widest, c), F32)
-        self.bits = np.empty((7, widest, c), np.uint32)  # each piece's half bits (low 16 bits)
-        self.signs = np.empty((7, widest, c), np.uint32)
+        # per-piece scratch, (rows, n, C) contiguous views of flat buffers (a strided out= would
+        # make NumPy buffer or copy): a piece's parents when they are not one range, the cross
+        # product, two temporaries, its half bits (the low 16 bits of uint32) and signs
+        self._flat = {name: np.empty(rows * widest * c, dtype) for name, rows, dtype in (
+            ("gathered", 7, F32), ("cross", 3, F32), ("tmp", 2, F32), ("bits", 7, np.uint32), ("signs", 7, np.uint32))}
         self.s_bits = np.empty(c, np.uint32)
         # the tape: segments of NumPy calls, each piece's ending with its pack (then stored)
         self.segments: list[tuple[list[tuple[Callable[..., Any], tuple[Any, ...]]], slice | None]] = []
@@ -115,6 +115,9 @@ class StateKernel:
         self._segment(None)
         self._emit_half(self.s_root, self.s_root, self.s_bits, clip=(0.0, HALF_MAX))
 
+    def _scratch(self, name: str, rows: int, n: int) -> np.ndarray:
+        return self._flat[name][:rows * n * self.characters].reshape(rows, n, self.characters)
+
     # ----------------------------------------------------------------- per tick
     def state(self, seconds: float, out: np.ndarray | None = None) -> np.ndarray:
         """The packed state at ``seconds``: (B, C, 8) half bits as uint16, into ``out`` when
@@ -124,15 +127,14 @@ class StateKernel:
         if out is None:
             out = np.empty((self.bones, self.characters, 8), np.uint16)
         np.multiply(self.omega, seconds, self.cycle)
-        bits = self.bits
         for tape, bones in self.segments:
             for f, args in tape:
                 f(*args)
             if bones is not None:  # the piece's halves, interleaved (t.xyz, s, q.xyzw)
-                n = bones.stop - bones.start
                 dst = out[bones]
+                bits = self._scratch("bits", 7, bones.stop - bones.start)
                 for row, k in enumerate(OUT_OF):
-                    np.copyto(dst[:, :, k], bits[row, :n], casting="unsafe")  # the low 16 bits
+                    np.copyto(dst[:, :, k], bits[row], casting="unsafe")  # the low 16 bits
         np.copyto(out[:, :, 3], self.s_bits, casting="unsafe")  # every bone's scale is its root's
         return out
 
@@ -181,9 +183,9 @@ class StateKernel:
         if isinstance(parents, slice):
             p = w[:, parents]
         else:
-            p = self.gathered[:, :n]
+            p = self._scratch("gathered", 7, n)
             op(np.take, w, parents, 1, p, "clip")
-        tmp, tmp2 = self.tmp[0, :n], self.tmp[1, :n]
+        tmp, tmp2 = self._scratch("tmp", 2, n)
         ax, ay, az, aw = p[3], p[4], p[5], p[6]
         bx, by, bz, bw = self.local_q[:, bones]
         qx, qy, qz, qw = w[3:7, bones]
@@ -197,7 +199,7 @@ class StateKernel:
                 op(combine, dst, tmp, dst)
         u = (ax, ay, az)
         v, v2 = self.off[:, bones], self.off2[:, bones]
-        c = self.cross[:, :n]
+        c = self._scratch("cross", 3, n)
         for k in range(3):  # c = 2 (u x v) = u x 2v
             i, j = (k + 1) % 3, (k + 2) % 3
             op(np.multiply, u[i], v2[j], c[k])
@@ -219,7 +221,7 @@ class StateKernel:
         """The piece's rows of ``world`` as half bits into ``bits``."""
         n = bones.stop - bones.start
         rows = self.world[:, bones]
-        bits, signs = self.bits[:, :n], self.signs[:, :n]
+        bits, signs = self._scratch("bits", 7, n), self._scratch("signs", 7, n)
         if self.clip_t:
             self._emit_half(rows[0:3], rows[0:3], bits[0:3], clip=(-HALF_MAX, HALF_MAX), signs=signs[0:3])
             self._emit_half(rows[3:7], rows[3:7], bits[3:7], signs=signs[3:7])

@@ -58,18 +58,20 @@ def test_clamped_translations_take_the_clip_path_and_stay_identical():
     assert not StateKernel(Animator(rig, 9)).clip_t  # the character's reach proves the clamp a no-op
 
 
-def test_a_tick_allocates_nothing_the_size_of_a_state():
-    anim = Animator(build_rig(256), 128, seed=1)
-    out = np.empty((256, 128, 8), np.float16)
-    anim.state(0, out=out)  # builds the kernel
-    tracemalloc.start()
-    try:
-        anim.state(1, out=out)
-        _, peak = tracemalloc.get_traced_memory()
-    finally:
-        tracemalloc.stop()
-    assert peak < 32 * 1024, peak  # the state is 512 KiB; the reference allocates tens of MiB
-    assert np.array_equal(bits(out), bits(anim.reference_state(1)))
+def test_a_tick_allocates_nothing_that_grows_with_the_state():
+    peaks = []
+    for characters in (128, 512):
+        anim = Animator(build_rig(256), characters, seed=1)
+        out = np.empty((256, characters, 8), np.float16)
+        anim.state(0, out=out)  # builds the kernel
+        tracemalloc.start()
+        try:
+            anim.state(1, out=out)
+            peaks.append(tracemalloc.get_traced_memory()[1])
+        finally:
+            tracemalloc.stop()
+        assert np.array_equal(bits(out), bits(anim.reference_state(1)))
+    assert peaks[1] < 128 * 1024 and peaks[1] <= peaks[0] * 1.25, peaks  # NumPy's iterator buffers; the state is 2 MiB
 
 
 def test_non_finite_inputs_are_refused_and_float64_takes_the_reference_path():

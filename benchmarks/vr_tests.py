@@ -196,6 +196,23 @@ def pass_ratios(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines) if len(lines) > 2 else ""
 
 
+def logic_summary(logic: dict[str, Any] | None) -> str:
+    """``; logic ...``: the logic thread's measured rate, late ticks and tick time, and how its
+    skinning states were evaluated (a worker process's evaluation time, the logic thread's wait)."""
+    if not logic:
+        return ""
+    text = (f"; logic {_f(logic.get('measured_hz'), '.1f')} Hz of {logic['hz']:g}, {logic['late_ticks']} late, "
+            f"tick {_f(logic.get('tick_us'), '.0f')} us on the logic thread")
+    skin = logic.get("skin")
+    if skin and skin.get("worker") == "process":
+        text += (f" (skinning in a worker process, {skin['threads']} thread(s): "
+                 f"{_f(skin.get('tick_us'), '.0f')} us per state, {_f(skin.get('tick_cpu_us'), '.0f')} us CPU, "
+                 f"logic thread waits {_f(skin.get('wait_us'), '.0f')} us)")
+    elif skin:
+        text += f" (skinning on the logic thread, {skin['threads']} thread(s))"
+    return text
+
+
 def _pct(v: float | None) -> float | None:
     return None if v is None else 100.0 * v
 
@@ -263,7 +280,7 @@ def main(argv: list[str] | None = None) -> int:
                       f"{_f(r['submit_median_us'], '.1f')}; {r.get('submits', '?')} vkQueueSubmit2 per frame), "
                       f"p90 {_f(r.get('render_cpu_p90_us'), '.1f')}, means: Python {_f(r.get('python_mean_us'), '.1f')}, "
                       f"Vulkan {_f(r.get('vulkan_mean_us'), '.1f')}, "
-                      f"GPU {_f(r['gpu_span_ms'], '.3f')} ms", flush=True)
+                      f"GPU {_f(r['gpu_span_ms'], '.3f')} ms{logic_summary(r.get('logic'))}", flush=True)
     print(f"device: {device}, {w}x{h}, {args.frames} frames per run after >= {args.warmup} s of warm-up, "
           f"timestamps read every {args.timestamps_every} frames, queues: {args.queues}, logic thread "
           + (f"at {args.logic_hz:g} Hz" if args.logic_hz else "off"))

@@ -103,6 +103,10 @@ def render_thread_line(timings: dict) -> str:
         line += (f"; logic {logic['ticks']} ticks at {logic['hz']:g} Hz"
                  + (f" (measured {measured:.1f} Hz" if measured else " (")
                  + f", {logic['late_ticks']} late)")
+        skin = logic.get("skin") or {}
+        if skin.get("worker") == "process" and skin.get("tick_us") is not None:
+            line += (f"; skinning in a worker process: {skin['tick_us'] / 1e3:.1f} ms per state, the logic "
+                     f"thread waits {skin['wait_us'] / 1e3:.2f} ms")
     return line
 
 

@@ -7,6 +7,10 @@ drawn from ``numpy.random.default_rng(seed)`` (phase in [0, 2 pi), speed x [0.8,
 also bobs (2 cm) and breathes (scale 1 +- 1%). Logic state ``k`` is the pose at ``t = k / hz``;
 the renderer shows ``interpolate(state k - 1, state k, alpha)`` (rgraph.scene.skinning), the
 study's two bone textures.
+
+``Animator.state`` evaluates a state with ``rgraph.scene.skin_kernel`` (preallocated buffers, a
+tape of NumPy calls), bit-identical to ``reference_state`` (``pack_bones`` of ``pose``: the
+readable path, also the float64 one).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rgraph.scene.character import Rig
+from rgraph.scene.skin_kernel import StateKernel, supported
 from rgraph.scene.skinning import Pose, axis_angle, forward_kinematics, pack_bones
 
 LOGIC_HZ = 60.0
@@ -36,6 +41,7 @@ class Animator:
     _amp: np.ndarray = field(init=False, repr=False)
     _bone_phase: np.ndarray = field(init=False, repr=False)
     _offsets: np.ndarray = field(init=False, repr=False)
+    _kernels: dict[int, list[tuple[StateKernel, slice]]] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         rng = np.random.default_rng(self.seed)
@@ -46,6 +52,11 @@ class Animator:
         self._amp = self.amplitude * np.array([b.amplitude for b in bones])
         self._bone_phase = np.array([b.phase for b in bones])
         self._offsets = self.rig.skeleton.rest_offsets()
+        self._kernels = {}
+
+    def __getstate__(self) -> dict:
+        """Pickled without the kernels' buffers (a worker process builds its own)."""
+        return {**self.__dict__, "_kernels": {}}
 
     @property
     def bones(self) -> int:
@@ -71,22 +82,36 @@ class Animator:
         state holds; ``skin_transforms`` of it maps rest vertices (the GPU does that per vertex)."""
         return forward_kinematics(self.rig.skeleton, self.local_pose(seconds, chars))
 
-    def state(self, tick: int, hz: float = LOGIC_HZ, threads: int = 1) -> np.ndarray:
-        """Logic state ``tick``: packed joint transforms (B, C, 8) float16 at ``t = tick / hz``; with
-        ``threads`` > 1 the characters are split into that many chunks evaluated on a thread
-        pool (NumPy releases the GIL inside its array loops)."""
+    def state(self, tick: int, hz: float = LOGIC_HZ, threads: int = 1, out: np.ndarray | None = None) -> np.ndarray:
+        """Logic state ``tick``: packed joint transforms (B, C, 8) float16 at ``t = tick / hz``,
+        into ``out`` when given (any (B, C, 8) 16-bit array or view); with ``threads`` > 1 the
+        characters are split into that many chunks evaluated on a thread pool (NumPy releases
+        the GIL inside its array loops). Bit-identical to :meth:`reference_state`."""
+        if not supported(self):
+            state = self.reference_state(tick, hz)
+            if out is not None:
+                out.view(np.uint16)[...] = state.view(np.uint16)
+                return out
+            return state
         n = max(1, min(int(threads), self.characters // 64 or 1))
+        if n not in self._kernels:
+            edges = np.linspace(0, self.characters, n + 1).astype(int)
+            chunks = [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+            self._kernels[n] = [(StateKernel(self, chars), chars) for chars in chunks]
+        if out is None:
+            out = np.empty((self.bones, self.characters, 8), dtype=np.float16)
+        bits = out.view(np.uint16)
+        seconds = tick / hz
+        kernels = self._kernels[n]
         if n == 1:
-            return pack_bones(self.pose(tick / hz))
-        out = np.empty((self.bones, self.characters, 8), dtype=np.float16)
-        edges = np.linspace(0, self.characters, n + 1).astype(int)
-        chunks = [slice(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True)]
-
-        def run(chars: slice) -> None:
-            out[:, chars] = pack_bones(self.pose(tick / hz, chars))
-
-        list(_pool(n).map(run, chunks))
+            kernels[0][0].state(seconds, bits)
+        else:
+            list(_pool(n).map(lambda kc: kc[0].state(seconds, bits[:, kc[1]]), kernels))
         return out
+
+    def reference_state(self, tick: int, hz: float = LOGIC_HZ) -> np.ndarray:
+        """Logic state ``tick`` the readable way: ``pack_bones(pose(tick / hz))`` (any dtype)."""
+        return pack_bones(self.pose(tick / hz))
 
 
 _POOLS: dict[int, ThreadPoolExecutor] = {}

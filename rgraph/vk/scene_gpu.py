@@ -73,6 +73,7 @@ class SceneGPU:
         self.extent: tuple[int, int] = tuple(plan.get("size") or (64, 64))  # type: ignore[assignment]
         self.plan_logic_hz = plan.get("logic_hz")  # skinning's logic rate (default 60 Hz)
         self.skin_threads = int(plan.get("params", {}).get("skin.threads", 1))
+        self.skin_worker = str(plan.get("params", {}).get("skin.worker", "process"))
         try:
             self.data: SceneData = load_scene_data(source, self.extent, int(plan.get("camera", 0)))
         except (OSError, ValueError) as exc:
@@ -200,7 +201,7 @@ class SceneGPU:
         self._upload(submit_once, [(b, d) for b, d in uploads if d])
         self.skin = SkinGPU(self.device, data, self.sets, skinned, vertex_space.size,
                             float(self.plan_logic_hz) if self.plan_logic_hz else 60.0,
-                            threads=self.skin_threads)
+                            threads=self.skin_threads, worker=self.skin_worker)
 
         self.frame_buffers = [self._host_buffer(packing.FRAME_BYTES, v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
                               for _ in range(self.sets)]
@@ -298,7 +299,7 @@ class SceneGPU:
         ``lock``)."""
         self.logic = logic
         if self.skin is not None:
-            self.skin.logic_hz = float(logic.hz)  # skinning's logic ticks are this thread's
+            self.skin.use_logic(logic.hz)  # skinning's logic ticks are this thread's (a worker process may start)
         self.ticks_taken = [None] * self.sets
         self.alpha_range = [1.0, 0.0]  # (min, max) of the alphas used, for the run's report
 

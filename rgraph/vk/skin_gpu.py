@@ -11,6 +11,9 @@
   two per frame set, the logic's published pair and the one being written); the study's
   "two bone textures" are the two slots a frame set names. With a logic thread the thread
   writes its states there itself (``write_slot``); the render thread only names the slots.
+  Graph param ``skin.worker``: ``process`` (default) evaluates the states in a worker process
+  (rgraph.scene.skin_worker: the logic thread only waits for it and copies each state into
+  its slot, holding the GIL for microseconds per tick); ``thread`` on the logic thread itself.
 - binding 9 ``SkinFrame`` (per frame set, std140): ``(alpha, previous slot's first entry,
   current slot's first entry, 0)``; the vertex shader interpolates previous -> current.
 
@@ -30,12 +33,14 @@ from rgraph.scene.animation import LOGIC_HZ, logic_tick
 from rgraph.scene.build import SceneData
 from rgraph.scene.skinning import BONE_BYTES
 from rgraph.vk.device import Device
+from rgraph.vk.errors import ExecutionError
 from rgraph.vk.resources import HostBuffer
 
 BINDING_SKIN_VERTICES, BINDING_BONES, BINDING_SKIN_FRAME = range(7, 10)  # after scene.glsl's Views (5), Meshes (6)
 SKIN_VERTEX_BYTES = 8
 SKIN_FRAME_BYTES = 16
 SLOTS = 8  # >= 2 sets x 2 slots in flight + the published pair + the one being written
+WORKERS = ("process", "thread")  # graph param skin.worker
 
 
 class SkinGPU:
@@ -43,12 +48,16 @@ class SkinGPU:
     buffer) of every skinned mesh; ``rigid_vertices``: that buffer's vertex count."""
 
     def __init__(self, device: Device, data: SceneData, sets: int, rigid_bases: list[tuple[Any, int]],
-                 rigid_vertices: int, logic_hz: float = LOGIC_HZ, threads: int = 1) -> None:
+                 rigid_vertices: int, logic_hz: float = LOGIC_HZ, threads: int = 1, worker: str = "process") -> None:
         from rgraph.vk.loader import vk
 
         v = vk()
+        if worker not in WORKERS:
+            raise ExecutionError(f"skin.worker must be one of {', '.join(WORKERS)}, not {worker!r}")
         self.data, self.sets, self.logic_hz = data, sets, float(logic_hz)
         self.threads = max(1, int(threads))  # a tick's characters split over this many threads (Animator.state)
+        self.worker_mode = worker  # with a logic thread (use_logic)
+        self.worker: Any = None  # rgraph.scene.skin_worker.SkinWorker (use_logic, skin.worker=process)
         self.meshes = list(rigid_bases)
         self.bones = data.bone_count
         self.slots = max(SLOTS, 2 * sets + 3)
@@ -123,12 +132,38 @@ class SkinGPU:
             self._states[tick] = got
         return got
 
+    def use_logic(self, hz: float) -> None:
+        """States come at ``hz`` from a logic thread from now on; with ``skin.worker=process``
+        a worker process evaluates them (started here, once)."""
+        self.logic_hz = float(hz)
+        if self.worker is not None and self.worker.hz != self.logic_hz:
+            self.worker.close()
+            self.worker = None
+        if self.active and self.worker_mode == "process" and self.worker is None:
+            from rgraph.scene.skin_worker import SkinWorker, SkinWorkerError
+
+            try:
+                self.worker = SkinWorker([m.animator for m in self.data.skinned], self.logic_hz, self.threads)
+            except (OSError, SkinWorkerError) as exc:
+                raise ExecutionError(f"skinning worker process: {exc}") from None
+
+    def logic_stats(self) -> dict[str, Any]:
+        """How the logic ticks' states were evaluated (the run's ``logic`` timings)."""
+        if self.worker is not None:
+            return self.worker.stats()
+        return {"worker": "thread", "threads": self.threads}
+
+    def _packed(self, tick: int) -> np.ndarray:
+        """State ``tick`` as bytes: the worker's shared buffer, or evaluated here."""
+        if self.worker is not None:
+            return self.worker.fetch(tick)
+        return np.ascontiguousarray(self.state(tick)).reshape(-1).view(np.uint8)
+
     def _write(self, slot: int, tick: int) -> None:
         """State ``tick`` into ring slot ``slot``: one NumPy copy, which releases the GIL while
         it runs (4 MiB for 1,024 x 256 bones: the render thread is not held up meanwhile)."""
         start = (self.header + slot * self.bones) * BONE_BYTES
-        packed = np.ascontiguousarray(self.state(tick)).reshape(-1).view(np.uint8)
-        np.copyto(self._ring_bytes[start:start + self.bones * BONE_BYTES], packed)
+        np.copyto(self._ring_bytes[start:start + self.bones * BONE_BYTES], self._packed(tick))
         self._slot_tick[slot] = tick
 
     def _slot_of(self, tick: int, frame_set: int, keep: int) -> int:
@@ -174,6 +209,9 @@ class SkinGPU:
         self.show(frame_set, tick - 1, tick, alpha)
 
     def destroy(self) -> None:
+        if self.worker is not None:
+            self.worker.close()
+            self.worker = None
         for buf in reversed(self._buffers):
             buf.destroy()
         self._buffers = []

@@ -159,6 +159,19 @@ def test_vr_benchmark_smoke(capsys):
     assert "| lighting | 2 | 969 |" in out
 
 
+def test_vr_benchmark_reports_the_logic_thread_and_the_skinning_worker():
+    from benchmarks.vr_tests import logic_summary
+
+    assert logic_summary(None) == ""
+    base = {"hz": 60.0, "measured_hz": 59.9, "late_ticks": 0, "tick_us": 612.0}
+    line = logic_summary({**base, "skin": {"worker": "process", "threads": 2, "tick_us": 9000.0,
+                                           "tick_cpu_us": 17000.0, "wait_us": 40.0}})
+    assert line == ("; logic 59.9 Hz of 60, 0 late, tick 612 us on the logic thread (skinning in a worker "
+                    "process, 2 thread(s): 9000 us per state, 17000 us CPU, logic thread waits 40 us)")
+    assert logic_summary({**base, "skin": {"worker": "thread", "threads": 1}}).endswith(
+        "(skinning on the logic thread, 1 thread(s))")
+
+
 @pytest.mark.vulkan
 def test_vr_benchmark_failed_row_costs_that_row_only(capsys):
     """Each row runs in its own process: a row whose process fails (an unknown draw mode here,

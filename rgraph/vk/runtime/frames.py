@@ -187,7 +187,8 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     out = timings(ex, rows, frames, np.asarray(cpu_s))
     out["render_thread"] = render
     if logic is not None:
-        out["logic"] = {**logic.stats(), "alpha_range": list(scene.alpha_range) if scene is not None else None}
+        out["logic"] = {**logic.stats(), "alpha_range": list(scene.alpha_range) if scene is not None else None,
+                        "skin": scene.skin.logic_stats() if scene is not None and scene.skin.active else None}
     return out
 
 

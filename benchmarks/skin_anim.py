@@ -7,6 +7,7 @@ Three parts, medians over ``--ticks`` after ``--warmup`` ticks, wall (perf_count
   by stage - the local pose (one sine per bone per character), forward kinematics (one
   vectorised step per depth level), half-float packing - in float32 and, total only, float64:
   where a tick's time goes without the kernel;
+- ``back to back``: a reference tick and a kernel tick in turn, minimum and median CPU;
 - ``kernel``: ``Animator.state`` (rgraph.scene.skin_kernel: a tape of NumPy calls on
   preallocated buffers, bit-identical - checked on every timed tick), with ``--threads``;
 - ``--worker``: a ``SkinWorker`` process (rgraph.scene.skin_worker) paced at ``--hz`` as the
@@ -57,6 +58,23 @@ def reference(anim: Animator, ticks: int, warmup: int, clock=time.perf_counter) 
             for name, dt in zip(STAGES, (t1 - t0, t2 - t1, t3 - t2, t3 - t0), strict=True):
                 times[name].append(1e3 * dt)
     return {s: statistics.median(v) for s, v in times.items()}
+
+
+def back_to_back(anim: Animator, ticks: int, warmup: int) -> dict[str, tuple[float, float]]:
+    """(minimum, median) CPU ms of the reference and of the kernel, one tick of each in turn
+    (A/B/A/B: a shared machine's drift hits both alike)."""
+    out = np.empty((anim.bones, anim.characters, 8), np.float16)
+    got: dict[str, list[float]] = {"reference": [], "kernel": []}
+    for tick in range(warmup + ticks):
+        c0 = time.thread_time()
+        anim.reference_state(tick)
+        c1 = time.thread_time()
+        anim.state(tick, out=out)
+        c2 = time.thread_time()
+        if tick >= warmup:
+            got["reference"].append(1e3 * (c1 - c0))
+            got["kernel"].append(1e3 * (c2 - c1))
+    return {k: (min(v), statistics.median(v)) for k, v in got.items()}
 
 
 def kernel(anim: Animator, ticks: int, warmup: int, threads: int) -> tuple[float, float, bool]:
@@ -180,6 +198,10 @@ def main(argv: list[str] | None = None) -> None:
     print("reference (pack_bones(pose)), median wall ms: " + ", ".join(f"{s} {ms[s]:.2f}" for s in STAGES))
     print("reference, median CPU ms:                     " + ", ".join(f"{s} {cpu[s]:.2f}" for s in STAGES))
     print(f"reference in float64, median CPU ms: total {exact['total']:.2f}")
+    ab = back_to_back(anim, a.ticks, a.warmup)
+    (rmin, rmed), (kmin, kmed) = ab["reference"], ab["kernel"]
+    print(f"back to back, CPU ms min / median: reference {rmin:.2f} / {rmed:.2f}, kernel {kmin:.2f} / {kmed:.2f} "
+          f"({rmin / kmin:.2f}x / {rmed / kmed:.2f}x)")
     threads = [int(x) for x in a.threads.split(",") if x]
     for n in threads:
         wall, c, same = kernel(anim, a.ticks, a.warmup, n)

@@ -17,7 +17,9 @@ allocated or computed twice and the interpreter does little:
   cross product ``2 (u x v)`` takes the pre-doubled offset (``u x 2v``: scaling by two is
   exact); ``0.5 (amp sin)`` is ``(0.5 amp) sin``;
 - the half conversion is ``half_bits``'s (the float32 bits of ``x 2^-112``, + 0x1000, >> 13,
-  | the sign) on the signed value: its sign bit is shifted out of the 16 bits kept;
+  | the sign) on the signed value (its shifted sign bit is masked off); two halves are paired
+  into each uint32 word of the output, so a bone is four strided stores, the scale (every
+  bone's is its root's) paired in from one row per character;
 - the translation clamp to the half range is skipped when a bound computed once (the rest
   offsets' lengths summed, times the largest root scale) proves it a no-op.
 
@@ -27,6 +29,7 @@ inputs every output is finite, which ``pack_bones`` checks on the reference path
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -42,14 +45,17 @@ REBIAS = np.float32(2.0 ** -112)  # float32 exponent bias 127 -> half bias 15
 ROOT_SCALE_MAX = 1.01  # Animator: the root breathes 1 +- 1%
 ROOT_BOB = 0.02  # and bobs up to 2 cm
 PIECE = 16  # bones per piece of a depth level
-OUT_OF = (0, 1, 2, 4, 5, 6, 7)  # the packed component of each row of ``world`` (t.xyz, q.xyzw); s is 3
+# the rows of ``world`` (t.xyz, q.xyzw) in a piece's half-bits scratch: first the low half of
+# each output word (t.x, t.z, q.x, q.z), then the high (t.y, q.y, q.w; s is t.z's high half)
+PAIR_ORDER = (0, 2, 3, 5, 1, 4, 6)
 
 
 def supported(animator: Animator) -> bool:
     """Whether the kernel applies: float32, every depth level one contiguous range of bones
-    (depth-sorted skeletons, as ``build_rig`` makes) and one root."""
+    (depth-sorted skeletons, as ``build_rig`` makes), one root, a little-endian host (the
+    halves are paired into words)."""
     levels = animator.rig.skeleton.levels
-    return (np.dtype(animator.dtype) == np.float32 and len(levels) > 0 and levels[0][0] == slice(0, 1)
+    return (sys.byteorder == "little" and np.dtype(animator.dtype) == np.float32 and len(levels) > 0 and levels[0][0] == slice(0, 1)
             and all(isinstance(b, slice) for b, _ in levels))
 
 
@@ -107,13 +113,12 @@ class StateKernel:
         self.segments: list[tuple[list[tuple[Callable[..., Any], tuple[Any, ...]]], slice | None]] = []
         self._segment(slice(0, 1))
         self._emit_local_and_root(axes)
+        self._emit_scale()
         self._emit_pack(slice(0, 1))
         for bones, parents in pieces:
             self._segment(bones)
             self._emit_level(bones, parents)
             self._emit_pack(bones)
-        self._segment(None)
-        self._emit_half(self.s_root, self.s_root, self.s_bits, clip=(0.0, HALF_MAX))
 
     def _scratch(self, name: str, rows: int, n: int) -> np.ndarray:
         return self._flat[name][:rows * n * self.characters].reshape(rows, n, self.characters)
@@ -121,21 +126,22 @@ class StateKernel:
     # ----------------------------------------------------------------- per tick
     def state(self, seconds: float, out: np.ndarray | None = None) -> np.ndarray:
         """The packed state at ``seconds``: (B, C, 8) half bits as uint16, into ``out`` when
-        given (any (B, C, 8) uint16 array or view, e.g. a shared buffer's characters)."""
+        given (a (B, C, 8) uint16 array or view whose last axis is contiguous, e.g. a shared
+        buffer's characters)."""
         if not np.isfinite(seconds):
             raise ValueError(f"scene time must be finite, not {seconds}")
         if out is None:
             out = np.empty((self.bones, self.characters, 8), np.uint16)
+        words = out.view(np.uint32)  # (B, C, 4): two halves per word, the low one first (little-endian)
         np.multiply(self.omega, seconds, self.cycle)
         for tape, bones in self.segments:
             for f, args in tape:
                 f(*args)
-            if bones is not None:  # the piece's halves, interleaved (t.xyz, s, q.xyzw)
-                dst = out[bones]
-                bits = self._scratch("bits", 7, bones.stop - bones.start)
-                for row, k in enumerate(OUT_OF):
-                    np.copyto(dst[:, :, k], bits[row], casting="unsafe")  # the low 16 bits
-        np.copyto(out[:, :, 3], self.s_bits, casting="unsafe")  # every bone's scale is its root's
+            if bones is not None:  # the piece's words, interleaved: (t.x|t.y, t.z|s, q.x|q.y, q.z|q.w)
+                dst = words[bones]
+                w = self._scratch("bits", 7, bones.stop - bones.start)
+                for j in range(4):
+                    np.copyto(dst[:, :, j], w[j])
         return out
 
     # ----------------------------------------------------------------- the tape
@@ -218,29 +224,37 @@ class StateKernel:
             op(np.add, dst, p[k], dst)
 
     def _emit_pack(self, bones: slice) -> None:
-        """The piece's rows of ``world`` as half bits into ``bits``."""
+        """The piece's rows of ``world`` as half bits (skinning.half_bits), paired into the
+        output's uint32 words in ``bits``: rows 0-3 hold ``lo | hi << 16`` of (t.x, t.y),
+        (t.z, s), (q.x, q.y), (q.z, q.w)."""
+        op = self._op
         n = bones.stop - bones.start
         rows = self.world[:, bones]
         bits, signs = self._scratch("bits", 7, n), self._scratch("signs", 7, n)
-        if self.clip_t:
-            self._emit_half(rows[0:3], rows[0:3], bits[0:3], clip=(-HALF_MAX, HALF_MAX), signs=signs[0:3])
-            self._emit_half(rows[3:7], rows[3:7], bits[3:7], signs=signs[3:7])
-        else:
-            self._emit_half(rows, rows, bits, signs=signs)
-
-    def _emit_half(self, x: np.ndarray, sign_of: np.ndarray, bits: np.ndarray, clip: tuple[float, float] | None = None,
-                   signs: np.ndarray | None = None) -> None:
-        """``bits`` (uint32, low 16 bits) = half_bits(clip(x)) (skinning.half_bits)."""
-        op = self._op
-        f = bits.view(F32)
-        if clip is not None:
-            op(np.clip, x, clip[0], clip[1], f)
-            op(np.multiply, f, REBIAS, f)
-        else:
-            op(np.multiply, x, REBIAS, f)  # signed: the sign (bit 31) lands on bit 18, beyond the 16 kept
+        for slot, r in enumerate(PAIR_ORDER):
+            f = bits[slot].view(F32)
+            if self.clip_t and r < 3:
+                op(np.clip, rows[r], -HALF_MAX, HALF_MAX, f)
+                op(np.multiply, f, REBIAS, f)
+            else:
+                op(np.multiply, rows[r], REBIAS, f)  # signed: the sign (bit 31) lands on bit 18, cleared below
+            op(np.right_shift, rows[r].view(np.uint32), 16, signs[slot])
         op(np.add, bits, 0x1000, bits)
         op(np.right_shift, bits, 13, bits)
-        if signs is not None:
-            op(np.right_shift, sign_of.view(np.uint32), 16, signs)
-            op(np.bitwise_and, signs, 0x8000, signs)
-            op(np.bitwise_or, bits, signs, bits)
+        op(np.bitwise_and, signs, 0x8000, signs)
+        op(np.bitwise_or, bits, signs, bits)
+        op(np.bitwise_and, bits[0:4], 0xFFFF, bits[0:4])  # the low halves
+        op(np.left_shift, bits[4:7], 16, bits[4:7])  # the high halves, in place
+        op(np.bitwise_or, bits[0], bits[4], bits[0])
+        op(np.bitwise_or, bits[1], self.s_bits, bits[1])  # every bone's scale is its root's
+        op(np.bitwise_or, bits[2:4], bits[5:7], bits[2:4])
+
+    def _emit_scale(self) -> None:
+        """The roots' scale as a high half (``s_bits``): half_bits(clip(s, 0, HALF_MAX)) << 16."""
+        op, s, b = self._op, self.s_root, self.s_bits
+        f = b.view(F32)
+        op(np.clip, s, 0.0, HALF_MAX, f)
+        op(np.multiply, f, REBIAS, f)
+        op(np.add, b, 0x1000, b)
+        op(np.right_shift, b, 13, b)
+        op(np.left_shift, b, 16, b)

@@ -49,9 +49,8 @@ class Grid:
 
 def auto_far(scene, frame: int = 0) -> float:
     """``cluster_far`` with ``clusters.far = 0``: |centre| + radius of the scene's bounding sphere."""
-    pts = scene.bounds_rel(scene.camera(frame).position)
-    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
-    return float(np.linalg.norm(centre) + np.linalg.norm(pts - centre, axis=1).max())
+    centre, radius = scene.bounding_sphere_rel(scene.camera(frame).position)
+    return float(np.linalg.norm(centre) + radius)
 
 
 def grid_for(scene, tile: int, slices: int, far: float = 0.0, frame: int = 0) -> Grid:

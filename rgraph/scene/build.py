@@ -184,6 +184,12 @@ class SceneData:
         """Bounding-box corners of the whole scene, camera-relative (float64)."""
         return self.world_corners - np.asarray(camera_position, dtype=np.float64)
 
+    def bounding_sphere_rel(self, camera_position: np.ndarray) -> tuple[np.ndarray, float]:
+        """(centre, radius) of the sphere around the scene's bounding box, camera-relative."""
+        pts = self.bounds_rel(camera_position)
+        centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
+        return centre, float(np.linalg.norm(pts - centre, axis=1).max())
+
     def shadow_matrices(self, camera_position: np.ndarray) -> list[np.ndarray]:
         pts = self.bounds_rel(camera_position)
         return [shadow_view_proj(li.direction, pts) for li in self.shadow_lights]

@@ -96,9 +96,8 @@ def draw_buckets(scene: SceneData, frame: int = 0) -> np.ndarray:
     ``cull.comp`` computes it in float32: the nearest point of its bounding sphere, log-spaced
     over [near, far side of the scene bounds] (the Frame's ``scene_bounds``)."""
     cam = scene.camera(frame)
-    pts = scene.bounds_rel(cam.position)
-    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
-    far_side = float(np.linalg.norm(centre) + np.linalg.norm(pts - centre, axis=1).max())
+    centre, radius = scene.bounding_sphere_rel(cam.position)
+    far_side = float(np.linalg.norm(centre) + radius)
     near = max(float(cam.near), 1e-6)
     far_side = max(far_side, 2.0 * near)
     t, c, radius = instance_arrays(scene)

@@ -92,9 +92,8 @@ def _frame_for_camera(scene: SceneData, cam) -> np.ndarray:
     hi, lo = split_hi_lo(cam.position)
     put("camera_hi", (*hi, 0.0))
     put("camera_lo", (*lo, 0.0))
-    pts = scene.bounds_rel(cam.position)
-    centre = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
-    put("scene_bounds", (*centre, float(np.linalg.norm(pts - centre, axis=1).max())))
+    centre, radius = scene.bounding_sphere_rel(cam.position)
+    put("scene_bounds", (*centre, radius))
     return f
 
 

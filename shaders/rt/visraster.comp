@@ -63,11 +63,10 @@ void main() {
         if (cull) {
             n = 0u;
             for (uint w = 0u; w < (CULL_TILES + 31u) / 32u; ++w) covered[w] = 0u;
+            uint tile = 0u;
             for (int ty = 0; ty < tiles.y; ++ty)
-                for (int tx = 0; tx < tiles.x; ++tx) {
-                    uint k = uint(ty * tiles.x + tx);
-                    if (tile_may_cover(tri, ivec2(tx, ty))) { covered[k >> 5] |= 1u << (k & 31u); ++n; }
-                }
+                for (int tx = 0; tx < tiles.x; ++tx, ++tile)
+                    if (tile_may_cover(tri, ivec2(tx, ty))) { covered[tile >> 5] |= 1u << (tile & 31u); ++n; }
             if (n == 0u) return;  // no pixel centre covered
         }
         uint rec = atomicAdd(tri_count, 1u);  // a record slot past the capacity is never written
@@ -75,10 +74,10 @@ void main() {
             uint first = atomicAdd(job_count, n);
             if (first + n <= JOB_CAPACITY) {
                 records[rec] = pack_tri(tri);
-                uint k = first;
+                uint k = first, tile = 0u;
                 for (int ty = 0; ty < tiles.y; ++ty)
-                    for (int tx = 0; tx < tiles.x; ++tx)
-                        if (!cull || (covered[uint(ty * tiles.x + tx) >> 5] & (1u << (uint(ty * tiles.x + tx) & 31u))) != 0u)
+                    for (int tx = 0; tx < tiles.x; ++tx, ++tile)
+                        if (!cull || (covered[tile >> 5] & (1u << (tile & 31u))) != 0u)
                             jobs[k++] = uvec2(rec, (uint(ty) << 16) | uint(tx));
                 atomicMax(args.groups, (first + n + JOBS_PER_GROUP - 1u) / JOBS_PER_GROUP);
                 return;

@@ -11,8 +11,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from rgraph.compiler import sync as csync
-from rgraph.compiler.plan_values import get_state, get_subresource, names, plan_state, subresource
-from rgraph.compiler.usages import Sync
+from rgraph.compiler.plan_values import get_state, names, plan_state
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
@@ -59,35 +58,14 @@ def _frozen_json(value: Any) -> Any:
     return value
 
 
-def _scope_names(s: Sync) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """An access scope's stage and access names as the plan lists them."""
-    return names(s.stages), names(s.access)
-
-
 def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
-    passes, sync = c.passes, c.sync
-    assert sync is not None
+    passes, sync, trace = c.passes, c.sync, c.trace
+    assert sync is not None and trace is not None
     signals = sync.signals
     signal_values = _signal_values(passes, signals)
-    scope_names: dict[int, tuple[tuple[str, ...], tuple[str, ...]]] = {}  # id(scope): the scopes live in sync
-    get_names = scope_names.get
-    access, get_sub = _Access, get_subresource
     barriers, releases, waits = sync.barriers, sync.releases, sync.waits
     out = []
-    for i, (p, row) in enumerate(zip(passes, sync.access_sync, strict=True)):
-        accesses = []
-        for a, s in zip(p.accesses, row, strict=True):
-            mips = a.mips
-            if mips is None:  # buffers and accels
-                sub = None
-            else:
-                sub = get_sub((mips, a.layers))
-                if sub is None:
-                    sub = subresource(mips, a.layers)
-            found = get_names(id(s))
-            if found is None:
-                found = scope_names[id(s)] = _scope_names(s)
-            accesses.append(access(a.resource, sub, a.usage, found[0], found[1], s.layout, a.write))
+    for i, (p, accesses) in enumerate(zip(passes, trace.accesses, strict=True)):
         pw = waits[i]
         params = p.params
         out.append(_Pass(

@@ -1,7 +1,8 @@
 """The trace phase: one walk over the executed passes' accesses, for every later phase.
 
 It gives each access its sync2 scope (``usages.sync_of``; read groups moved to GENERAL by
-``read_layouts``), each resource its usages, its first and last pass and the timeline of
+``read_layouts``) and its plan value (``rgraph.plan.model.Access``: emit does not walk the
+accesses again), each resource its usages, its first and last pass and the timeline of
 each of its cells (``Use``: the accesses of one pass to one cell merged into one), and each
 pass the other queues it already waits for (a cell whose previous use was on another
 queue). ``measure`` reads the usages and lifetimes, ``place`` the cross-queue waits
@@ -13,9 +14,11 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
+from rgraph.compiler.plan_values import get_subresource, names, subresource
 from rgraph.compiler.read_layouts import to_general
 from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell
+from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
@@ -24,7 +27,8 @@ from rgraph.spec.specialize import PassSpec, ResourceSpec
 #: as much to build).
 Use = tuple[int, Sync, bool, str, int]
 
-_SCOPES: dict[tuple, Sync] = {}  # sync_of by (usage, kind, stages, format code, refit)
+#: (sync_of, its stage names, its access names) by (usage, kind, stages, format code, refit)
+_SCOPES: dict[tuple, tuple[Sync, tuple[str, ...], tuple[str, ...]]] = {}
 
 
 @dataclass(slots=True)
@@ -41,11 +45,13 @@ class ResourceTrace:
 
 
 _new_trace = builder(ResourceTrace)
+_new_access = builder(pm.Access)
 
 
 @dataclass
 class Trace:
     syncs: list[list[Sync]]  # per pass, per declared access
+    accesses: list[list[pm.Access]]  # per pass, per declared access: the plan's values
     resources: dict[str, ResourceTrace]  # used resources, in the order of their first use
     #: per pass (only those that have one): queue -> the latest pass on that queue that a cell's
     #: previous use was, i.e. the semaphore waits the dedicated plan has there
@@ -62,12 +68,13 @@ def _start(res: ResourceSpec, i: int, usage: str) -> ResourceTrace:
     return _new_trace({usage}, i, i, [], image + 2 * depth + 4 * stencil, group)
 
 
-def _scope(key: tuple) -> Sync:
+def _scope(key: tuple) -> tuple[Sync, tuple[str, ...], tuple[str, ...]]:
     usage, kind, stages, code, refit = key
     if len(_SCOPES) > 4096:
         _SCOPES.clear()
-    found = _SCOPES[key] = sync_of(usage, kind, explicit_stages=stages, is_image=bool(code & 1),
-                                   depth_format=bool(code & 2), stencil_format=bool(code & 4), refit=refit)
+    s = sync_of(usage, kind, explicit_stages=stages, is_image=bool(code & 1), depth_format=bool(code & 2),
+                stencil_format=bool(code & 4), refit=refit)
+    found = _SCOPES[key] = (s, names(s.stages), names(s.access))
     return found
 
 
@@ -75,16 +82,18 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
     """Scopes, usages, lifetimes, timelines and cross-queue waits in one walk; the reads
     ``read_layouts`` moves to GENERAL are patched in afterwards (a few per graph)."""
     syncs: list[list[Sync]] = []
+    plan_accesses: list[list[pm.Access]] = []
     info: dict[str, ResourceTrace] = {}
     full: dict[str, tuple] = {}  # read-group candidates: (0, mips), (0, layers)
     timeline: dict[Cell, list[Use]] = {}
     waits: dict[int, dict[str, int]] = {}
     scopes = _SCOPES
-    get_info, get_uses, get_scope = info.get, timeline.get, scopes.get
+    get_info, get_uses, get_scope, get_sub, new_access = info.get, timeline.get, scopes.get, get_subresource, _new_access
     for i, p in enumerate(passes):
         queue, kind = p.queue, p.kind
         raytrace = kind == "raytrace"
         row: list[Sync] = []
+        values: list[pm.Access] = []
         pos = 0
         for j, a in enumerate(p.accesses):
             name, usage, w = a.resource, a.usage, a.write
@@ -100,10 +109,19 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
             if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 r.usages.add("trace_indirect")
             key = (usage, kind, a.stages, r.code, a.refit)
-            s = get_scope(key)
-            if s is None:
-                s = _scope(key)
+            scope = get_scope(key)
+            if scope is None:
+                scope = _scope(key)
+            s = scope[0]
             row.append(s)
+            mips = a.mips
+            if mips is None:  # buffers and accels
+                sub = None
+            else:
+                sub = get_sub((mips, a.layers))
+                if sub is None:
+                    sub = subresource(mips, a.layers)
+            values.append(new_access(name, sub, usage, scope[1], scope[2], s.layout, w))
             group = r.group
             if group is not None:
                 whole = full[name]
@@ -132,6 +150,7 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                 uses.append((i, s, w, queue, pos))
                 pos += 1
         syncs.append(row)
+        plan_accesses.append(values)
     moved = to_general({name: r.group for name, r in info.items() if r.group is not None}, syncs)
     general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
     for i, j in moved:
@@ -140,9 +159,11 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
         if found is None:
             found = general[id(scope)] = (scope, replace(scope, layout="GENERAL"))
         syncs[i][j] = found[1]
+        v = plan_accesses[i][j]
+        plan_accesses[i][j] = _new_access(v.resource, v.subresource, v.usage, v.stages, v.access, "GENERAL", v.write)
     for i, j in moved:
         _repatch(passes[i], i, passes[i].accesses[j].cells, syncs[i], timeline)
-    return Trace(syncs, info, waits)
+    return Trace(syncs, plan_accesses, info, waits)
 
 
 def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], timeline: dict[Cell, list[Use]]) -> None:

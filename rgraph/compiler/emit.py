@@ -6,16 +6,15 @@ plan (and ``rgraph.plan.dump`` the same bytes).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from rgraph.compiler import sync as csync
-from rgraph.compiler.plan_values import get_state, names, plan_state
+from rgraph.compiler.plan_values import get_state, plan_state
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
-from rgraph.spec.specialize import PassSpec
 
 if TYPE_CHECKING:
     from rgraph.compiler.phases import Compilation
@@ -61,17 +60,15 @@ def _frozen_json(value: Any) -> Any:
 def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
     passes, sync, trace = c.passes, c.sync, c.trace
     assert sync is not None and trace is not None
-    signals = sync.signals
-    signal_values = _signal_values(passes, signals)
+    signals, signal_values = sync.signals, sync.signal_values
     barriers, releases, waits = sync.barriers, sync.releases, sync.waits
     out = []
     for i, (p, accesses) in enumerate(zip(passes, trace.accesses, strict=True)):
-        pw = waits[i]
         params = p.params
         out.append(_Pass(
             p.name, i, 0, p.queue, p.kind, p.impl, _frozen(params) if params else pm.EMPTY, tuple(accesses),
             barriers[i], releases[i],
-            tuple([_Wait(w.queue, signal_values[w.signal_pass], names(w.stages)) for w in pw]) if pw else (),
+            waits[i],
             (_Signal(p.queue, signal_values[i], SIGNAL_STAGES),) if signals[i] else (),
         ))
     return tuple(out)
@@ -108,7 +105,6 @@ def emit(c: Compilation) -> pm.Plan:
     spec, placement, culling = c.spec, c.placement, c.culling
     assert placement is not None and culling is not None
     passes = _passes(c)
-    by_name = {p.name: p for p in spec.passes}
     used = c.memory
     st = placement.stats
     return pm.Plan(
@@ -116,7 +112,7 @@ def emit(c: Compilation) -> pm.Plan:
         size=tuple(spec.size), params=_frozen(spec.params), features=_frozen(spec.features),
         device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if any(p.queue == q for p in passes)),
         passes=passes,
-        culled=tuple(_culled(x.pass_name, x.reason, by_name[x.pass_name], c, used) for x in culling.culled),
+        culled=_culled(c, used),
         dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
         resources=_resources(c),
         heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
@@ -130,18 +126,27 @@ def emit(c: Compilation) -> pm.Plan:
     )
 
 
-def _culled(name: str, reason: str, p: PassSpec, c: Compilation, used: Mapping[str, Any]) -> pm.Culled:
-    """A culled pass with the resources only culled passes used (not in ``used``), and their bytes."""
-    only = tuple(sorted({a.resource for a in p.accesses if a.resource not in used}))
-    return _Culled(name, reason, only, sum(c.culled_bytes.get(r, 0) for r in only))
-
-
-def _signal_values(passes: Sequence[PassSpec], signals: Sequence[bool]) -> dict[int, int]:
-    """Timeline values per queue, 1, 2, ... in plan order."""
-    counters: dict[str, int] = {}
-    values: dict[int, int] = {}
-    for i, p in enumerate(passes):
-        if signals[i]:
-            counters[p.queue] = counters.get(p.queue, 0) + 1
-            values[i] = counters[p.queue]
-    return values
+def _culled(c: Compilation, used: Mapping[str, Any]) -> tuple[pm.Culled, ...]:
+    """The culled passes, each with the resources only culled passes used (not in ``used``)
+    and their bytes."""
+    assert c.culling is not None
+    culled = c.culling.culled
+    if not culled:
+        return ()
+    by_name = {p.name: p for p in c.spec.passes}
+    get_bytes = c.culled_bytes.get
+    out = []
+    for x in culled:
+        only: set[str] | None = None
+        for a in by_name[x.pass_name].accesses:
+            if a.resource not in used:
+                if only is None:
+                    only = {a.resource}
+                else:
+                    only.add(a.resource)
+        if only is None:  # most culled passes: every resource is also used by an executed one
+            out.append(_Culled(x.pass_name, x.reason, (), 0))
+        else:
+            names_only = tuple(sorted(only))
+            out.append(_Culled(x.pass_name, x.reason, names_only, sum(get_bytes(r, 0) for r in names_only)))
+    return tuple(out)

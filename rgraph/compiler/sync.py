@@ -23,20 +23,25 @@ resource's last accesses and UNDEFINED.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from operator import itemgetter
 
 from rgraph.compiler.alias_starts import alias_state, with_partial_handoffs
 from rgraph.compiler.plan_values import get_state, make_barrier, plan_state, subresource
+from rgraph.compiler.plan_values import names as sorted_names
 from rgraph.compiler.rectangles import mip_layer_rectangles
-from rgraph.compiler.sync_types import EMPTY, StateKey, SyncResult, Wait
+from rgraph.compiler.sync_types import EMPTY, StateKey, SyncResult
 from rgraph.compiler.trace import Trace, Use
 from rgraph.ir.graph import Cell
 from rgraph.plan import model as pm
+from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
-__all__ = ["EMPTY", "StateKey", "SyncResult", "Wait", "synchronize"]
+__all__ = ["EMPTY", "StateKey", "SyncResult", "synchronize"]
 
 PERSISTENT = ("persistent", "imported")
 EMPTY2 = (EMPTY, EMPTY)
+_LAST = itemgetter(-1)
+_new_wait = builder(pm.Wait)
 
 #: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
 #: is (stages, write access) of the last write or None, reads the stages of each read since it,
@@ -127,7 +132,7 @@ def synchronize(
             _rectangles(name, multi, bars, rels)
         initial[name] = starts
         final[name] = finals
-    return _gather(bars, rels, waits, trace, final, initial)
+    return _gather(bars, rels, waits, passes, final, initial)
 
 
 def _state(end: CellEnd) -> StateKey:
@@ -316,15 +321,17 @@ def _rectangles(res: str, found: list[tuple[int, int, Cell, Key, int | None]], b
                     rels[release_at].append((i, res, first, made))
 
 
-def _gather(bars: list, rels: list, waits: list, trace: Trace, final: dict, initial: dict) -> SyncResult:
+def _gather(bars: list, rels: list, waits: list, passes: Sequence[PassSpec], final: dict, initial: dict) -> SyncResult:
     """Each pass's barriers in (resource, mips, layers) order, the releases it owes later
     acquires (by acquiring pass, resource, then the order that pass touches the cells), its
-    waits by queue and whether it signals."""
+    waits by queue (the plan's values: a wait names the timeline value that its pass signals)
+    and whether it signals."""
     count = len(bars)
     barriers: list[tuple[pm.Barrier, ...]] = [()] * count
     releases: list[tuple[pm.Barrier, ...]] = [()] * count
-    pass_waits: list[tuple[Wait, ...]] = [()] * count
+    pass_waits: list[tuple[pm.Wait, ...]] = [()] * count
     signals = [False] * count
+    last = _LAST
     for i in range(count):
         found = bars[i]
         if found is not None:
@@ -332,7 +339,7 @@ def _gather(bars: list, rels: list, waits: list, trace: Trace, final: dict, init
                 barriers[i] = (found[0][-1],)
             else:
                 found.sort()  # (resource, [mips, layers]) never tie within a pass: barriers not compared
-                barriers[i] = tuple([e[-1] for e in found])
+                barriers[i] = tuple(map(last, found))
         found = rels[i]
         if found is not None:
             if len(found) > 1:
@@ -340,10 +347,24 @@ def _gather(bars: list, rels: list, waits: list, trace: Trace, final: dict, init
             releases[i] = tuple([b for e in found for b in e[3]])
         found = waits[i]
         if found is not None:
-            pass_waits[i] = tuple([Wait(q, j, stages) for q, (j, stages) in sorted(found.items())])
-            for _, (j, _) in found.items():
+            for j, _ in found.values():
                 signals[j] = True
-    return SyncResult(barriers, releases, pass_waits, signals, trace.syncs, final, initial)
+    values = [0] * count  # timeline values per queue, 1, 2, ... in plan order
+    counters: dict[str, int] = {}
+    for i in range(count):
+        if signals[i]:
+            queue = passes[i].queue
+            values[i] = counters[queue] = counters.get(queue, 0) + 1
+    new_wait = _new_wait
+    for i in range(count):
+        found = waits[i]
+        if found is not None:
+            if len(found) == 1:
+                for q, (j, stages) in found.items():
+                    pass_waits[i] = (new_wait(q, values[j], sorted_names(stages)),)
+            else:
+                pass_waits[i] = tuple([new_wait(q, values[j], sorted_names(stages)) for q, (j, stages) in sorted(found.items())])
+    return SyncResult(barriers, releases, pass_waits, signals, values, final, initial)
 
 
 def _group(uses: list[Use], k: int, layout: str | None, queue: str) -> tuple[frozenset[str], frozenset[str], int]:

@@ -3,9 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
 
-from rgraph.compiler.usages import Sync
 from rgraph.ir.graph import Cell
 from rgraph.plan import model as pm
 
@@ -17,18 +15,12 @@ EMPTY: frozenset[str] = frozenset()
 StateKey = tuple
 
 
-class Wait(NamedTuple):
-    queue: str
-    signal_pass: int  # executed index of the pass whose signal is waited for
-    stages: frozenset[str]
-
-
 @dataclass
 class SyncResult:
     barriers: list[tuple[pm.Barrier, ...]]  # per pass: before it
     releases: list[tuple[pm.Barrier, ...]]  # per pass: queue-family releases after it
-    waits: list[tuple[Wait, ...]]  # per pass, by queue
+    waits: list[tuple[pm.Wait, ...]]  # per pass, by queue
     signals: list[bool]  # per pass: a later pass waits for it
-    access_sync: list[list[Sync]]  # per pass, per declared access
+    signal_values: list[int]  # per pass: the timeline value it signals on its queue (1, 2, ...; 0: none)
     final: dict[str, dict[Cell, StateKey]]  # per resource: end-of-frame state per cell
     initial: dict[str, dict[Cell, StateKey]]

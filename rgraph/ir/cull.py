@@ -16,13 +16,17 @@ from functools import cached_property
 import networkx as nx
 
 from rgraph.ir.graph import READ_WRITE_USAGES, Cell, build_graph, last_writers
+from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, Spec
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Culled:
     pass_name: str
     reason: str
+
+
+_new_culled = builder(Culled)
 
 
 @dataclass(frozen=True)
@@ -50,8 +54,16 @@ def cull(spec: Spec) -> Culling:
     kept, dropped, cascade = _drop_unproduced_reads(spec, removed_reason)
     culled += cascade
     alive = _alive(spec, kept)
-    final = [p for p in kept if p.name in alive]
-    culled += [Culled(p.name, "reaches no output") for p in kept if p.name not in alive]
+    final = []
+    unreached = []
+    for p in kept:
+        if p.name in alive:
+            final.append(p)
+        else:
+            unreached.append(_new_culled(p.name, "reaches no output"))
+    if not culled:  # kept is in declaration order
+        return Culling(final, unreached, dropped)
+    culled += unreached
     order = {p.name: p.order for p in spec.passes}
     culled.sort(key=lambda c: order[c.pass_name])
     return Culling(final, culled, dropped)

@@ -10,8 +10,6 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-from rgraph.compiler import sync as csync
-from rgraph.compiler.plan_values import get_state, plan_state
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
@@ -25,23 +23,6 @@ SIGNAL_STAGES = ("ALL_COMMANDS",)
 # from the sync phase as plan values.
 _Access, _Pass, _Resource = (builder(c) for c in (pm.Access, pm.PlanPass, pm.PlanResource))
 _Wait, _Signal, _Culled = (builder(c) for c in (pm.Wait, pm.Signal, pm.Culled))
-
-
-def _end_state(lifetime: str, states: Mapping[Any, csync.StateKey] | None) -> pm.EndState:
-    """One state when every cell agrees. Otherwise: None for transients (nothing outlives the
-    frame), a per-cell list for the others (docs/plan.md)."""
-    if not states:
-        return None
-    if len(states) == 1:
-        for st in states.values():
-            return get_state(st) or plan_state(st)
-    distinct = set(states.values())
-    if len(distinct) == 1:
-        return plan_state(next(iter(distinct)))
-    if lifetime == "transient":
-        return None
-    return tuple(pm.CellState(pm.Subresource((mip, mip + 1), (layer, layer + 1)), plan_state(st))
-                 for (_, mip, layer), st in sorted(states.items()))
 
 
 def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -93,7 +74,7 @@ def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
         out.append(_Resource(  # positional, in PlanResource's field order (a keyword call costs more)
             name, res.kind, fmt.vk_name if fmt else None, mem.bytes, size_bytes, mem.alignment, mem.memory_type_bits,
             mem.memory_class, mem.usages, lifetime, mem.first, mem.last, heap, offset,
-            _end_state(lifetime, initial.get(name)), _end_state(lifetime, final.get(name)),
+            initial.get(name), final.get(name),
             extent, mips, layers, samples, _frozen_json(accel.as_plan()) if accel is not None else None,
             res.scratch_of,
         ))

@@ -134,7 +134,8 @@ def synchronize(c: Compilation) -> Compilation:
     """Barriers, queue-ownership releases, semaphore waits and signals per pass."""
     assert c.placement is not None and c.trace is not None
     ranges = {n: (heap, off, off + c.memory[n].bytes) for n, (heap, off) in c.placement.offsets.items()}
-    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, c.aliases, ranges))
+    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, c.aliases, ranges,
+                                              set(c.spec.outputs)))
 
 
 def emit(c: Compilation) -> Compilation:

@@ -22,7 +22,7 @@ resource's last accesses and UNDEFINED.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from operator import itemgetter
 
 from rgraph.compiler.alias_starts import alias_state, with_partial_handoffs
@@ -42,6 +42,9 @@ PERSISTENT = ("persistent", "imported")
 EMPTY2 = (EMPTY, EMPTY)
 _LAST = itemgetter(-1)
 _new_wait = builder(pm.Wait)
+#: A transient with nothing aliased before it starts in this layout and plan state (an image, a buffer).
+_START_IMAGE = ("UNDEFINED", plan_state((EMPTY, EMPTY, "UNDEFINED", None)))
+_START_BUFFER = (None, plan_state((EMPTY, EMPTY, None, None)))
 
 #: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
 #: is (stages, write access) of the last write or None, reads the stages of each read since it,
@@ -63,13 +66,15 @@ def synchronize(
     trace: Trace,
     alias_sources: Mapping[str, Sequence[str]] | None = None,
     ranges: Mapping[str, tuple[int, int, int]] | None = None,
+    outputs: Collection[str] = (),
 ) -> SyncResult:
     """Barriers and semaphores for ``passes`` (executed order; ``trace``: theirs).
 
     ``alias_sources`` maps a transient resource to the resources whose memory it reuses
     (all of them ended before it starts); ``ranges`` gives (heap, first byte, end byte) of
     the placed resources, so that older occupants reached through a partial hand-off count
-    only where their bytes overlap.
+    only where their bytes overlap. ``outputs``: the graph's outputs (an output's cells may
+    end in different states: the plan lists them, as for persistent resources).
     """
     count = len(passes)
     touched = {name: len(r.cells) for name, r in trace.resources.items()}
@@ -77,23 +82,38 @@ def synchronize(
     bars: list[list | None] = [None] * count
     rels: list[list | None] = [None] * count
     waits: list[dict | None] = [None] * count
-    initial: dict[str, dict[Cell, StateKey]] = {}
-    final: dict[str, dict[Cell, StateKey]] = {}
+    initial: dict[str, pm.EndState] = {}
+    final: dict[str, pm.EndState] = {}
     ends: dict[str, list[tuple[StateKey, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
     wanted = {pred for preds in sources.values() for pred in preds}
+    one_sink = (bars, rels, waits, None)
+    fresh = {True: _START_IMAGE, False: _START_BUFFER}  # (layout, plan state) of an unaliased transient's start
     # resources in the order of their first pass: every earlier occupant of a resource's memory
     # ends before it starts, so it is walked before it
     for name, r in trace.resources.items():
         res = resources[name]
         image = res.kind == "image"
-        layout = "UNDEFINED" if image else None
         cells = r.cells
+        preds = sources.get(name)
+        lifetime = res.lifetime
+        if len(cells) == 1 and not preds and lifetime == "transient" and name not in wanted:
+            # most resources: one cell (every buffer), nothing aliased before or after it
+            c, uses = cells[0]
+            if image:
+                (_, mip, layer) = c
+                sub = subresource((mip, mip + 1), (layer, layer + 1))
+            else:
+                sub = None
+            layout, initial[name] = fresh[image]
+            st = _state(_walk(uses, image, (layout, None, None, [], None, EMPTY2), (), (), False, one_sink, c, sub))
+            final[name] = get_state(st) or plan_state(st)
+            continue
+        layout = "UNDEFINED" if image else None
         starts: dict[Cell, StateKey] = {}
         finals: dict[Cell, StateKey] = {}
         kept: list[tuple[StateKey, int | None]] | None = None
         if name in wanted:
             kept = ends[name] = []
-        preds = sources.get(name)
         multi: list | None = None
         sub = None  # the one cell's subresource
         if len(cells) > 1:
@@ -102,10 +122,10 @@ def synchronize(
             (_, mip, layer), _ = cells[0]
             sub = subresource((mip, mip + 1), (layer, layer + 1))
         sink = (bars, rels, waits, multi)
-        if res.lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
+        if lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
             for c, uses in cells:
                 lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
-                                                                 (), (), False, None, c, None)
+                                                                (), (), False, None, c, None)
                 start = (lay, queue, write, list(reads), last, visible)
                 starts[c] = _state(start)
                 end = _walk(uses, image, start, (), (), True, sink, c, sub)
@@ -130,9 +150,28 @@ def synchronize(
                     kept.append((st, end[4]))
         if multi:
             _rectangles(name, multi, bars, rels)
-        initial[name] = starts
-        final[name] = finals
+        per_cell = lifetime != "transient" or name in outputs
+        initial[name] = _end_state(per_cell, starts)
+        final[name] = _end_state(per_cell, finals)
     return _gather(bars, rels, waits, passes, final, initial)
+
+
+def _end_state(per_cell: bool, states: Mapping[Cell, StateKey]) -> pm.EndState:
+    """A resource's state at the frame's start or end, as the plan has it: one state when
+    every cell agrees; otherwise a per-cell list if ``per_cell`` (it outlives the frame), else
+    None (docs/plan.md)."""
+    if not states:
+        return None
+    if len(states) == 1:
+        for st in states.values():
+            return get_state(st) or plan_state(st)
+    distinct = set(states.values())
+    if len(distinct) == 1:
+        return plan_state(next(iter(distinct)))
+    if not per_cell:
+        return None
+    return tuple(pm.CellState(pm.Subresource((mip, mip + 1), (layer, layer + 1)), plan_state(st))
+                 for (_, mip, layer), st in sorted(states.items()))
 
 
 def _state(end: CellEnd) -> StateKey:

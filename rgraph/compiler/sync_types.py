@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rgraph.ir.graph import Cell
 from rgraph.plan import model as pm
 
 EMPTY: frozenset[str] = frozenset()
@@ -22,5 +21,5 @@ class SyncResult:
     waits: list[tuple[pm.Wait, ...]]  # per pass, by queue
     signals: list[bool]  # per pass: a later pass waits for it
     signal_values: list[int]  # per pass: the timeline value it signals on its queue (1, 2, ...; 0: none)
-    final: dict[str, dict[Cell, StateKey]]  # per resource: end-of-frame state per cell
-    initial: dict[str, dict[Cell, StateKey]]
+    final: dict[str, pm.EndState]  # per resource: its end-of-frame state as the plan has it
+    initial: dict[str, pm.EndState]

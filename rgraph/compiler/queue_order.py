@@ -30,20 +30,33 @@ def cross_queue_conflicts(passes: Sequence[PassSpec], trace: Trace, candidates: 
     if len({p.queue for p in passes}) < 2:
         return {}
     waits = trace.waits
-    firsts: dict[str, set[tuple[int, str]]] = {}  # resource -> (first pass of a cell, its queue)
+    firsts: dict[str, Collection[tuple[int, str]]] = {}  # resource -> (first pass of a cell, its queue)
     # Per queue q: the resources with a cell last used on q, by that last use. Sharing with a
     # later r adds a wait iff some cell of r first used on another queue does not already
     # wait for q at or after it: a range of this order, found by bisection.
     by_queue: dict[str, list[tuple[int, str]]] = {}
     resources = trace.resources
     for name in candidates:
-        r = resources[name]
-        firsts[name] = {(uses[0][0], uses[0][3]) for _, uses in r.cells}
+        cells = resources[name].cells
+        if len(cells) == 1:  # most resources
+            uses = cells[0][1]
+            first, end = uses[0], uses[-1]
+            firsts[name] = ((first[0], first[3]),)
+            q = end[3]
+            if q in by_queue:
+                by_queue[q].append((end[0], name))
+            else:
+                by_queue[q] = [(end[0], name)]
+            continue
+        starts: set[tuple[int, str]] = set()
         per: dict[str, int] = {}  # queue -> last pass of a cell ending there
-        for _, uses in r.cells:
-            _, _, _, q, _ = end = uses[-1]
+        for _, uses in cells:
+            first, end = uses[0], uses[-1]
+            starts.add((first[0], first[3]))
+            q = end[3]
             if per.get(q, -1) < end[0]:
                 per[q] = end[0]
+        firsts[name] = starts
         for q, j in per.items():
             if q in by_queue:
                 by_queue[q].append((j, name))
@@ -58,10 +71,16 @@ def cross_queue_conflicts(passes: Sequence[PassSpec], trace: Trace, candidates: 
         r_first = resources[r].first
         r_firsts = firsts[r]
         for q, rows in by_queue.items():
-            have = [waits.get(v, none).get(q, -1) for v, qv in r_firsts if qv != q]
-            if not have:
+            low = None  # the earliest pass on q that a cell of r first used elsewhere already waits for
+            for v, qv in r_firsts:
+                if qv != q:
+                    have = waits.get(v, none).get(q, -1)
+                    if low is None or have < low:
+                        low = have
+            if low is None:
                 continue  # r starts on q only: a pipeline barrier orders it
-            lo, hi = bisect_right(keys[q], min(have)), bisect_left(keys[q], r_first)
+            key = keys[q]
+            lo, hi = bisect_right(key, low), bisect_left(key, r_first)
             for _, p in rows[lo:hi]:
                 if resources[p].last < r_first:
                     if r in out:

@@ -26,7 +26,7 @@ from collections.abc import Collection, Mapping, Sequence
 from operator import itemgetter
 
 from rgraph.compiler.alias_starts import alias_state, with_partial_handoffs
-from rgraph.compiler.plan_values import get_state, make_barrier, plan_state, subresource
+from rgraph.compiler.plan_values import get_state, get_subresource, make_barrier, plan_state, subresource
 from rgraph.compiler.plan_values import names as sorted_names
 from rgraph.compiler.rectangles import mip_layer_rectangles
 from rgraph.compiler.sync_types import EMPTY, StateKey, SyncResult
@@ -55,8 +55,8 @@ CellEnd = tuple
 Key = tuple
 #: Where the walk puts what it finds, per executed pass: (barriers as (resource, [mips, layers,]
 #: plan barrier) sort entries, releases as (acquiring pass, resource, cell position, barriers),
-#: waits as queue -> (pass, stages), and for a resource of several cells its list of
-#: (pass, cell position, cell, key, release pass), else None).
+#: waits as queue -> (pass, stages), and for a resource of several cells its barrier groups
+#: per pass (``_rectangles``), else None).
 Sink = tuple
 
 
@@ -114,10 +114,10 @@ def synchronize(
         kept: list[tuple[StateKey, int | None]] | None = None
         if name in wanted:
             kept = ends[name] = []
-        multi: list | None = None
+        multi: dict[int, list[list]] | None = None
         sub = None  # the one cell's subresource
         if len(cells) > 1:
-            multi = []
+            multi = {}
         elif image:
             (_, mip, layer), _ = cells[0]
             sub = subresource((mip, mip + 1), (layer, layer + 1))
@@ -291,8 +291,19 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                 found[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
         if key is None:
             continue
-        if multi is not None:
-            multi.append((i, pos, c, key, release_at))
+        if multi is not None:  # per pass: [key, release pass, first cell position, cells] (few keys per pass)
+            groups = multi.get(i)
+            if groups is None:
+                multi[i] = [[key, release_at, pos, [(c[1], c[2])]]]
+                continue
+            for group in groups:  # compared in a list: hashing a key (nested tuples) costs more
+                if group[1] == release_at and group[0] == key:
+                    group[3].append((c[1], c[2]))
+                    if pos < group[2]:
+                        group[2] = pos
+                    break
+            else:
+                groups.append([key, release_at, pos, [(c[1], c[2])]])
             continue
         src, dst, names = key
         ps = get_state(src)
@@ -317,26 +328,12 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
     return layout, cq, write, reads, last_pass, visible
 
 
-def _rectangles(res: str, found: list[tuple[int, int, Cell, Key, int | None]], bars: list, rels: list) -> None:
-    """A resource of several cells: per pass, its cells with one key and release pass merged into
+def _rectangles(res: str, by_pass: dict[int, list[list]], bars: list, rels: list) -> None:
+    """A resource of several cells: per pass, its cells with one key and release pass (grouped
+    by the walks: [key, release pass, first cell position, (mip, layer) cells]) merged into
     mip x layer rectangles (an acquire's rectangles equal its release's: the layer pairs
     ownership transfers by exact subresource range)."""
-    # per pass: [key, release pass, first cell position, cells]; a pass has few keys per
-    # resource, compared in a list (hashing a key, nested tuples, costs more)
-    by_pass: dict[int, list[list]] = {}
-    for i, pos, c, key, release_at in found:
-        groups = by_pass.get(i)
-        if groups is None:
-            by_pass[i] = [[key, release_at, pos, [(c[1], c[2])]]]
-            continue
-        for group in groups:
-            if group[1] == release_at and group[0] == key:
-                group[3].append((c[1], c[2]))
-                if pos < group[2]:
-                    group[2] = pos
-                break
-        else:
-            groups.append([key, release_at, pos, [(c[1], c[2])]])
+    get_sub = get_subresource
     for i, groups in by_pass.items():
         for (src, dst, names), release_at, first, cells in groups:
             ps = get_state(src) or plan_state(src)
@@ -344,7 +341,8 @@ def _rectangles(res: str, found: list[tuple[int, int, Cell, Key, int | None]], b
             if len(cells) == 1:
                 ((mip, layer),) = cells
                 mips, layers = (mip, mip + 1), (layer, layer + 1)
-                entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))]
+                sub = get_sub((mips, layers)) or subresource(mips, layers)
+                entries = [(res, mips, layers, make_barrier(res, sub, ps, pd, names))]
             else:
                 entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
                            for mips, layers in mip_layer_rectangles(cells)]

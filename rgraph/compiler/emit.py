@@ -86,14 +86,13 @@ def emit(c: Compilation) -> pm.Plan:
     spec, placement, culling = c.spec, c.placement, c.culling
     assert placement is not None and culling is not None
     passes = _passes(c)
-    used = c.memory
     st = placement.stats
     return pm.Plan(
         graph=spec.name, source=spec.source, scene=spec.scene_name, scene_source=c.spec.scene_source,
         size=tuple(spec.size), params=_frozen(spec.params), features=_frozen(spec.features),
         device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if any(p.queue == q for p in passes)),
         passes=passes,
-        culled=_culled(c, used),
+        culled=_culled(c),
         dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
         resources=_resources(c),
         heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
@@ -107,27 +106,16 @@ def emit(c: Compilation) -> pm.Plan:
     )
 
 
-def _culled(c: Compilation, used: Mapping[str, Any]) -> tuple[pm.Culled, ...]:
-    """The culled passes, each with the resources only culled passes used (not in ``used``)
-    and their bytes."""
+def _culled(c: Compilation) -> tuple[pm.Culled, ...]:
+    """The culled passes, each with the resources only culled passes used and their bytes
+    (``measure`` found them)."""
     assert c.culling is not None
-    culled = c.culling.culled
-    if not culled:
-        return ()
-    by_name = {p.name: p for p in c.spec.passes}
-    get_bytes = c.culled_bytes.get
+    get_only, get_bytes = c.culled_only.get, c.culled_bytes.get
     out = []
-    for x in culled:
-        only: set[str] | None = None
-        for a in by_name[x.pass_name].accesses:
-            if a.resource not in used:
-                if only is None:
-                    only = {a.resource}
-                else:
-                    only.add(a.resource)
-        if only is None:  # most culled passes: every resource is also used by an executed one
+    for x in c.culling.culled:
+        only = get_only(x.pass_name)
+        if only is None:
             out.append(_Culled(x.pass_name, x.reason, (), 0))
         else:
-            names_only = tuple(sorted(only))
-            out.append(_Culled(x.pass_name, x.reason, names_only, sum(get_bytes(r, 0) for r in names_only)))
+            out.append(_Culled(x.pass_name, x.reason, only, sum(get_bytes(r, 0) for r in only)))
     return tuple(out)

@@ -19,7 +19,7 @@ builds no edges). Building a DiGraph for either costs more than the phase itself
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -33,7 +33,7 @@ from rgraph.compiler.trace import Trace
 from rgraph.compiler.trace import trace as trace_passes
 from rgraph.defaults import DEFAULT_SCHEDULE
 from rgraph.errors import RGraphError
-from rgraph.ir.cull import Culling
+from rgraph.ir.cull import Culled, Culling
 from rgraph.ir.cull import cull as cull_spec
 from rgraph.ir.schedule import schedule_passes
 from rgraph.memory.model import Placement
@@ -60,6 +60,7 @@ class Compilation:
     trace: Trace | None = None  # scopes, usages, lifetimes and cell timelines of ``passes``
     memory: Mapping[str, memory.ResourceMemory] = field(default_factory=dict)  # used resources, name order
     culled_bytes: Mapping[str, int] = field(default_factory=dict)  # resources only culled passes use
+    culled_only: Mapping[str, tuple[str, ...]] = field(default_factory=dict)  # culled pass -> those it uses (if any)
     placement: Placement | None = None
     aliases: Mapping[str, list[str]] = field(default_factory=dict)  # resource -> earlier occupants it waits for
     sync: SyncResult | None = None
@@ -110,12 +111,36 @@ def measure(c: Compilation) -> Compilation:
     used = {name: r.usages for name, r in traced.items()}
     spans = {name: (r.first, r.last) for name, r in traced.items()}
     reqs = memory.requirements(spec.resources, used, spec.outputs, c.provider)
-    culled = {x.pass_name for x in c.culling.culled}
-    culled_used = {r: u for r, u in memory.usages_by_resource([p for p in spec.passes if p.name in culled]).items()
-                   if r not in reqs} if culled else {}
+    culled_only, culled_passes = _culled_only(spec, c.culling.culled, traced)
+    culled_used = memory.usages_by_resource(culled_passes) if culled_passes else {}
+    culled_used = {r: u for r, u in culled_used.items() if r not in traced}
     culled_reqs = memory.requirements(spec.resources, culled_used, spec.outputs, c.provider) if culled_used else {}
     return replace(c, memory=memory.resource_memory(reqs, used, spans),
-                   culled_bytes={r: q.bytes for r, q in culled_reqs.items()})
+                   culled_bytes={r: q.bytes for r, q in culled_reqs.items()}, culled_only=culled_only)
+
+
+def _culled_only(spec: Spec, culled: Sequence[Culled], traced: Mapping[str, object]
+                 ) -> tuple[dict[str, tuple[str, ...]], list[PassSpec]]:
+    """Per culled pass that uses resources no executed pass uses (not in ``traced``): those,
+    sorted; and those passes (the only ones whose usages size a culled-only resource)."""
+    if not culled:
+        return {}, []
+    by_name = {p.name: p for p in spec.passes}
+    only_by_pass: dict[str, tuple[str, ...]] = {}
+    passes: list[PassSpec] = []
+    for x in culled:
+        p = by_name[x.pass_name]
+        only: set[str] | None = None
+        for a in p.accesses:
+            if a.resource not in traced:
+                if only is None:
+                    only = {a.resource}
+                else:
+                    only.add(a.resource)
+        if only is not None:  # most culled passes: every resource is also used by an executed one
+            only_by_pass[p.name] = tuple(sorted(only))
+            passes.append(p)
+    return only_by_pass, passes
 
 
 def place(c: Compilation) -> Compilation:

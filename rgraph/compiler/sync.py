@@ -87,7 +87,7 @@ def synchronize(
     ends: dict[str, list[tuple[StateKey, int | None]]] = {}  # aliased-from resources: (end state, last pass) per cell
     wanted = {pred for preds in sources.values() for pred in preds}
     one_sink = (bars, rels, waits, None)
-    fresh = {True: _START_IMAGE, False: _START_BUFFER}  # (layout, plan state) of an unaliased transient's start
+    fresh = {True: _START_IMAGE, False: _START_BUFFER}  # (layout, plan state) of an unaliased start
     # resources in the order of their first pass: every earlier occupant of a resource's memory
     # ends before it starts, so it is walked before it
     for name, r in trace.resources.items():
@@ -96,17 +96,29 @@ def synchronize(
         cells = r.cells
         preds = sources.get(name)
         lifetime = res.lifetime
-        if len(cells) == 1 and not preds and lifetime == "transient" and name not in wanted:
-            # most resources: one cell (every buffer), nothing aliased before or after it
+        if len(cells) == 1 and lifetime not in PERSISTENT:  # most resources: one cell (every buffer)
             c, uses = cells[0]
             if image:
                 (_, mip, layer) = c
                 sub = subresource((mip, mip + 1), (layer, layer + 1))
             else:
                 sub = None
-            layout, initial[name] = fresh[image]
-            st = _state(_walk(uses, image, (layout, None, None, [], None, EMPTY2), (), (), False, one_sink, c, sub))
+            if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
+                layout = "UNDEFINED" if image else None
+                stages, access, queue, last, aliases, alias_waits = alias_state(
+                    preds, [end for pred in preds for end in ends.get(pred, ())], r.first)
+                write = (stages, access) if stages or access else None
+                first = _state((layout, queue, write, (), last, EMPTY2))
+                initial[name] = get_state(first) or plan_state(first)
+                end = _walk(uses, image, (layout, queue, write, [], last, EMPTY2), aliases, alias_waits, False,
+                            one_sink, c, sub)
+            else:
+                layout, initial[name] = fresh[image]
+                end = _walk(uses, image, (layout, None, None, [], None, EMPTY2), (), (), False, one_sink, c, sub)
+            st = _state(end)
             final[name] = get_state(st) or plan_state(st)
+            if name in wanted:
+                ends[name] = [(st, end[4])]
             continue
         layout = "UNDEFINED" if image else None
         starts: dict[Cell, StateKey] = {}

@@ -86,11 +86,14 @@ def emit(c: Compilation) -> pm.Plan:
     spec, placement, culling = c.spec, c.placement, c.culling
     assert placement is not None and culling is not None
     passes = _passes(c)
+    sync = c.sync
+    assert sync is not None
+    present = {p.queue for p in c.passes}
     st = placement.stats
     return pm.Plan(
         graph=spec.name, source=spec.source, scene=spec.scene_name, scene_source=c.spec.scene_source,
         size=tuple(spec.size), params=_frozen(spec.params), features=_frozen(spec.features),
-        device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if any(p.queue == q for p in passes)),
+        device_profile=c.profile_name, queues=tuple(q for q in pm.QUEUE_ORDER if q in present),
         passes=passes,
         culled=_culled(c),
         dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
@@ -98,7 +101,7 @@ def emit(c: Compilation) -> pm.Plan:
         heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
         outputs=tuple(c.spec.outputs),
         stats=pm.Stats(
-            barriers=sum(len(p.barriers) for p in passes), semaphores=sum(1 for p in passes if p.signals),
+            barriers=sum(map(len, sync.barriers)), semaphores=sum(sync.signals),
             peak_bytes=st.peak_bytes, lower_bound_bytes=st.lower_bound_bytes, unaliased_bytes=st.unaliased_bytes,
             allocations=st.allocations, policy=st.policy,
             schedule=None if c.schedule == DEFAULT_SCHEDULE else c.schedule,  # absent = declaration order

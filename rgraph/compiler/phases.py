@@ -158,8 +158,11 @@ def place(c: Compilation) -> Compilation:
 def synchronize(c: Compilation) -> Compilation:
     """Barriers, queue-ownership releases, semaphore waits and signals per pass."""
     assert c.placement is not None and c.trace is not None
-    ranges = {n: (heap, off, off + c.memory[n].bytes) for n, (heap, off) in c.placement.offsets.items()}
-    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, c.aliases, ranges,
+    offsets, aliases = c.placement.offsets, c.aliases
+    # (heap, first byte, end byte) of the resources that alias or are aliased (``with_partial_handoffs``)
+    named = {n for preds in aliases.values() for n in preds}.union(aliases)
+    ranges = {n: (heap, off, off + c.memory[n].bytes) for n in named for heap, off in (offsets[n],)}
+    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, aliases, ranges,
                                               set(c.spec.outputs)))
 
 

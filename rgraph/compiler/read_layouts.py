@@ -15,28 +15,28 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from rgraph.compiler.usages import Sync
-
 # Not transfer_src: copies from GENERAL draw a validation performance warning (the layer
 # wants TRANSFER_SRC_OPTIMAL), so a copy keeps its own layout and transition.
 GENERAL_READS = frozenset({"sampled", "storage_read"})
 
 
-def to_general(groups: Mapping[str, Sequence[tuple[int, int, bool, str]]],
-               syncs: Sequence[Sequence[Sync]]) -> list[tuple[int, int]]:
+def to_general(groups: Mapping[str, Sequence[tuple[int, int, bool, str, str | None]]]) -> list[tuple[int, int]]:
     """(pass, access) of the reads to move to GENERAL: the movable reads of each group between
     two writes whose layouts differ. ``groups``: per candidate image (transient, colour, every
     access covering the whole image; ``rgraph.compiler.trace``), its (pass, access, write,
-    usage) in executed order."""
+    usage, layout) in executed order."""
     out = []
     for seq in groups.values():
         group: list[tuple[int, int]] = []  # the movable reads since the last write
-        for i, j, write, usage in [*seq, (-1, -1, True, "")]:  # a sentinel closes the last group
+        layouts: set[str | None] = set()
+        for i, j, write, usage, layout in [*seq, (-1, -1, True, "", None)]:  # a sentinel closes the last group
             if not write:
                 if usage in GENERAL_READS:
                     group.append((i, j))
+                    layouts.add(layout)
                 continue
-            if len(group) > 1 and len({syncs[gi][gj].layout for gi, gj in group}) > 1:
+            if len(group) > 1 and len(layouts) > 1:
                 out += group
             group = []
+            layouts = set()
     return out

@@ -41,7 +41,8 @@ class ResourceTrace:
     last: int
     cells: list[tuple[Cell, list[Use]]]
     code: int  # format part of the scope's key: image + 2 * depth + 4 * stencil
-    group: list[tuple[int, int, bool, str]] | None  # read_layouts candidates: (pass, access, write, usage)
+    group: list[tuple[int, int, bool, str, str | None]] | None  # read_layouts candidates: (pass, access, write,
+    # usage, layout)
 
 
 _new_trace = builder(ResourceTrace)
@@ -50,7 +51,6 @@ _new_access = builder(pm.Access)
 
 @dataclass
 class Trace:
-    syncs: list[list[Sync]]  # per pass, per declared access
     accesses: list[list[pm.Access]]  # per pass, per declared access: the plan's values
     resources: dict[str, ResourceTrace]  # used resources, in the order of their first use
     #: per pass (only those that have one): queue -> the latest pass on that queue that a cell's
@@ -81,7 +81,6 @@ def _scope(key: tuple) -> tuple[Sync, tuple[str, ...], tuple[str, ...]]:
 def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> Trace:
     """Scopes, usages, lifetimes, timelines and cross-queue waits in one walk; the reads
     ``read_layouts`` moves to GENERAL are patched in afterwards (a few per graph)."""
-    syncs: list[list[Sync]] = []
     plan_accesses: list[list[pm.Access]] = []
     info: dict[str, ResourceTrace] = {}
     full: dict[str, tuple] = {}  # read-group candidates: (0, mips), (0, layers)
@@ -92,7 +91,6 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
     for i, p in enumerate(passes):
         queue, kind = p.queue, p.kind
         raytrace = kind == "raytrace"
-        row: list[Sync] = []
         values: list[pm.Access] = []
         pos = 0
         for j, a in enumerate(p.accesses):
@@ -113,7 +111,6 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
             if scope is None:
                 scope = _scope(key)
             s = scope[0]
-            row.append(s)
             mips = a.mips
             if mips is None:  # buffers and accels
                 sub = None
@@ -128,7 +125,7 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                 if a.mips != whole[0] or a.layers != whole[1]:  # not the whole image: never unified
                     r.group = None
                 else:
-                    group.append((i, j, w, usage))
+                    group.append((i, j, w, usage, s.layout))
             for c in a.cells:
                 uses = get_uses(c)
                 if uses is None:
@@ -149,21 +146,34 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                         found[q] = prev[0]
                 uses.append((i, s, w, queue, pos))
                 pos += 1
-        syncs.append(row)
         plan_accesses.append(values)
-    moved = to_general({name: r.group for name, r in info.items() if r.group is not None}, syncs)
+    moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
     general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
+    rows: dict[int, list[Sync]] = {}  # the passes with a moved read: the scope of each access
     for i, j in moved:
-        scope = syncs[i][j]
+        row = rows.get(i)
+        if row is None:
+            row = rows[i] = _row(passes[i], info)
+        scope = row[j]
         found = general.get(id(scope))
         if found is None:
             found = general[id(scope)] = (scope, replace(scope, layout="GENERAL"))
-        syncs[i][j] = found[1]
+        row[j] = found[1]
         v = plan_accesses[i][j]
         plan_accesses[i][j] = _new_access(v.resource, v.subresource, v.usage, v.stages, v.access, "GENERAL", v.write)
     for i, j in moved:
-        _repatch(passes[i], i, passes[i].accesses[j].cells, syncs[i], timeline)
-    return Trace(syncs, plan_accesses, info, waits)
+        _repatch(passes[i], i, passes[i].accesses[j].cells, rows[i], timeline)
+    return Trace(plan_accesses, info, waits)
+
+
+def _row(p: PassSpec, info: Mapping[str, ResourceTrace]) -> list[Sync]:
+    """The scope of each access of ``p`` as the walk found it (by the same keys)."""
+    out = []
+    for a in p.accesses:
+        key = (a.usage, p.kind, a.stages, info[a.resource].code, a.refit)
+        found = _SCOPES.get(key)
+        out.append((found or _scope(key))[0])
+    return out
 
 
 def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], timeline: dict[Cell, list[Use]]) -> None:

@@ -77,8 +77,10 @@ def synchronize(
     end in different states: the plan lists them, as for persistent resources).
     """
     count = len(passes)
-    touched = {name: len(r.cells) for name, r in trace.resources.items()}
-    sources = with_partial_handoffs(alias_sources or {}, touched, resources, ranges)
+    alias_sources = alias_sources or {}
+    traced = trace.resources
+    touched = {n: len(traced[n].cells) for preds in alias_sources.values() for n in preds if n in traced}  # earlier occupants
+    sources = with_partial_handoffs(alias_sources, touched, resources, ranges)
     bars: list[list | None] = [None] * count
     rels: list[list | None] = [None] * count
     waits: list[dict | None] = [None] * count

@@ -393,9 +393,11 @@ def _gather(bars: list, rels: list, waits: list, passes: Sequence[PassSpec], fin
                 barriers[i] = tuple(map(last, found))
         found = rels[i]
         if found is not None:
-            if len(found) > 1:
+            if len(found) == 1:
+                releases[i] = found[0][3]
+            else:
                 found.sort()  # (acquiring pass, resource, cell position) never tie
-            releases[i] = tuple([b for e in found for b in e[3]])
+                releases[i] = tuple([b for e in found for b in e[3]])
         found = waits[i]
         if found is not None:
             for j, _ in found.values():

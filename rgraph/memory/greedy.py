@@ -63,27 +63,31 @@ def _fit(taken: Iterable[tuple[int, int, int]], need: int, a: int, skip: Collect
 def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None) -> list[int] | None:
     """``best_fit`` for blocks that overlap most others. A block that overlaps about half
     of the placed blocks or more scans the union of their byte ranges when all of them are
-    its neighbours (the same gaps), else the sorted list of every placed block, skipping
-    its non-neighbours; one with fewer neighbours sorts its placed ones."""
+    its neighbours (the same gaps; one range from 0, the usual case, needs no scan), else
+    the sorted list of every placed block, skipping its non-neighbours; one with fewer
+    neighbours sorts its placed ones."""
     n = inst.n
     offsets = [-1] * n
     placed: list[tuple[int, int, int] | None] = [None] * n  # (offset, top, block) once placed
-    size, align, neighbors = inst.size, inst.align, inst.neighbors
+    size, align, degree, far = inst.size, inst.align, inst.degree, inst.far
     get = placed.__getitem__
     every: list[tuple[int, int, int]] = []  # (offset, top, block) of the placed blocks, sorted
     placed_set: set[int] = set()
     union_lo: list[int] = []  # the union of the placed blocks' byte ranges: disjoint, sorted
     union_hi: list[int] = []
-    far = inst.non_neighbors
     limit = give_up_at if give_up_at is not None else -1
     for i in order:
-        need, row = size[i], neighbors[i]
-        if len(every) >= 2 * len(row) + 16:
-            off = _fit(sorted(filter(None, map(get, row))), need, align[i])
-        elif far(i).isdisjoint(placed_set):  # every placed block is a neighbour: their union's gaps
-            off = _fit(zip(union_lo, union_hi, repeat(-1)), need, align[i])
+        need, a = size[i], align[i]
+        if len(every) >= 2 * degree[i] + 16:
+            off = _fit(sorted(filter(None, map(get, inst.neighbor_row(i)))), need, a)
+        elif far[i].isdisjoint(placed_set):  # every placed block is a neighbour: their union's gaps
+            if len(union_lo) == 1 and union_lo[0] == 0:  # no gap: on top
+                top = union_hi[0]
+                off = top if top % a == 0 else top + a - top % a
+            else:
+                off = _fit(zip(union_lo, union_hi, repeat(-1)), need, a)
         else:
-            off = _fit(every, need, align[i], far(i))
+            off = _fit(every, need, a, far[i])
         top = off + need
         if 0 <= limit <= top:
             return None
@@ -91,7 +95,13 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
         placed[i] = entry = (off, top, i)
         insort(every, entry)
         placed_set.add(i)
-        _merge(union_lo, union_hi, off, top)
+        if len(union_lo) == 1 and off <= union_hi[0] and union_lo[0] <= top:  # joins the one range
+            if off < union_lo[0]:
+                union_lo[0] = off
+            if top > union_hi[0]:
+                union_hi[0] = top
+        else:
+            _merge(union_lo, union_hi, off, top)
     return offsets
 
 

@@ -10,6 +10,8 @@ from bisect import bisect_left, insort
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from itertools import repeat
 
+import numpy as np
+
 from rgraph.memory.instance import Instance
 
 
@@ -117,21 +119,39 @@ def _merge(los: list[int], his: list[int], lo: int, hi: int) -> None:
     his[k:end] = [hi]
 
 
+def range_max(values: Sequence[int], lo: Sequence[int], hi: Sequence[int]) -> list[int]:
+    """``max(values[lo[k]:hi[k]])`` for each ``k`` (every range non-empty)."""
+    if not lo:
+        return []
+    padded = np.append(np.asarray(values, dtype=np.int64), 0)  # hi may be len(values)
+    bounds = np.empty(2 * len(lo), dtype=np.int64)
+    bounds[0::2], bounds[1::2] = lo, hi
+    return np.maximum.reduceat(padded, bounds)[0::2].tolist()
+
+
+def _sorted_by(*columns: Sequence[int]) -> list[int]:
+    """Indices sorted by ``columns`` (the first most significant), ties by index."""
+    try:
+        keys = [np.asarray(c, dtype=np.int64) for c in reversed(columns)]
+    except OverflowError:  # keys past 64 bits: Python's sort
+        return [i for *_, i in sorted(zip(*columns, range(len(columns[0])), strict=True))]
+    return np.lexsort(keys).tolist()  # stable: ties keep index order
+
+
 def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:
     """The static orderings tried by the heuristic, in turn (all deterministic, ties by
     index); each is sorted only when asked for, so a caller that stops early pays less."""
-    n = range(inst.n)
     s = inst.start
     neg_size, neg_area, neg_width = inst.neg_size, inst.neg_area, inst.neg_width
-
-    def by(*columns: Iterable[int]) -> list[int]:
-        return [i for *_, i in sorted(zip(*columns, n, strict=True))]
-
-    yield "size", by(neg_size, s)
-    yield "area", by(neg_area)
-    yield "length", by(neg_width, neg_size)  # width - 1 = end - start: the same order
-    yield "start", by(s, neg_size)
+    yield "size", _sorted_by(neg_size, s)
+    yield "area", _sorted_by(neg_area)
+    yield "length", _sorted_by(neg_width, neg_size)  # width - 1 = end - start: the same order
+    yield "start", _sorted_by(s, neg_size)
     totals = inst.section_totals()
-    neg_contention = [-max(totals[lo:hi]) for lo, hi in zip(inst.sec_lo, inst.sec_hi, strict=True)]
-    yield "contention", by(neg_contention, neg_area)
-    yield "contention_size", by(neg_contention, neg_size)
+    try:
+        peaks = range_max(totals, inst.sec_lo, inst.sec_hi)
+    except OverflowError:
+        peaks = [max(totals[lo:hi]) for lo, hi in zip(inst.sec_lo, inst.sec_hi, strict=True)]
+    neg_contention = [-p for p in peaks]
+    yield "contention", _sorted_by(neg_contention, neg_area)
+    yield "contention_size", _sorted_by(neg_contention, neg_size)

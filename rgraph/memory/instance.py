@@ -91,28 +91,36 @@ class Instance:
         blocks = list(blocks)
         start = [b.start for b in blocks]
         end = [b.end for b in blocks]
-        extra: list[tuple[int, int]] = []  # conflicts apart in time (those overlapping are neighbours already)
+        ks: list[int] = []  # conflicting pairs (k, j), some of them overlapping in time as well
+        js: list[int] = []
         if conflicts:
             index = {b.name: k for k, b in enumerate(blocks)}
+            get = index.get
             for k, b in enumerate(blocks):
                 names = conflicts.get(b.name)
-                if not names:
-                    continue
-                s, e = start[k], end[k]
-                extra.extend((k, j) for j in map(index.get, names) if j is not None and (start[j] > e or end[j] < s))
+                if names:
+                    found = [j for j in map(get, names) if j is not None and j != k]
+                    ks.extend([k] * len(found))
+                    js.extend(found)
+        separable = True
+        if ks:  # pairs apart in time: beyond what the time sections see
+            starts, ends = np.asarray(start, dtype=np.int64), np.asarray(end, dtype=np.int64)
+            apart = (starts[js] > ends[ks]) | (ends[js] < starts[ks])
+            separable = not apart.any()
         adjacency, rows = None, None
         if len(blocks) < SWEEP_FROM:
             adjacency = time_overlaps(start, end)
-            if extra:
-                ks, js = zip(*extra, strict=True)
-                adjacency[list(ks), list(js)] = True
+            if not separable:
+                adjacency[ks, js] = True  # those overlapping in time are already
         else:
             rows = time_neighbors(start, end)
-            by_block: dict[int, set[int]] = {}
-            for k, j in extra:
-                by_block.setdefault(k, set()).add(j)
-            for k, js in by_block.items():
-                rows[k] = sorted(rows[k] + list(js))
+            if not separable:
+                by_block: dict[int, set[int]] = {}
+                for k, j, far in zip(ks, js, apart.tolist(), strict=True):
+                    if far:
+                        by_block.setdefault(k, set()).add(j)
+                for k, extra in by_block.items():
+                    rows[k] = sorted(rows[k] + list(extra))
         coords = sorted(set(start) | {e + 1 for e in end})
         sec_lo = [bisect_left(coords, s) for s in start]
         sec_hi = [bisect_left(coords, e + 1) for e in end]
@@ -125,7 +133,7 @@ class Instance:
             sec_lo=sec_lo,
             sec_hi=sec_hi,
             section_count=max(len(coords) - 1, 0),
-            separable=not extra,
+            separable=separable,
             adjacency=adjacency,
             rows=rows,
         )

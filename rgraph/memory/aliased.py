@@ -86,7 +86,11 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
     lb = inst.lower_bound()
     bound, cliqued = lb, inst.separable  # non-separable: the clique bound once greedy misses lb
     best: ClassResult | None = None
+    tried: list[list[int]] = []
     for name, order in orderings(inst):
+        if order in tried:
+            continue  # the same placement again (orderings often coincide on small classes)
+        tried.append(order)
         offsets = best_fit(inst, order, None if best is None else best.peak)  # None: not lower
         if offsets is None:
             continue

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from bisect import bisect_left
 from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from heapq import heappop, heappush
 
@@ -77,8 +77,8 @@ class Instance:
     sec_hi: list[int]
     section_count: int
     separable: bool = True  # no overlaps beyond the time ones: parts split in time are independent
-    adjacency: np.ndarray | None = None  # ``[i, j]``: i and j may not share bytes (None: lists only)
-    rows: list[list[int]] | None = None  # the neighbour lists, when built by the sweep
+    adjacency: np.ndarray | None = field(default=None, compare=False, repr=False)  # ``[i, j]``: i and j may not share bytes (None: lists only)
+    rows: list[list[int]] | None = field(default=None, compare=False, repr=False)  # the neighbour lists, when built by the sweep
 
     @property
     def n(self) -> int:

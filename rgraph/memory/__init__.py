@@ -10,7 +10,7 @@ import time
 from collections.abc import Collection, Mapping, Sequence
 
 from rgraph.memory.aliased import place_class, too_dense
-from rgraph.memory.bounds import lower_bound
+from rgraph.memory.bounds import class_lower_bound
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats, by_class, check_blocks
 from rgraph.memory.online import place_blocks, place_tlsf
@@ -60,6 +60,7 @@ def place(
         time_budget_s = OPTIMAL_BUDGET_S
     offsets: dict[str, tuple[int, int]] = {}
     heaps: list[Heap] = []
+    bound = 0  # the time bound summed over classes
 
     def new_heap(size: int, memory_class: str, alignment: int) -> int:
         heaps.append(Heap(len(heaps), size, memory_class, alignment))
@@ -67,16 +68,20 @@ def place(
 
     for memory_class, group in by_class(blocks).items():
         max_align = max(b.alignment for b in group)
+        searched = chosen.kind in ("aliased", "optimal") and not too_dense(group, time_budget_s)
+        if not searched:  # place_class gives it otherwise
+            bound += class_lower_bound(group)
         if chosen.kind == "dedicated":
             for b in group:
                 offsets[b.name] = (new_heap(b.aligned_size, memory_class, b.alignment), 0)
-        elif chosen.kind in ("aliased", "optimal") and too_dense(group, time_budget_s):
+        elif chosen.kind in ("aliased", "optimal") and not searched:
             tlsf_offsets, high_water = place_tlsf(group)  # bounded time on very dense lifetimes
             heap_id = new_heap(high_water, memory_class, max_align)
             for b, offset in zip(group, tlsf_offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)
-        elif chosen.kind in ("aliased", "optimal"):
+        elif searched:
             result = place_class(Instance.build(group, conflicts), time_budget_s, exact=chosen.kind == "optimal")
+            bound += result.lower_bound
             heap_id = new_heap(result.peak, memory_class, max_align)
             for b, offset in zip(group, result.offsets, strict=True):
                 offsets[b.name] = (heap_id, offset)
@@ -96,7 +101,7 @@ def place(
     stats = PlacementStats(
         policy=str(chosen),
         peak_bytes=sum(h.bytes for h in heaps),
-        lower_bound_bytes=lower_bound(blocks),
+        lower_bound_bytes=bound,
         unaliased_bytes=sum(b.aligned_size for b in blocks),
         allocations=len(heaps),
         seconds=time.perf_counter() - began,

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rgraph.memory.bounds import clique_bound
 from rgraph.memory.elastic import improve
 from rgraph.memory.greedy import best_fit, orderings
 from rgraph.memory.instance import Instance
@@ -83,18 +84,25 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
     dives, most of the budget goes to MiniMalloc's own run at the bound (round robin with no
     round limit), the rest to more dives and the bisection."""
     lb = inst.lower_bound()
+    bound, cliqued = lb, inst.separable  # non-separable: the clique bound once greedy misses lb
     best: ClassResult | None = None
+    tried: list[list[int]] = []
     for name, order in orderings(inst):
+        if order in tried:
+            continue  # the same placement again (orderings often coincide on small classes)
+        tried.append(order)
         offsets = best_fit(inst, order, None if best is None else best.peak)  # None: not lower
         if offsets is None:
             continue
         peak = inst.peak(offsets)
         if best is None or peak < best.peak:
             best = ClassResult(offsets, peak, lb, f"greedy:{name}")
-        if best.peak <= lb:
+        if best.peak > bound and not cliqued:
+            bound, cliqued = clique_bound(inst), True
+        if best.peak <= bound:
             break  # proven optimal: no later ordering can be strictly better
     assert best is not None
-    if best.peak <= lb:
+    if best.peak <= bound:
         best.proven = True
         return best
     if inst.n == 0 or not inst.separable:

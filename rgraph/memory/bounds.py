@@ -6,6 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block, by_class
 
 
@@ -30,3 +31,25 @@ def class_lower_bound(blocks: Sequence[Block]) -> int:
 def lower_bound(blocks: Sequence[Block]) -> int:
     """Per class lower bound, summed over classes."""
     return sum(class_lower_bound(group) for group in by_class(blocks).values())
+
+
+def clique_bound(inst: Instance) -> int:
+    """The weight of a clique of ``inst``'s conflict graph (blocks that pairwise may not
+    share bytes: all stacked in any placement): the blocks live in the busiest section,
+    then, heaviest first, every block in conflict with all chosen so far. At least the time
+    bound; above it only where conflicts join blocks apart in time (cross-queue pairs).
+    Instances without the conflict matrix (:data:`rgraph.memory.instance.SWEEP_FROM` blocks
+    and more) get the time bound."""
+    totals = inst.section_totals()
+    if not totals or inst.adjacency is None or inst.separable:
+        return max(totals, default=0)
+    busiest = max(range(len(totals)), key=totals.__getitem__)
+    weight = totals[busiest]
+    members = [i for i, (lo, hi) in enumerate(zip(inst.sec_lo, inst.sec_hi, strict=True)) if lo <= busiest < hi]
+    joinable = inst.adjacency[:, members].all(axis=1)
+    sizes = np.asarray(inst.size, dtype=np.float64)  # ranks only: exact weights come from inst.size
+    while joinable.any():
+        k = int(np.argmax(np.where(joinable, sizes, -1.0)))
+        weight += inst.size[k]
+        joinable &= inst.adjacency[:, k]
+    return weight

@@ -10,6 +10,8 @@ from bisect import bisect_left, insort
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from itertools import repeat
 
+import numpy as np
+
 from rgraph.memory.instance import Instance
 
 
@@ -63,27 +65,31 @@ def _fit(taken: Iterable[tuple[int, int, int]], need: int, a: int, skip: Collect
 def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None) -> list[int] | None:
     """``best_fit`` for blocks that overlap most others. A block that overlaps about half
     of the placed blocks or more scans the union of their byte ranges when all of them are
-    its neighbours (the same gaps), else the sorted list of every placed block, skipping
-    its non-neighbours; one with fewer neighbours sorts its placed ones."""
+    its neighbours (the same gaps; one range from 0, the usual case, needs no scan), else
+    the sorted list of every placed block, skipping its non-neighbours; one with fewer
+    neighbours sorts its placed ones."""
     n = inst.n
     offsets = [-1] * n
     placed: list[tuple[int, int, int] | None] = [None] * n  # (offset, top, block) once placed
-    size, align, neighbors = inst.size, inst.align, inst.neighbors
+    size, align, degree, far = inst.size, inst.align, inst.degree, inst.far
     get = placed.__getitem__
     every: list[tuple[int, int, int]] = []  # (offset, top, block) of the placed blocks, sorted
     placed_set: set[int] = set()
     union_lo: list[int] = []  # the union of the placed blocks' byte ranges: disjoint, sorted
     union_hi: list[int] = []
-    far = inst.non_neighbors
     limit = give_up_at if give_up_at is not None else -1
     for i in order:
-        need, row = size[i], neighbors[i]
-        if len(every) >= 2 * len(row) + 16:
-            off = _fit(sorted(filter(None, map(get, row))), need, align[i])
-        elif far(i).isdisjoint(placed_set):  # every placed block is a neighbour: their union's gaps
-            off = _fit(zip(union_lo, union_hi, repeat(-1)), need, align[i])
+        need, a = size[i], align[i]
+        if len(every) >= 2 * degree[i] + 16:
+            off = _fit(sorted(filter(None, map(get, inst.neighbor_row(i)))), need, a)
+        elif far[i].isdisjoint(placed_set):  # every placed block is a neighbour: their union's gaps
+            if len(union_lo) == 1 and union_lo[0] == 0:  # no gap: on top
+                top = union_hi[0]
+                off = top if top % a == 0 else top + a - top % a
+            else:
+                off = _fit(zip(union_lo, union_hi, repeat(-1)), need, a)
         else:
-            off = _fit(every, need, align[i], far(i))
+            off = _fit(every, need, a, far[i])
         top = off + need
         if 0 <= limit <= top:
             return None
@@ -91,7 +97,13 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
         placed[i] = entry = (off, top, i)
         insort(every, entry)
         placed_set.add(i)
-        _merge(union_lo, union_hi, off, top)
+        if len(union_lo) == 1 and off <= union_hi[0] and union_lo[0] <= top:  # joins the one range
+            if off < union_lo[0]:
+                union_lo[0] = off
+            if top > union_hi[0]:
+                union_hi[0] = top
+        else:
+            _merge(union_lo, union_hi, off, top)
     return offsets
 
 
@@ -107,21 +119,39 @@ def _merge(los: list[int], his: list[int], lo: int, hi: int) -> None:
     his[k:end] = [hi]
 
 
+def range_max(values: Sequence[int], lo: Sequence[int], hi: Sequence[int]) -> list[int]:
+    """``max(values[lo[k]:hi[k]])`` for each ``k`` (every range non-empty)."""
+    if not lo:
+        return []
+    padded = np.append(np.asarray(values, dtype=np.int64), 0)  # hi may be len(values)
+    bounds = np.empty(2 * len(lo), dtype=np.int64)
+    bounds[0::2], bounds[1::2] = lo, hi
+    return np.maximum.reduceat(padded, bounds)[0::2].tolist()
+
+
+def _sorted_by(*columns: Sequence[int]) -> list[int]:
+    """Indices sorted by ``columns`` (the first most significant), ties by index."""
+    try:
+        keys = [np.asarray(c, dtype=np.int64) for c in reversed(columns)]
+    except OverflowError:  # keys past 64 bits: Python's sort
+        return [i for *_, i in sorted(zip(*columns, range(len(columns[0])), strict=True))]
+    return np.lexsort(keys).tolist()  # stable: ties keep index order
+
+
 def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:
     """The static orderings tried by the heuristic, in turn (all deterministic, ties by
     index); each is sorted only when asked for, so a caller that stops early pays less."""
-    n = range(inst.n)
     s = inst.start
     neg_size, neg_area, neg_width = inst.neg_size, inst.neg_area, inst.neg_width
-
-    def by(*columns: Iterable[int]) -> list[int]:
-        return [i for *_, i in sorted(zip(*columns, n, strict=True))]
-
-    yield "size", by(neg_size, s)
-    yield "area", by(neg_area)
-    yield "length", by(neg_width, neg_size)  # width - 1 = end - start: the same order
-    yield "start", by(s, neg_size)
+    yield "size", _sorted_by(neg_size, s)
+    yield "area", _sorted_by(neg_area)
+    yield "length", _sorted_by(neg_width, neg_size)  # width - 1 = end - start: the same order
+    yield "start", _sorted_by(s, neg_size)
     totals = inst.section_totals()
-    neg_contention = [-max(totals[lo:hi]) for lo, hi in zip(inst.sec_lo, inst.sec_hi, strict=True)]
-    yield "contention", by(neg_contention, neg_area)
-    yield "contention_size", by(neg_contention, neg_size)
+    try:
+        peaks = range_max(totals, inst.sec_lo, inst.sec_hi)
+    except OverflowError:
+        peaks = [max(totals[lo:hi]) for lo, hi in zip(inst.sec_lo, inst.sec_hi, strict=True)]
+    neg_contention = [-p for p in peaks]
+    yield "contention", _sorted_by(neg_contention, neg_area)
+    yield "contention_size", _sorted_by(neg_contention, neg_size)

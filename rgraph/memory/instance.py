@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from bisect import bisect_left
 from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from heapq import heappop, heappush
 
@@ -17,18 +17,28 @@ from rgraph.memory.model import Block
 SWEEP_FROM = 1500
 
 
+def time_overlaps(start: Sequence[int], end: Sequence[int]) -> np.ndarray:
+    """``m[i, j]``: blocks ``i != j`` overlap in (closed) time."""
+    starts = np.asarray(start, dtype=np.int64)
+    ends = np.asarray(end, dtype=np.int64)
+    overlap = (starts[:, None] <= ends[None, :]) & (ends[:, None] >= starts[None, :])
+    np.fill_diagonal(overlap, False)
+    return overlap
+
+
+def _rows(matrix: np.ndarray) -> list[list[int]]:
+    """The column indices of each row's true entries, ascending."""
+    columns = np.nonzero(matrix)[1].tolist()  # row by row, ascending within a row
+    bounds = np.concatenate(([0], np.cumsum(matrix.sum(axis=1)))).tolist()
+    return [columns[bounds[i] : bounds[i + 1]] for i in range(len(matrix))]
+
+
 def time_neighbors(start: Sequence[int], end: Sequence[int]) -> list[list[int]]:
     """For each block, the other blocks whose closed lifetime ``[start, end]`` overlaps
     its own, ascending by index."""
     n = len(start)
     if n < SWEEP_FROM:
-        starts = np.asarray(start, dtype=np.int64)
-        ends = np.asarray(end, dtype=np.int64)
-        overlap = (starts[:, None] <= ends[None, :]) & (ends[:, None] >= starts[None, :])
-        np.fill_diagonal(overlap, False)
-        columns = np.nonzero(overlap)[1].tolist()  # row by row, ascending within a row
-        bounds = np.concatenate(([0], np.cumsum(overlap.sum(axis=1)))).tolist()
-        return [columns[bounds[i] : bounds[i + 1]] for i in range(n)]
+        return _rows(time_overlaps(start, end))
     neighbors: list[list[int]] = [[] for _ in range(n)]
     active: list[tuple[int, int]] = []  # heap of (end, block) of blocks begun so far
     live: set[int] = set()
@@ -52,7 +62,10 @@ class Instance:
     """Blocks of one memory class, indexed 0..n-1 in input order.
 
     Sections are the maximal time ranges in which the set of live blocks does not change;
-    block ``i`` lives in sections ``sec_lo[i] .. sec_hi[i]-1``.
+    block ``i`` lives in sections ``sec_lo[i] .. sec_hi[i]-1``. Pairs that may not share
+    bytes are kept as a boolean matrix below :data:`SWEEP_FROM` blocks (``neighbors``, the
+    lists, are then made when first asked for: dense conflict graphs need only the few
+    non-neighbours), as lists from a sweep above.
     """
 
     blocks: list[Block]
@@ -60,11 +73,12 @@ class Instance:
     end: list[int]
     size: list[int]  # aligned sizes
     align: list[int]
-    neighbors: list[list[int]]  # blocks overlapping in time, ascending index
     sec_lo: list[int]
     sec_hi: list[int]
     section_count: int
     separable: bool = True  # no overlaps beyond the time ones: parts split in time are independent
+    adjacency: np.ndarray | None = field(default=None, compare=False, repr=False)  # ``[i, j]``: i and j may not share bytes (None: lists only)
+    rows: list[list[int]] | None = field(default=None, compare=False, repr=False)  # the neighbour lists, when built by the sweep
 
     @property
     def n(self) -> int:
@@ -77,20 +91,36 @@ class Instance:
         blocks = list(blocks)
         start = [b.start for b in blocks]
         end = [b.end for b in blocks]
-        neighbors = time_neighbors(start, end)
-        separable = True
+        ks: list[int] = []  # conflicting pairs (k, j), some of them overlapping in time as well
+        js: list[int] = []
         if conflicts:
             index = {b.name: k for k, b in enumerate(blocks)}
+            get = index.get
             for k, b in enumerate(blocks):
                 names = conflicts.get(b.name)
-                if not names:
-                    continue
-                s, e = start[k], end[k]
-                # conflicts apart in time (those overlapping it are neighbours already)
-                extra = {j for j in map(index.get, names) if j is not None and (start[j] > e or end[j] < s)}
-                if extra:
-                    neighbors[k] = sorted(neighbors[k] + list(extra))
-                    separable = False
+                if names:
+                    found = [j for j in map(get, names) if j is not None and j != k]
+                    ks.extend([k] * len(found))
+                    js.extend(found)
+        separable = True
+        if ks:  # pairs apart in time: beyond what the time sections see
+            starts, ends = np.asarray(start, dtype=np.int64), np.asarray(end, dtype=np.int64)
+            apart = (starts[js] > ends[ks]) | (ends[js] < starts[ks])
+            separable = not apart.any()
+        adjacency, rows = None, None
+        if len(blocks) < SWEEP_FROM:
+            adjacency = time_overlaps(start, end)
+            if not separable:
+                adjacency[ks, js] = True  # those overlapping in time are already
+        else:
+            rows = time_neighbors(start, end)
+            if not separable:
+                by_block: dict[int, set[int]] = {}
+                for k, j, far in zip(ks, js, apart.tolist(), strict=True):
+                    if far:
+                        by_block.setdefault(k, set()).add(j)
+                for k, extra in by_block.items():
+                    rows[k] = sorted(rows[k] + list(extra))
         coords = sorted(set(start) | {e + 1 for e in end})
         sec_lo = [bisect_left(coords, s) for s in start]
         sec_hi = [bisect_left(coords, e + 1) for e in end]
@@ -100,12 +130,35 @@ class Instance:
             end=end,
             size=[b.aligned_size for b in blocks],
             align=[b.alignment for b in blocks],
-            neighbors=neighbors,
             sec_lo=sec_lo,
             sec_hi=sec_hi,
             section_count=max(len(coords) - 1, 0),
             separable=separable,
+            adjacency=adjacency,
+            rows=rows,
         )
+
+    @cached_property
+    def neighbors(self) -> list[list[int]]:
+        """For each block, the blocks it may not share bytes with (overlapping in time or
+        conflicting), ascending index."""
+        if self.rows is not None:
+            return self.rows
+        assert self.adjacency is not None
+        return _rows(self.adjacency)
+
+    def neighbor_row(self, i: int) -> list[int]:
+        """``neighbors[i]`` without building every list."""
+        if "neighbors" in self.__dict__ or self.adjacency is None:
+            return self.neighbors[i]
+        return np.flatnonzero(self.adjacency[i]).tolist()
+
+    @cached_property
+    def degree(self) -> list[int]:
+        """How many neighbours each block has."""
+        if self.adjacency is not None:
+            return self.adjacency.sum(axis=1).tolist()
+        return [len(row) for row in self.neighbors]
 
     @cached_property
     def neg_width(self) -> list[int]:
@@ -152,15 +205,19 @@ class Instance:
     @cached_property
     def pair_count(self) -> int:
         """Ordered pairs of blocks that may not share bytes (the neighbour lists' total)."""
-        return sum(map(len, self.neighbors))
+        return sum(self.degree)
+
+    @cached_property
+    def far(self) -> list[set[int]]:
+        """For each block, the blocks, itself included, that it may share bytes with."""
+        if self.adjacency is not None:
+            return [set(row) for row in _rows(~self.adjacency)]
+        everything = range(self.n)
+        return [set(everything).difference(row) for row in self.neighbors]
 
     def non_neighbors(self, i: int) -> set[int]:
-        """The blocks, ``i`` included, that ``i`` may share bytes with (cached)."""
-        cache = self.__dict__.setdefault("_non_neighbors", {})
-        far = cache.get(i)
-        if far is None:
-            far = cache[i] = set(range(self.n)).difference(self.neighbors[i])
-        return far
+        """The blocks, ``i`` included, that ``i`` may share bytes with."""
+        return self.far[i]
 
     def lower_bound(self) -> int:
         return max(self.section_totals(), default=0)

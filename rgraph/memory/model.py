@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 
 @dataclass(frozen=True)
@@ -17,7 +18,7 @@ class Block:
     alignment: int
     memory_class: str  # resources only alias within a class
 
-    @property
+    @cached_property  # written to the instance's __dict__: allowed on a frozen dataclass
     def aligned_size(self) -> int:
         return align_up(self.size, self.alignment)
 

@@ -1,0 +1,106 @@
+"""Deformable meshes in ray tracing plans: each frame's deformed geometry, per frame-in-flight set.
+
+When an accel over the scene is built every frame (a persistent accel the plan marks
+``refit``, or a per-frame one) and the scene has deformable meshes, ``rgraph.vk.accel.AccelSet``
+owns one ``DeformedTables``: per set, a host-visible (coherent) positions buffer and normals
+buffer in the layout of the ray tracing passes' scene tables (``passes.raytrace_standalone.
+pack_tables``: every mesh's object-space float32 vertices, mesh after mesh). Static meshes are
+written once; ``update(frame, set)`` writes the deformable ones at the frame's scene time
+(``Deformer.traced``: the float32 positions the raster path gets and their smoothed normals,
+recomputed on the CPU by the NumPy reference rule of ``rgraph.scene.smoothing``).
+
+Readers of set ``s``: the BLAS builds/refits of that frame (vertex input by device address)
+and the passes' table reads (``rt_standalone``, the hybrid's shade/secondary/wave passes, the
+compute visibility buffer). Synchronization: the frame loop writes set ``s`` after waiting on
+its fences (its previous frame, everything that read these buffers, has finished) and before
+the frame's ``vkQueueSubmit2``; a submission makes earlier host writes to coherent memory
+visible to every command in it (the host -> device memory domain operation), so no barrier
+is recorded. Skinned meshes stay in their rest pose.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from rgraph.vk.device import Device
+from rgraph.vk.resources import HostBuffer
+
+STORAGE_BUFFER = 0x20
+
+
+def has_deformable(plan: dict) -> bool:
+    from rgraph.vk.rt_scene import scene_data
+
+    return any(m.deformer is not None for m in scene_data(plan).meshes)
+
+
+class DeformedTables:
+    """See the module docstring. ``sets``: frame-in-flight sets."""
+
+    def __init__(self, device: Device, plan: dict, sets: int) -> None:
+        from rgraph.vk.accel import INPUT_USAGE, AddressBuffer
+        from rgraph.vk.rt_scene import scene_data
+
+        self.data = scene_data(plan)
+        self.sets = sets
+        meshes = self.data.meshes
+        self.first_vertex = np.concatenate([[0], np.cumsum([m.data.vertex_count for m in meshes])]).astype(np.int64)
+        vertices = int(self.first_vertex[-1])
+        positions = np.concatenate([m.data.positions for m in meshes]).astype(np.float32)
+        normals = np.concatenate([m.data.normals for m in meshes]).astype(np.float32)
+        self.deformable = [k for k, m in enumerate(meshes) if m.deformer is not None]
+        self.positions: list[Any] = []  # per set: AddressBuffer (BLAS input, storage)
+        self.normals: list[HostBuffer] = []
+        self._views: list[tuple[np.ndarray, np.ndarray]] = []  # per set: (vertices, 3) float32 of the mapped memory
+        try:
+            for _ in range(sets):
+                pos = AddressBuffer.create(device, positions.nbytes, INPUT_USAGE | STORAGE_BUFFER)
+                self.positions.append(pos)
+                nrm = HostBuffer.create(device, normals.nbytes, STORAGE_BUFFER)
+                self.normals.append(nrm)
+                pos.host.write(positions.tobytes())
+                nrm.write(normals.tobytes())
+                self._views.append((np.frombuffer(pos.host.mapped, dtype=np.float32, count=3 * vertices).reshape(-1, 3),
+                                    np.frombuffer(nrm.mapped, dtype=np.float32, count=3 * vertices).reshape(-1, 3)))
+        except BaseException:
+            self.destroy()
+            raise
+        self.frame_of: list[int | None] = [None] * sets  # per set: the content frame its geometry shows
+
+    def update(self, frame: int, frame_set: int) -> None:
+        """Set ``frame_set`` shows the deformable meshes at content frame ``frame``'s scene time
+        (its previous frame has finished; called before the frame's submits). Once per frame."""
+        if self.frame_of[frame_set] == frame:
+            return
+        seconds = self.data.seconds(frame)
+        pos_view, nrm_view = self._views[frame_set]
+        for k in self.deformable:
+            lo, hi = int(self.first_vertex[k]), int(self.first_vertex[k + 1])
+            pos, nrm = self.data.meshes[k].deformer.traced(seconds)
+            pos_view[lo:hi] = pos  # mapped memory: written, never read back
+            nrm_view[lo:hi] = nrm
+        self.frame_of[frame_set] = frame
+
+    def is_deformable(self, mesh: int) -> bool:
+        return mesh in self.deformable
+
+    def vertex_address(self, mesh: int, frame_set: int) -> int:
+        """Device address of mesh ``mesh``'s first position in set ``frame_set``'s buffer."""
+        return self.positions[frame_set].address + 12 * int(self.first_vertex[mesh])
+
+    def position_buffers(self) -> tuple[tuple[Any, int], ...]:
+        """(VkBuffer, bytes) per set: the passes' positions table."""
+        return tuple((b.host.handle, b.host.size) for b in self.positions)
+
+    def normal_buffers(self) -> tuple[tuple[Any, int], ...]:
+        return tuple((b.handle, b.size) for b in self.normals)
+
+    def destroy(self) -> None:
+        self._views = []
+        for b in self.positions:
+            b.destroy()
+        for n in self.normals:
+            n.destroy()
+        self.positions, self.normals = [], []

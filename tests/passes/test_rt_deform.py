@@ -4,6 +4,7 @@ tests/data/rt/deform_tiny.yaml (a breathing, pressed neck beside a mirror and a 
 - the stand-alone image follows the deformation: two frames differ where the neck moves, each
   matches the NumPy float64 reference ray tracer fed the deformed geometry of its frame's scene
   time, and not the rest pose's;
+- a per-frame (transient) accel is rebuilt from the same deformed geometry;
 - the hybrids (compute visibility buffer, hardware raster) agree with the stand-alone at a
   deformed frame, and the visibility ids are the deformed triangles';
 - the refit accel and the compute visibility buffer under validation + synchronization
@@ -30,6 +31,7 @@ from rgraph.passes.rt_vis_ref import edge_pixels, visibility_reference  # noqa: 
 
 SCENE = TESTS / "data" / "rt" / "deform_tiny.yaml"
 BUILD_GRAPH = TESTS / "pass_graphs" / "rt_deform_build.yaml"
+REBUILT_GRAPH = TESTS / "pass_graphs" / "rt_standalone_rebuilt.yaml"
 SIZE = (48, 32)
 SKY = 64  # rt.sky_size of the graphs
 DEPTH = 4
@@ -43,12 +45,13 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
     return float("inf") if mse == 0 else 10 * np.log10(1.0 / mse)
 
 
-def _run(graph, frame: int, extra=(), params=None, validate: bool = False) -> dict:
-    """Outputs of content frame ``frame`` (the last of ``frame + 1`` frames)."""
+def _run(graph, frame: int, extra=(), params=None, validate: bool = False, refit: bool = True) -> dict:
+    """Outputs of content frame ``frame`` (the last of ``frame + 1`` frames); ``refit``: the
+    plan's accel is persistent and refitted."""
     from rgraph.vk.executor import execute_plan
 
     plan = compile_graph(str(graph), scene_path=SCENE, size=SIZE, extra_outputs=list(extra), params=params or {})
-    assert any(r["kind"] == "accel" and r["accel"]["refit"] for r in plan["resources"])
+    assert any(r["kind"] == "accel" and r["accel"]["refit"] for r in plan["resources"]) == refit
     try:
         result = execute_plan(plan, validate=validate, frames=frame + 1, read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
@@ -124,6 +127,15 @@ def test_standalone_follows_the_deformation_and_matches_the_reference(standalone
     assert all(any(_in_neck_shadow(data, x, y, f) for f in (0, LATE)) for y, x in rest), rest
     rest = _reference(None)  # before: the refit read the rest pose every frame
     assert psnr(standalone[LATE], rest) < 45
+
+
+@pytest.mark.vulkan
+def test_a_per_frame_accel_is_built_from_the_deformed_geometry(references):
+    plan = compile_graph(str(REBUILT_GRAPH), scene_path=SCENE, size=SIZE)
+    assert [(r["lifetime"], r["accel"]["refit"]) for r in plan["resources"] if r["kind"] == "accel"] == \
+        [("transient", False)]
+    gpu = _color(_run(REBUILT_GRAPH, LATE, refit=False))
+    assert np.abs(gpu - references[LATE]).max() < 0.01 and psnr(gpu, references[LATE]) > 60
 
 
 @pytest.mark.vulkan

@@ -75,9 +75,9 @@ class AddressBuffer:
     address: int
 
     @classmethod
-    def create(cls, device: Device, size: int, usage: int) -> AddressBuffer:
+    def create(cls, device: Device, size: int, usage: int, device_local: bool = False) -> AddressBuffer:
         host = HostBuffer.create(device, max(int(size), 16), usage | names.SHADER_DEVICE_ADDRESS,
-                                 allocate_flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
+                                 allocate_flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS, device_local=device_local)
         return cls(host, buffer_address(device, host.handle))
 
     def destroy(self) -> None:

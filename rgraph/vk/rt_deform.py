@@ -2,8 +2,8 @@
 
 When an accel over the scene is built every frame (a persistent accel the plan marks
 ``refit``, or a per-frame one) and the scene has deformable meshes, ``rgraph.vk.accel.AccelSet``
-owns one ``DeformedTables``: per set, a host-visible (coherent) positions buffer and normals
-buffer in the layout of the ray tracing passes' scene tables (``passes.raytrace_standalone.
+owns one ``DeformedTables``: per set, a host-visible (coherent; device-local where a memory
+type is both, e.g. resizable BAR) positions buffer and normals buffer in the layout of the ray tracing passes' scene tables (``passes.raytrace_standalone.
 pack_tables``: every mesh's object-space float32 vertices, mesh after mesh). Static meshes are
 written once; ``update(frame, set)`` writes the deformable ones at the frame's scene time
 (``Deformer.traced``: the float32 positions the raster path gets and their smoothed normals,
@@ -56,9 +56,10 @@ class DeformedTables:
         self._views: list[tuple[np.ndarray, np.ndarray]] = []  # per set: (vertices, 3) float32 of the mapped memory
         try:
             for _ in range(sets):
-                pos = AddressBuffer.create(device, positions.nbytes, INPUT_USAGE | STORAGE_BUFFER)
+                # every hit and the visibility buffer read them: device-local where the host sees such memory
+                pos = AddressBuffer.create(device, positions.nbytes, INPUT_USAGE | STORAGE_BUFFER, device_local=True)
                 self.positions.append(pos)
-                nrm = HostBuffer.create(device, normals.nbytes, STORAGE_BUFFER)
+                nrm = HostBuffer.create(device, normals.nbytes, STORAGE_BUFFER, device_local=True)
                 self.normals.append(nrm)
                 pos.host.write(positions.tobytes())
                 nrm.write(normals.tobytes())

@@ -95,7 +95,8 @@ class SkyCubemap(PassImpl):
 
 
 class RayTracingImpl(PassImpl):
-    """Common setup of the ray tracing implementations: scene tables (set 0, bindings 0-5),
+    """Common setup of the ray tracing implementations: scene tables (set 0, bindings 0-5;
+    over deformable meshes positions and normals are the frame's, per set: ``deformed_tables``),
     the sky (binding 6), the pass's own images from binding 7, the TLAS (set 1)."""
 
     raygen = "rt/standalone.rgen"

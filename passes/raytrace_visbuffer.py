@@ -77,7 +77,8 @@ def atomic64(setup: Any) -> bool:
 
 
 class VisPass(PassImpl):
-    """Common setup: geometry tables (device-local), the per-instance triangle starts, the
+    """Common setup: geometry tables (device-local; over deformable meshes the positions are
+    the frame's, per set: ``deformed_tables``), the per-instance triangle starts, the
     visibility-buffer images and the job list, the push constants."""
 
     shader = "rt/visraster.comp"

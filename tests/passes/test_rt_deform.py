@@ -9,6 +9,8 @@ tests/data/rt/deform_tiny.yaml (a breathing, pressed neck beside a mirror and a 
   deformed frame, and the visibility ids are the deformed triangles';
 - the refit accel and the compute visibility buffer under validation + synchronization
   validation (zero messages) over 51 frames, ids equal to the reference at the last frame;
+- a scene without deformable meshes keeps the static tables and inputs (its images are
+  byte-identical to before: benchmarks/rt_image_hashes.py, docs/raytracing.md);
 - the CPU normals are the float64 reference rule of the GPU's deform_normals pass.
 """
 
@@ -184,3 +186,20 @@ def test_traced_geometry_is_the_raster_positions_and_the_reference_normals():
     assert np.array_equal(nrm, ref_normals)
     assert np.abs(pos - neck.data.positions).max() > 0.01  # it moved
     assert np.allclose(np.linalg.norm(nrm, axis=1), 1.0)
+
+
+@pytest.mark.vulkan
+def test_a_scene_without_deformable_meshes_keeps_the_static_tables(tmp_path):
+    from rgraph.api import open_device
+
+    static = tmp_path / "static.yaml"
+    static.write_text(SCENE.read_text().replace("deformable: true", "deformable: false"))
+    for scene, deformed in ((static, False), (SCENE, True)):
+        plan = compile_graph("rt_standalone", scene_path=scene, size=SIZE)
+        try:
+            with open_device(validate=False, verbose=False, ray_tracing=True) as gpu:
+                accels = gpu.load(plan).executor.accels
+                assert (accels.deformed is not None) == deformed
+                assert accels.deforming == ({"scene_as"} if deformed else set())
+        except VulkanUnavailable as exc:  # pragma: no cover
+            pytest.skip(str(exc))

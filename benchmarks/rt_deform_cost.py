@@ -3,8 +3,9 @@
     python3 benchmarks/rt_deform_cost.py --scene graphs/scenes/cct.yaml
 
 Per deformable mesh: the minimum CPU time (process time, over ``--repeats``) of
-``Deformer.traced`` (float32 positions + the NumPy smoothed normals, what each frame writes)
-and of ``write_positions`` alone (the raster path's CPU share). Then ``rt_standalone`` on the
+``write_positions`` (what each frame writes; the normals are the GPU's: rgraph/vk/rt_normals.py)
+and of ``Deformer.traced`` (positions + the float64 NumPy normals: the reference, which an
+earlier version wrote every frame). Then ``rt_standalone`` on the
 scene for ``--frames`` frames (``--size``, default 48x32): the frame loop's median host update
 (``render_thread.update_us``: scene, accel and pass updates) and CPU time per frame; with
 ``--static`` also the same scene with ``deformable`` removed, for the difference.
@@ -60,8 +61,8 @@ def main() -> None:
         out = np.empty((mesh.data.vertex_count, 3), dtype=np.float32)
         traced = min_cpu_ms(lambda i, d=d: d.traced(i / 60.0), args.repeats)
         written = min_cpu_ms(lambda i, d=d, out=out: d.write_positions(i / 60.0, out), args.repeats)
-        print(f"mesh {mesh.data.vertex_count} vertices, {mesh.data.triangle_count} triangles: traced "
-              f"{traced:.3f} ms, write_positions {written:.3f} ms (min CPU of {args.repeats})")
+        print(f"mesh {mesh.data.vertex_count} vertices, {mesh.data.triangle_count} triangles: write_positions "
+              f"{written:.3f} ms, traced (CPU reference normals) {traced:.3f} ms (min CPU of {args.repeats})")
     scenes = [("deformable", args.scene)]
     if args.static:
         text = Path(args.scene).read_text().replace("deformable: true", "deformable: false")

@@ -366,6 +366,8 @@ class AccelSet:
         scratch = self.resources.get(name + ".scratch", set_index)
         align = int(layout["scratch_alignment"])
         address = -(-buffer_address(self.device, scratch.handle) // align) * align
+        if name in self.deforming:  # the frame's normals, with their barriers (rgraph.vk.rt_normals)
+            self.deformed.record_normals(cb, set_index)
         self.record_build(cb, name, set_index, address, update=res["lifetime"] in SHARED)
 
     def destroy(self) -> None:

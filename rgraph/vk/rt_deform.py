@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 
 from rgraph.vk.device import Device
-from rgraph.vk.resources import HostBuffer
 
 STORAGE_BUFFER = 0x20
 
@@ -41,6 +40,7 @@ class DeformedTables:
 
     def __init__(self, device: Device, plan: dict, sets: int) -> None:
         from rgraph.vk.accel import INPUT_USAGE, AddressBuffer
+        from rgraph.vk.rt_normals import NormalsGPU
         from rgraph.vk.rt_scene import scene_data
 
         self.data = scene_data(plan)
@@ -52,19 +52,16 @@ class DeformedTables:
         normals = np.concatenate([m.data.normals for m in meshes]).astype(np.float32)
         self.deformable = [k for k, m in enumerate(meshes) if m.deformer is not None]
         self.positions: list[Any] = []  # per set: AddressBuffer (BLAS input, storage)
-        self.normals: list[HostBuffer] = []
-        self._views: list[tuple[np.ndarray, np.ndarray]] = []  # per set: (vertices, 3) float32 of the mapped memory
+        self._views: list[np.ndarray] = []  # per set: (vertices, 3) float32 of the mapped memory
+        self.normals: Any = None
         try:
             for _ in range(sets):
                 # every hit and the visibility buffer read them: device-local where the host sees such memory
                 pos = AddressBuffer.create(device, positions.nbytes, INPUT_USAGE | STORAGE_BUFFER, device_local=True)
                 self.positions.append(pos)
-                nrm = HostBuffer.create(device, normals.nbytes, STORAGE_BUFFER, device_local=True)
-                self.normals.append(nrm)
                 pos.host.write(positions.tobytes())
-                nrm.write(normals.tobytes())
-                self._views.append((np.frombuffer(pos.host.mapped, dtype=np.float32, count=3 * vertices).reshape(-1, 3),
-                                    np.frombuffer(nrm.mapped, dtype=np.float32, count=3 * vertices).reshape(-1, 3)))
+                self._views.append(np.frombuffer(pos.host.mapped, dtype=np.float32, count=3 * vertices).reshape(-1, 3))
+            self.normals = NormalsGPU(device, self, self.position_buffers(), normals.tobytes())
         except BaseException:
             self.destroy()
             raise
@@ -76,13 +73,15 @@ class DeformedTables:
         if self.frame_of[frame_set] == frame:
             return
         seconds = self.data.seconds(frame)
-        pos_view, nrm_view = self._views[frame_set]
+        view = self._views[frame_set]
         for k in self.deformable:
             lo, hi = int(self.first_vertex[k]), int(self.first_vertex[k + 1])
-            pos, nrm = self.data.meshes[k].deformer.traced(seconds)
-            pos_view[lo:hi] = pos  # mapped memory: written, never read back
-            nrm_view[lo:hi] = nrm
+            self.data.meshes[k].deformer.write_positions(seconds, view[lo:hi])  # mapped memory: only written
         self.frame_of[frame_set] = frame
+
+    def record_normals(self, cb: Any, frame_set: int) -> None:
+        """Set ``frame_set``'s normals from its positions (in a build of an accel of this geometry)."""
+        self.normals.record(cb, frame_set)
 
     def is_deformable(self, mesh: int) -> bool:
         return mesh in self.deformable
@@ -96,12 +95,13 @@ class DeformedTables:
         return tuple((b.host.handle, b.host.size) for b in self.positions)
 
     def normal_buffers(self) -> tuple[tuple[Any, int], ...]:
-        return tuple((b.handle, b.size) for b in self.normals)
+        return self.normals.normal_buffers()
 
     def destroy(self) -> None:
         self._views = []
+        if self.normals is not None:
+            self.normals.destroy()
+            self.normals = None
         for b in self.positions:
             b.destroy()
-        for n in self.normals:
-            n.destroy()
-        self.positions, self.normals = [], []
+        self.positions = []

@@ -7,11 +7,13 @@ tests/data/rt/deform_tiny.yaml (a breathing, pressed neck beside a mirror and a 
 - a per-frame (transient) accel is rebuilt from the same deformed geometry;
 - the hybrids (compute visibility buffer, hardware raster) agree with the stand-alone at a
   deformed frame, and the visibility ids are the deformed triangles';
-- the refit accel and the compute visibility buffer under validation + synchronization
-  validation (zero messages) over 51 frames, ids equal to the reference at the last frame;
+- the refit accel (with the GPU normals pass and its barriers, rgraph/vk/rt_normals.py) and the
+  compute visibility buffer under validation + synchronization validation (zero messages) over
+  51 frames, ids equal to the reference at the last frame;
 - a scene without deformable meshes keeps the static tables and inputs (its images are
   byte-identical to before: benchmarks/rt_image_hashes.py, docs/raytracing.md);
-- the CPU normals are the float64 reference rule of the GPU's deform_normals pass.
+- the reference geometry (``Deformer.traced``) is the raster path's positions and the float64
+  normal rule of the GPU's deform_normals pass.
 """
 
 from __future__ import annotations

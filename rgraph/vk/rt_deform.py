@@ -2,20 +2,23 @@
 
 When an accel over the scene is built every frame (a persistent accel the plan marks
 ``refit``, or a per-frame one) and the scene has deformable meshes, ``rgraph.vk.accel.AccelSet``
-owns one ``DeformedTables``: per set, a host-visible (coherent; device-local where a memory
-type is both, e.g. resizable BAR) positions buffer and normals buffer in the layout of the ray tracing passes' scene tables (``passes.raytrace_standalone.
-pack_tables``: every mesh's object-space float32 vertices, mesh after mesh). Static meshes are
-written once; ``update(frame, set)`` writes the deformable ones at the frame's scene time
-(``Deformer.traced``: the float32 positions the raster path gets and their smoothed normals,
-recomputed on the CPU by the NumPy reference rule of ``rgraph.scene.smoothing``).
+owns one ``DeformedTables``: per set, the positions and normals tables in the layout of the
+passes' scene tables (``passes.raytrace_standalone.pack_tables``: every mesh's object-space
+float32 vertices, mesh after mesh). Static meshes are written once.
 
-Readers of set ``s``: the BLAS builds/refits of that frame (vertex input by device address)
-and the passes' table reads (``rt_standalone``, the hybrid's shade/secondary/wave passes, the
-compute visibility buffer). Synchronization: the frame loop writes set ``s`` after waiting on
-its fences (its previous frame, everything that read these buffers, has finished) and before
-the frame's ``vkQueueSubmit2``; a submission makes earlier host writes to coherent memory
-visible to every command in it (the host -> device memory domain operation), so no barrier
-is recorded. Skinned meshes stay in their rest pose.
+- Positions: host-visible, coherent (device-local where a memory type is both, e.g. resizable
+  BAR). ``update(frame, set)`` writes the deformable meshes' at the frame's scene time
+  (``Deformer.write_positions``: what the raster path gets). Readers of set ``s``: that frame's
+  BLAS builds/refits (vertex input by device address), the hit/shade passes' and the compute
+  visibility buffer's table reads, the normals pass. The frame loop writes set ``s`` after
+  waiting on its fences (its previous frame, everything that read the buffer, has finished) and
+  before the frame's ``vkQueueSubmit2``, which makes earlier host writes to coherent memory
+  visible to every command in it (the host -> device memory domain operation): no barrier.
+- Normals: device-local, written on the GPU by the raster path's smoothing pass in every frame
+  build of an accel built from this geometry (``rgraph.vk.rt_normals``, with its barriers);
+  read by the hit/shade passes. Their float64 NumPy reference: ``Deformer.traced``.
+
+Skinned meshes stay in their rest pose.
 """
 
 from __future__ import annotations

@@ -100,9 +100,9 @@ class Deformer:
                                 self.rest.uvs)[1]
 
     def traced(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
-        """What ray tracing uses at ``seconds`` (``rgraph.vk.rt_deform``, its NumPy reference
-        ``passes.rt_model.build_tables``): the float32 positions ``write_positions`` gives the
-        raster path and their reference normals (float64, of those float32 positions)."""
+        """The reference of the ray tracing geometry at ``seconds`` (``passes.rt_model.build_tables``;
+        the GPU's: ``rgraph.vk.rt_deform``): the float32 positions ``write_positions`` gives the
+        raster path and ray tracing, and their reference normals (float64, of those positions)."""
         pos = np.empty((self.rest.vertex_count, 3), dtype=np.float32)
         self.write_positions(seconds, pos)
         return pos, smooth_normals(pos, self.rest.indices, self.topology, self.rest.normals)

@@ -76,7 +76,8 @@ class NormalsGPU:
             shared = [header, *(a.tobytes() for a in global_topology(meshes, tables.first_vertex, tables.deformable)),
                       rest_normals]
             self.shared = [self._upload(b, storage) for b in shared]
-            self.normals = [self._upload(rest_normals, storage) for _ in range(self.sets)]
+            readable = storage | v.VK_BUFFER_USAGE_TRANSFER_SRC_BIT  # (tests read them back)
+            self.normals = [self._upload(rest_normals, readable) for _ in range(self.sets)]
             self._make_pipeline(positions)
         except BaseException:
             self.destroy()

@@ -10,6 +10,8 @@ tests/data/rt/deform_tiny.yaml (a breathing, pressed neck beside a mirror and a 
 - the refit accel (with the GPU normals pass and its barriers, rgraph/vk/rt_normals.py) and the
   compute visibility buffer under validation + synchronization validation (zero messages) over
   51 frames, ids equal to the reference at the last frame;
+- the GPU normals of each set (DeformedTables alone, under validation + synchronization
+  validation) are the float64 reference's;
 - a scene without deformable meshes keeps the static tables and inputs (its images are
   byte-identical to before: benchmarks/rt_image_hashes.py, docs/raytracing.md);
 - the reference geometry (``Deformer.traced``) is the raster path's positions and the float64
@@ -205,3 +207,48 @@ def test_a_scene_without_deformable_meshes_keeps_the_static_tables(tmp_path):
                 assert accels.deforming == ({"scene_as"} if deformed else set())
         except VulkanUnavailable as exc:  # pragma: no cover
             pytest.skip(str(exc))
+
+
+@pytest.mark.vulkan
+def test_gpu_normals_match_the_float64_reference():
+    """DeformedTables alone under validation + synchronization validation: each set's GPU
+    normals (rgraph/vk/rt_normals.py) from its host-written positions, against the reference."""
+    from types import SimpleNamespace
+
+    import rgraph
+    from rgraph.vk.device_local import DeviceLocal, one_time_submitter
+    from rgraph.vk.loader import vk
+    from rgraph.vk.rt_deform import DeformedTables
+
+    v = vk()
+    data = load_scene_data(SCENE, SIZE)
+    first = np.concatenate([[0], np.cumsum([m.data.vertex_count for m in data.meshes])])
+    rest = np.concatenate([m.data.normals for m in data.meshes]).astype(np.float32)
+    plan = {"scene_source": str(SCENE), "size": list(SIZE), "camera": 0}
+    got = {}
+    try:
+        with rgraph.open_device(validate=True, verbose=False, ray_tracing=True) as gpu:
+            tables = DeformedTables(gpu.device, plan, 2)
+            local = DeviceLocal(gpu.device)
+            try:
+                with one_time_submitter(gpu.device) as submit:
+                    for s, frame in ((0, LATE), (1, 7), (0, 3)):
+                        tables.update(frame, s)
+                        submit("graphics", lambda cb, s=s: tables.record_normals(cb, s))
+                        handle, size = tables.normal_buffers()[s]
+                        raw = local.read(submit, SimpleNamespace(handle=handle, size=size),
+                                         v.VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, v.VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT)
+                        got[frame] = np.frombuffer(raw, dtype=np.float32)[:rest.size].reshape(-1, 3).copy()
+            finally:
+                local.destroy()
+                tables.destroy()
+            messages = [str(m) for m in gpu.close()]
+    except VulkanUnavailable as exc:  # pragma: no cover
+        pytest.skip(str(exc))
+    assert messages == []
+    lo, hi = int(first[NECK]), int(first[NECK + 1])
+    for frame, normals in got.items():
+        _pos, ref = data.meshes[NECK].deformer.traced(_seconds(frame))
+        np.testing.assert_allclose(normals[lo:hi], ref, rtol=0, atol=2e-6)  # the raster pass's tolerance
+        assert np.array_equal(np.delete(normals, np.s_[lo:hi], axis=0), np.delete(rest, np.s_[lo:hi], axis=0))
+    assert np.abs(got[LATE][lo:hi] - rest[lo:hi]).max() > 0.05  # they moved

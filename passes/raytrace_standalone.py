@@ -58,6 +58,13 @@ def pack_tables(data) -> dict[str, bytes]:
     }
 
 
+def deformed_tables(setup) -> Any:
+    """The deformed geometry the plan's accels are built from (``rgraph.vk.rt_deform``): per set
+    positions and normals the scene-table readers bind instead of the static ones; None when
+    the scene has no deformable meshes or no accel is built every frame."""
+    return getattr(setup.accels, "deformed", None)
+
+
 def frame_constants(data, size: tuple[int, int], max_depth: int) -> bytes:
     _cam, basis, tan_half = camera_basis(data)
     right, up, fwd = basis
@@ -88,7 +95,8 @@ class SkyCubemap(PassImpl):
 
 
 class RayTracingImpl(PassImpl):
-    """Common setup of the ray tracing implementations: scene tables (set 0, bindings 0-5),
+    """Common setup of the ray tracing implementations: scene tables (set 0, bindings 0-5;
+    over deformable meshes positions and normals are the frame's, per set: ``deformed_tables``),
     the sky (binding 6), the pass's own images from binding 7, the TLAS (set 1)."""
 
     raygen = "rt/standalone.rgen"
@@ -101,8 +109,13 @@ class RayTracingImpl(PassImpl):
             raise ValueError(f"pass {setup.name!r}: ray tracing needs a scene (--scene)")
         self.data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
         tables = pack_tables(self.data)
+        deformed = deformed_tables(setup)
         bindings = []
         for i, name in enumerate(TABLES):  # device-local: every hit reads them, every frame
+            if deformed is not None and name in ("positions", "normals"):  # per set, the frame's
+                buffers = deformed.position_buffers() if name == "positions" else deformed.normal_buffers()
+                bindings.append(Binding(i, "storage_buffer", buffers=buffers))
+                continue
             bindings.append(Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)))
         bindings.append(Binding(6, "sampled", "sky", array=True, sampler="nearest"))
         self.sets = setup.descriptors(bindings + images)

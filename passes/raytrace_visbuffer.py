@@ -26,7 +26,7 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.passkit import Binding
 
 from .raytrace_hybrid import prim_bits
-from .raytrace_standalone import pack_tables
+from .raytrace_standalone import deformed_tables, pack_tables
 from .raytrace_wave import MAX_WAVE_RESETS, list_args
 from .rt_model import camera_basis
 
@@ -77,7 +77,8 @@ def atomic64(setup: Any) -> bool:
 
 
 class VisPass(PassImpl):
-    """Common setup: geometry tables (device-local), the per-instance triangle starts, the
+    """Common setup: geometry tables (device-local; over deformable meshes the positions are
+    the frame's, per set: ``deformed_tables``), the per-instance triangle starts, the
     visibility-buffer images and the job list, the push constants."""
 
     shader = "rt/visraster.comp"
@@ -93,7 +94,9 @@ class VisPass(PassImpl):
             raise ValueError(f"pass {setup.name!r}: the visibility buffer needs a scene (--scene)")
         self.data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
         tables = pack_tables(self.data)
-        bindings = [Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),))
+        deformed = deformed_tables(setup)
+        bindings = [Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)
+                            if deformed is None or name != "positions" else deformed.position_buffers())
                     for i, name in ((0, "instances"), (1, "positions"), (3, "indices"))]
         bindings.append(Binding(4, "storage_buffer", buffers=(setup.device_buffer(triangle_starts(self.data).tobytes()),)))
         bindings.append(Binding(5, "storage_image", "vis_depth"))

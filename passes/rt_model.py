@@ -124,15 +124,27 @@ def camera_basis(data: SceneData) -> tuple[np.ndarray, np.ndarray, float]:
     return pos, np.stack([right, up, fwd]), float(np.tan(np.radians(c.fov_y) / 2.0))
 
 
-def build_tables(data: SceneData) -> Tables:
+def object_geometry(mesh, seconds: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh's object-space (positions, normals) as ray tracing sees them: the rest mesh, or
+    for a deformable mesh at scene time ``seconds`` (not None) the deformed one
+    (``Deformer.traced``). Skinned meshes stay in their rest pose."""
+    if seconds is not None and mesh.deformer is not None:
+        pos, nrm = mesh.deformer.traced(seconds)
+        return pos.astype(np.float64), nrm
+    return mesh.data.positions, mesh.data.normals
+
+
+def build_tables(data: SceneData, seconds: float | None = None) -> Tables:
+    """``seconds``: the scene time of the deformable meshes (None: every mesh at rest)."""
     cam, basis, tan_half = camera_basis(data)
     tris, norms, mats = [], [], []
     for mesh in data.meshes:
+        positions, normals = object_geometry(mesh, seconds)
         for p in mesh.positions:
             m = model_matrix(p - cam, mesh.rotation, mesh.scale)
             nm = np.linalg.inv(m[:3, :3]).T
-            pos = mesh.data.positions @ m[:3, :3].T + m[:3, 3]
-            nrm = mesh.data.normals @ nm.T
+            pos = positions @ m[:3, :3].T + m[:3, 3]
+            nrm = normals @ nm.T
             tris.append(pos[mesh.data.indices])
             norms.append(nrm[mesh.data.indices])
             mats.append(np.full(len(mesh.data.indices), mesh.material))

@@ -21,9 +21,11 @@ def pixel_directions(tables, size: tuple[int, int]) -> np.ndarray:
     return (fwd + sx[..., None] * right + sy[..., None] * up).reshape(-1, 3)
 
 
-def visibility_reference(data, size: tuple[int, int], bits: int, chunk: int = 128) -> np.ndarray:
-    """(h, w) uint32 ids; ties in t go to the larger id, as the GPU's atomicMax."""
-    tables = build_tables(data)
+def visibility_reference(data, size: tuple[int, int], bits: int, chunk: int = 128,
+                         seconds: float | None = None) -> np.ndarray:
+    """(h, w) uint32 ids; ties in t go to the larger id, as the GPU's atomicMax (``seconds``:
+    the deformable meshes' scene time, ``build_tables``)."""
+    tables = build_tables(data, seconds)
     tris = tables.triangles.astype(np.float64)  # (n, 3, 3) camera-relative world, instance-major
     starts = triangle_starts(data).astype(np.int64)
     instance = np.searchsorted(starts, np.arange(len(tris)), side="right") - 1

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rgraph.scene.shapes import MeshData
-from rgraph.scene.smoothing import SmoothingTopology, build_topology, normals_tangents
+from rgraph.scene.smoothing import SmoothingTopology, build_topology, normals_tangents, smooth_normals
 
 FRAME_SECONDS = 1.0 / 60.0
 
@@ -98,6 +98,14 @@ class Deformer:
         """Reference tangents (n, 4) at ``seconds``: xyz unit, w the bitangent's handedness."""
         return normals_tangents(self.positions(seconds), self.rest.indices, self.topology, self.rest.normals,
                                 self.rest.uvs)[1]
+
+    def traced(self, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+        """The reference of the ray tracing geometry at ``seconds`` (``passes.rt_model.build_tables``;
+        the GPU's: ``rgraph.vk.rt_deform``): the float32 positions ``write_positions`` gives the
+        raster path and ray tracing, and their reference normals (float64, of those positions)."""
+        pos = np.empty((self.rest.vertex_count, 3), dtype=np.float32)
+        self.write_positions(seconds, pos)
+        return pos, smooth_normals(pos, self.rest.indices, self.topology, self.rest.normals)
 
     def at_frame(self, frame: int) -> MeshData:
         return self.at(frame * FRAME_SECONDS)

@@ -85,9 +85,15 @@ def _perpendicular(n: np.ndarray) -> np.ndarray:
     return t / np.linalg.norm(t, axis=1, keepdims=True)
 
 
-def normals_tangents(positions: np.ndarray, indices: np.ndarray, topology: SmoothingTopology,
-                     fallback: np.ndarray, uvs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The reference: (normals (n, 3), tangents (n, 4)) in float64 by the rule of the module docstring."""
+def smooth_normals(positions: np.ndarray, indices: np.ndarray, topology: SmoothingTopology,
+                   fallback: np.ndarray) -> np.ndarray:
+    """The reference normals alone ((n, 3) float64, equal to ``normals_tangents``' first result)."""
+    return _normals(positions, indices, topology, fallback)[0]
+
+
+def _normals(positions: np.ndarray, indices: np.ndarray, topology: SmoothingTopology,
+             fallback: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(normals, indices (m, 3), scaled edges e1, e2 (m, 3)) by the rule of the module docstring."""
     p = np.asarray(positions, dtype=np.float64) * topology.scale
     idx = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
     n = len(p)
@@ -105,6 +111,14 @@ def normals_tangents(positions: np.ndarray, indices: np.ndarray, topology: Smoot
     group_normal = np.where(ok[:, None], acc / np.where(ok, length, 1.0)[:, None], 0.0)
     g = topology.group.astype(np.int64)
     normals = np.where(ok[g][:, None], group_normal[g], fallback)
+    return normals, idx, e1, e2
+
+
+def normals_tangents(positions: np.ndarray, indices: np.ndarray, topology: SmoothingTopology,
+                     fallback: np.ndarray, uvs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The reference: (normals (n, 3), tangents (n, 4)) in float64 by the rule of the module docstring."""
+    normals, idx, e1, e2 = _normals(positions, indices, topology, fallback)
+    n = len(normals)
     # tangents: each vertex's own triangles
     uv = np.zeros((n, 2)) if uvs is None else np.asarray(uvs, dtype=np.float64).reshape(n, 2)
     tuv = uv[idx]

@@ -6,7 +6,10 @@ device addresses. A build records every BLAS build in one call, a memory depende
 build itself (BLAS written -> TLAS build reads them; the scratch reused) and the TLAS build:
 that dependency is internal to the one ``accel_build`` access the plan synchronizes.
 Persistent accels are built once at load (BLAS with compaction into the plan's buffer); when
-the plan marks them ``refit`` every frame's build updates them in place.
+the plan marks them ``refit`` every frame's build updates them in place. Accels over a scene
+with deformable meshes that are built every frame (refit, or per-frame lifetimes) read their
+vertices from ``rgraph.vk.rt_deform.DeformedTables`` (per set, the frame's deformed geometry;
+a refit updates only the deformable meshes' BLAS, then the TLAS).
 """
 
 from __future__ import annotations
@@ -72,9 +75,9 @@ class AddressBuffer:
     address: int
 
     @classmethod
-    def create(cls, device: Device, size: int, usage: int) -> AddressBuffer:
+    def create(cls, device: Device, size: int, usage: int, device_local: bool = False) -> AddressBuffer:
         host = HostBuffer.create(device, max(int(size), 16), usage | names.SHADER_DEVICE_ADDRESS,
-                                 allocate_flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
+                                 allocate_flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS, device_local=device_local)
         return cls(host, buffer_address(device, host.handle))
 
     def destroy(self) -> None:
@@ -103,6 +106,8 @@ class AccelSet:
         self.layouts: dict[str, dict] = {}
         self.compacted: dict[str, list[int]] = {}  # persistent accels: each BLAS's compacted bytes
         self.inputs: dict[str, tuple[Geometry, list[tuple[int, int]]]] = {}
+        self.deformed: Any = None  # rgraph.vk.rt_deform.DeformedTables (see the module docstring)
+        self.deforming: set[str] = set()  # accels whose builds read it
         for res in plan["resources"]:
             if res["kind"] != "accel":
                 continue
@@ -145,6 +150,9 @@ class AccelSet:
         inputs.host.write(bytes(data))
         self.buffers.append(inputs)
         self.inputs[res["name"]] = (geo, [(inputs.address + vo, inputs.address + io) for vo, io in ranges])
+        per_frame = res["lifetime"] not in SHARED or layout["refit"]
+        if layout["geometry"] == "scene" and per_frame:
+            self._use_deformed(res["name"])
         create = proc(self.device, "vkCreateAccelerationStructureKHR")
         sets = 1 if res["lifetime"] in SHARED else self.resources.sets
         for s in range(sets):
@@ -162,6 +170,23 @@ class AccelSet:
             built = BuiltAccel(blas, tlas, instances)
             for t in (range(self.resources.sets) if res["lifetime"] in SHARED else [s]):
                 self.built[(res["name"], t)] = built
+
+    def _use_deformed(self, name: str) -> None:
+        """Accel ``name`` is built every frame: over a scene with deformable meshes, from the
+        frame's deformed geometry."""
+        from rgraph.vk.rt_deform import DeformedTables, has_deformable
+
+        if self.deformed is None:
+            if not has_deformable(self.plan):
+                return
+            self.deformed = DeformedTables(self.device, self.plan, self.resources.sets)
+        self.deforming.add(name)
+
+    def update(self, frame: int, frame_set: int) -> None:
+        """Before frame ``frame``'s submits (its set's previous frame has finished): the
+        deformed geometry of set ``frame_set`` (nothing without deformable meshes)."""
+        if self.deformed is not None:
+            self.deformed.update(frame, frame_set)
 
     def _address(self, accel: Any) -> int:
         v = vk()
@@ -291,8 +316,16 @@ class AccelSet:
         mode = v.VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR if update else v.VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR
         align = int(layout["scratch_alignment"])
         fn = proc(self.device, "vkCmdBuildAccelerationStructuresKHR")
+        deformed = self.deformed if name in self.deforming else None
         infos, ranges, keep, offset = [], [], [], 0
         for i, ((positions, indices), (va, ia), b) in enumerate(zip(geo.meshes, addresses, layout["blas"], strict=True)):
+            sizes = query(self.device, "bottom", b["triangles"], b["max_vertex"], refit)
+            step = -(-(sizes[2] if update else sizes[1]) // align) * align
+            if deformed is not None:
+                if update and not deformed.is_deformable(i):  # a static mesh's BLAS stays valid
+                    offset += step
+                    continue
+                va = deformed.vertex_address(i, set_index)
             geometry = v.ffi.new("VkAccelerationStructureGeometryKHR[1]", [triangles_geometry(va, ia, len(positions) - 1)])
             keep.append(geometry)
             infos.append(v.VkAccelerationStructureBuildGeometryInfoKHR(
@@ -300,10 +333,10 @@ class AccelSet:
                 srcAccelerationStructure=built.blas[i] if update else None, dstAccelerationStructure=built.blas[i],
                 geometryCount=1, pGeometries=geometry,
                 scratchData=v.VkDeviceOrHostAddressKHR(deviceAddress=scratch_address + offset)))
-            sizes = query(self.device, "bottom", b["triangles"], b["max_vertex"], refit)
-            offset += -(-(sizes[2] if update else sizes[1]) // align) * align
+            offset += step
             ranges.append(len(indices))
-        self._build(fn, cb, infos, ranges, keep)
+        if infos:
+            self._build(fn, cb, infos, ranges, keep)
         self._build_barrier(cb)  # inside the build: BLAS -> TLAS, scratch reuse
         geometry = v.ffi.new("VkAccelerationStructureGeometryKHR[1]", [instances_geometry(built.instances.address)])
         tlas_info = v.VkAccelerationStructureBuildGeometryInfoKHR(
@@ -333,6 +366,8 @@ class AccelSet:
         scratch = self.resources.get(name + ".scratch", set_index)
         align = int(layout["scratch_alignment"])
         address = -(-buffer_address(self.device, scratch.handle) // align) * align
+        if name in self.deforming:  # the frame's normals, with their barriers (rgraph.vk.rt_normals)
+            self.deformed.record_normals(cb, set_index)
         self.record_build(cb, name, set_index, address, update=res["lifetime"] in SHARED)
 
     def destroy(self) -> None:
@@ -345,6 +380,9 @@ class AccelSet:
             for handle in [*built.blas, built.tlas]:
                 fn(self.device.handle, handle, None)
         self.built.clear()
+        if self.deformed is not None:
+            self.deformed.destroy()
+            self.deformed = None
         for buf in reversed(self.buffers):
             buf.destroy()
         self.buffers.clear()

@@ -64,10 +64,11 @@ class HostBuffer:
 
     @classmethod
     def create(cls, device: Device, size: int, usage: int, allocate_flags: int = 0,
-               readback: bool = False) -> HostBuffer:
+               readback: bool = False, device_local: bool = False) -> HostBuffer:
         """``allocate_flags``: VkMemoryAllocateFlags (e.g. device address) for its memory;
         ``readback``: the host reads it, so prefer HOST_CACHED memory (reads of uncached,
-        write-combined memory run at a few hundred MB/s)."""
+        write-combined memory run at a few hundred MB/s); ``device_local``: shaders read it
+        often, so prefer DEVICE_LOCAL memory where a host-visible type has it (resizable BAR)."""
         v = vk()
         size = max(int(size), 4)
         info = v.VkBufferCreateInfo(size=size, usage=usage, sharingMode=v.VK_SHARING_MODE_EXCLUSIVE)
@@ -75,6 +76,8 @@ class HostBuffer:
         req = v.vkGetBufferMemoryRequirements(device.handle, handle)
         want = v.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | v.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
         prefer = v.VK_MEMORY_PROPERTY_HOST_CACHED_BIT if readback else 0
+        if device_local:
+            prefer |= v.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
         index = memory_type(device, req.memoryTypeBits, want, prefer=prefer)
         chain = {"pNext": v.VkMemoryAllocateFlagsInfo(flags=allocate_flags)} if allocate_flags else {}  # alive until the call returns
         memory = v.vkAllocateMemory(device.handle, v.VkMemoryAllocateInfo(

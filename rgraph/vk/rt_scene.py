@@ -11,14 +11,20 @@ from rgraph.scene.camera import model_matrix
 from rgraph.vk.errors import ExecutionError
 
 
-def scene_geometry(plan: dict):
+def scene_data(plan: dict):
+    """The plan's scene (``SceneData``) at the plan's size and camera."""
     from rgraph.scene.build import load_scene_data
-    from rgraph.vk.accel import Geometry
 
     source = plan.get("scene_source")
     if not source:
         raise ExecutionError("an accel over the scene needs a scene (--scene)")
-    data = load_scene_data(source, tuple(plan.get("size") or (64, 64)), int(plan.get("camera", 0)))
+    return load_scene_data(source, tuple(plan.get("size") or (64, 64)), int(plan.get("camera", 0)))
+
+
+def scene_geometry(plan: dict):
+    from rgraph.vk.accel import Geometry
+
+    data = scene_data(plan)
     cam = np.asarray(data.camera(0).position, dtype=np.float64)
     meshes = [(m.data.positions.astype(np.float32), m.data.indices.astype(np.uint32)) for m in data.meshes]
     instances = []

@@ -3,7 +3,9 @@
 // One invocation per vertex v: its position (the two logic states mixed by alpha), its
 // smoothed normal (a fixed-order gather over its smoothing group's CSR triangle list: no
 // atomics, reproducible) and its tangent. The rule, and the float64 reference it is tested
-// against: rgraph/scene/smoothing.py.
+// against: rgraph/scene/smoothing.py. With NORMALS_ONLY (the ray tracing tables,
+// rgraph/vk/rt_deform.py): the ring is one slot of positions, binding 8 takes the normals alone
+// (3 floats per vertex), no UVs, no tangents.
 
 layout(local_size_x = 64) in;
 
@@ -14,10 +16,16 @@ layout(set = 0, binding = 2, std430) readonly buffer Groups { uint group_of[]; }
 layout(set = 0, binding = 3, std430) readonly buffer Offsets { uint offsets[]; };
 layout(set = 0, binding = 4, std430) readonly buffer Triangles { uint triangles[]; };
 layout(set = 0, binding = 5, std430) readonly buffer Indices { uint indices[]; };  // 3 per triangle
+#ifndef NORMALS_ONLY
 layout(set = 0, binding = 6, std430) readonly buffer Uvs { vec2 uvs[]; };
+#endif
 layout(set = 0, binding = 7, std430) readonly buffer Fallback { float fallback[]; };  // rest normals
+#ifdef NORMALS_ONLY
+layout(set = 0, binding = 8, std430) writeonly buffer Normals { float normals_out[]; };  // normal
+#else
 layout(set = 0, binding = 8, std430) writeonly buffer Vertices { float vertices[]; };  // position, normal
 layout(set = 0, binding = 9, std430) writeonly buffer Tangents { vec4 tangents[]; };
+#endif
 
 layout(push_constant) uniform Push {
     uint first;  // the mesh's first vertex
@@ -70,6 +78,7 @@ void main() {
         vec3 f = cross_accurate(e1, e2);
         acc += f;
         total += length(f);
+#ifndef NORMALS_ONLY
         if (i0 == v || i1 == v || i2 == v) {  // the vertex's own triangles (its UV chart): tangents
             vec2 d1 = uvs[i1] - uvs[i0];
             vec2 d2 = uvs[i2] - uvs[i0];
@@ -77,10 +86,16 @@ void main() {
             big_t += (e1 * d2.y - e2 * d1.y) * s;
             big_b += (e2 * d1.x - e1 * d2.x) * s;
         }
+#endif
     }
     float len = length(acc);
     vec3 n = (total > 0.0 && len > REL * total)
         ? acc / len : vec3(fallback[3u * v], fallback[3u * v + 1u], fallback[3u * v + 2u]);
+#ifdef NORMALS_ONLY
+    normals_out[3u * v] = n.x;
+    normals_out[3u * v + 1u] = n.y;
+    normals_out[3u * v + 2u] = n.z;
+#else
     vec3 t = big_t - n * dot(n, big_t);
     float t_len = length(t);
     float big_len = length(big_t);
@@ -99,4 +114,5 @@ void main() {
     vertices[6u * v + 4u] = n.y;
     vertices[6u * v + 5u] = n.z;
     tangents[v] = vec4(t, w);
+#endif
 }

@@ -193,14 +193,19 @@ def test_failing_logic_and_interrupts_shut_down_cleanly(monkeypatch):
 
         exe = gpu.load(plan, logic_hz=60)
         scene = exe.executor.scene_gpu
-        real = scene.update
+        real = scene.frame_update  # the per-frame update the frame loop takes for a run
 
-        def interrupted(frame: int, frame_set: int) -> None:
-            if frame == 3:
-                raise KeyboardInterrupt
-            real(frame, frame_set)
+        def interrupting() -> object:
+            update = real()
 
-        monkeypatch.setattr(scene, "update", interrupted)
+            def interrupted(frame: int, frame_set: int) -> None:
+                if frame == 3:
+                    raise KeyboardInterrupt
+                update(frame, frame_set)
+
+            return interrupted
+
+        monkeypatch.setattr(scene, "frame_update", interrupting)
         exe.executor.scene_gpu = scene
         with pytest.raises(KeyboardInterrupt):
             exe.run(50)

@@ -85,7 +85,7 @@ def test_restarts_keep_the_rate_and_the_old_figure_counts_the_part_periods():
     since each run's first tick is due a period after its start."""
     clock = FakeClock()
     logic = LogicThread(lambda s: s, 60.0, clock=clock.now, wait=clock.advance)
-    for k in range(8):
+    for _ in range(8):
         run_until(logic, logic.ticks + 3)
         clock.advance(0.1)  # stopped: no schedule
     stats = logic.stats()

@@ -208,6 +208,20 @@ def test_unvalidated_frames_group_submits_and_keep_data_exact(cuts, monkeypatch)
         executor.close()
 
 
+def test_polled_fence_wait_keeps_data_exact(monkeypatch):
+    """``RGRAPH_FENCE_WAIT=poll`` (a diagnostic: the frame loop polls its fences instead of
+    sleeping in vkWaitForFences) runs the same frames; an unknown way is refused."""
+    from rgraph.vk.errors import ExecutionError
+
+    plan, _ = cross_queue()
+    monkeypatch.setenv("RGRAPH_FENCE_WAIT", "poll")
+    result = _execute_unvalidated(plan, frames=4)
+    assert result.data_ok is True, [str(m) for m in result.mismatches]
+    monkeypatch.setenv("RGRAPH_FENCE_WAIT", "spin")
+    with pytest.raises(ExecutionError, match="RGRAPH_FENCE_WAIT must be block or poll"):
+        _execute_unvalidated(plan, frames=1)
+
+
 def _execute_unvalidated(plan, frames):
     from rgraph.vk.executor import execute_plan
 

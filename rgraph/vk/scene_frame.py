@@ -19,6 +19,7 @@ The render thread's only scene work per frame. What it writes, per frame-in-flig
 
 from __future__ import annotations
 
+import os
 import threading
 from collections.abc import Callable
 from typing import Any
@@ -58,11 +59,11 @@ class SceneFrames:
         logic thread and draw modes gpu or cpu, a closure over what ``update`` would look up
         every frame (the scene's parts, the skin's SkinFrame words, the logic's clock), doing
         the same writes in the same order with about half its bytecodes; ``update`` itself
-        otherwise."""
+        otherwise, or with ``RGRAPH_FRAME_UPDATE=method``."""
         sc = self.scene
         logic, skin, deform = sc.logic, sc.skin, sc.deform
-        if logic is None or sc.mode == "naive":
-            return self.update
+        if logic is None or sc.mode == "naive" or os.environ.get("RGRAPH_FRAME_UPDATE") == "method":
+            return self.update  # RGRAPH_FRAME_UPDATE=method: the path before session 11 (an A/B switch)
         lock, latest, clock, hz = self.lock, logic.latest, logic.clock, logic.hz
         camera, frame_words, camera_tables = sc.data.camera, self.frame_words, self._camera_tables
         alpha_range, ticks_taken = sc.alpha_range, sc.ticks_taken

@@ -38,9 +38,10 @@ def _scramble(scene) -> None:
 
 
 @pytest.mark.vulkan
-def test_frame_update_writes_what_update_writes(tmp_path):
+def test_frame_update_writes_what_update_writes(tmp_path, monkeypatch):
     import rgraph
     from rgraph.compiler.pipeline import compile_graph
+    from rgraph.vk.scene_frame import SceneFrames
 
     path = tmp_path / "skin_case.yaml"
     path.write_text(SCENE.replace("BONES", "16"))
@@ -58,6 +59,7 @@ def test_frame_update_writes_what_update_writes(tmp_path):
             now = [0.0]
             logic.clock = lambda: now[0]
             fast = scene.frame_update()
+            assert getattr(fast, "__func__", None) is not SceneFrames.update
             cases = 0
             for frame in range(8):
                 if frame == 4:
@@ -79,3 +81,5 @@ def test_frame_update_writes_what_update_writes(tmp_path):
                     assert _snapshot(scene) == want, (frame, offset)
                     cases += 1
             assert cases == 56
+            monkeypatch.setenv("RGRAPH_FRAME_UPDATE", "method")  # the A/B switch: the method itself
+            assert scene.frame_update() == scene.frames.update

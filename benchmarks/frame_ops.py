@@ -2,6 +2,8 @@
 loop by function (``sys.settrace`` opcode events on the render thread, between a frame's
 start and the end of its submits; the logic thread is not traced) and the submit's structure
 (vkQueueSubmit2 calls, VkSubmitInfo2, command buffers, semaphore infos, fences per frame).
+As in ``benchmarks.vr_tests``: one VkQueue, draw.mode=gpu, a logic thread, timestamps read in
+one frame of 4, the loop's timing marks on (they are part of the count).
 
 Counts, not times: the same on any machine and load, so they compare two paths exactly
 (``RGRAPH_BATCH_CUTS=plan RGRAPH_FRAME_UPDATE=method``: the render path before session 11).
@@ -89,6 +91,7 @@ def main(argv: list[str] | None = None) -> int:
                 plan = compile_graph(GRAPH, scene_path=SCENES / TESTS[test], size=size,
                                      params={"views": views, "draw.mode": "gpu"}, memory=gpu.memory_requirements())
                 with gpu.load(plan, logic_hz=args.logic_hz) as exe:
+                    exe.executor.timestamp_every = 4  # as vr_tests: one frame's timestamps read in 4
                     exe.run(4)
                     ops, calls = count_frames(exe, args.frames)
                     structure = submit_structure(exe.executor)

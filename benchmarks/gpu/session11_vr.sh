@@ -6,7 +6,7 @@
 #          semaphore is needed), the per-run update closure (SceneFrames.frame_update);
 #   old  : RGRAPH_BATCH_CUTS=plan RGRAPH_FRAME_UPDATE=method, the render path of main 0a194d8
 #          (two command buffers / VkSubmitInfo2 per frame, SceneFrames.update per frame);
-#   cuts : the new update with the old cuts (what the one command buffer alone gives);
+#   cuts : the new update with the old cuts (new against cuts: what the one command buffer gives);
 #   poll : new, and RGRAPH_FENCE_WAIT=poll (diagnostic: the thread polls its fences instead of
 #          sleeping: is the time after a long wait the cold wake-up's? burns the wait's CPU);
 #   lighting at 3840x2160 mono, new and old: lighting with a frame as long as skinned's

@@ -197,12 +197,17 @@ def pass_ratios(rows: list[dict[str, Any]]) -> str:
 
 
 def logic_summary(logic: dict[str, Any] | None) -> str:
-    """``; logic ...``: the logic thread's measured rate, late ticks and tick time, and how its
-    skinning states were evaluated (a worker process's evaluation time, the logic thread's wait)."""
+    """``; logic ...``: the logic thread's kept rate (``LogicThread.stats``: with the ticks per
+    running second, the runs, ticks behind at stop, the median tick delay), late ticks and tick
+    time, and how its skinning states were evaluated (a worker process's evaluation time, the logic thread's wait)."""
     if not logic:
         return ""
-    text = (f"; logic {_f(logic.get('measured_hz'), '.1f')} Hz of {logic['hz']:g}, {logic['late_ticks']} late, "
-            f"tick {_f(logic.get('tick_us'), '.0f')} us on the logic thread")
+    text = f"; logic {_f(logic.get('measured_hz'), '.1f')} Hz of {logic['hz']:g}"
+    if "ticks_per_running_second" in logic:  # session 11: the kept rate, then the old figure
+        text += (f" ({_f(logic['ticks_per_running_second'], '.1f')} ticks per running second over "
+                 f"{logic['runs']} runs, {logic['behind_at_stop']} behind at stop, ticks "
+                 f"{_f(logic.get('tick_delay_us'), '.0f')} us past due)")
+    text += f", {logic['late_ticks']} late, tick {_f(logic.get('tick_us'), '.0f')} us on the logic thread"
     skin = logic.get("skin")
     if skin and skin.get("worker") == "process":
         text += (f" (skinning in a worker process, {skin['threads']} thread(s): "

@@ -102,7 +102,7 @@ def render_thread_line(timings: dict) -> str:
         measured = logic.get("measured_hz")
         line += (f"; logic {logic['ticks']} ticks at {logic['hz']:g} Hz"
                  + (f" (measured {measured:.1f} Hz" if measured else " (")
-                 + f", {logic['late_ticks']} late)")
+                 + f", {logic['late_ticks']} late, {logic.get('behind_at_stop', 0)} behind at stop)")
         skin = logic.get("skin") or {}
         if skin.get("worker") == "process" and skin.get("tick_us") is not None:
             line += (f"; skinning in a worker process: {skin['tick_us'] / 1e3:.1f} ms per state, the logic "

@@ -22,7 +22,7 @@ from typing import Any
 from rgraph.vk.device import Device, create_device
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.impl_pass import ImplPass
-from rgraph.vk.instance import Instance, ValidationMessage, create_instance, submit_per_pass
+from rgraph.vk.instance import Instance, ValidationMessage, batch_cuts, create_instance, submit_per_pass
 from rgraph.vk.lower import LAYER_WORKAROUNDS, LoweringError, Recording, from_device, lower
 from rgraph.vk.probe_rt import has_raytrace, layer_crashes, needs_ray_tracing, refuse_layer_for_ray_tracing
 from rgraph.vk.record import BarrierBatch
@@ -120,7 +120,7 @@ class Executor:
                                      "raytrace passes): open_device(ray_tracing=True)")
             try:
                 self.recording = lower(plan, from_device(self.device), one_batch_per_pass=submit_per_pass(self.instance.validate),
-                                       workarounds=workarounds)
+                                       workarounds=workarounds, batch_cuts=batch_cuts())
             except LoweringError as exc:
                 raise ExecutionError(str(exc)) from None
             self.plan = self.recording.plan

@@ -11,7 +11,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-from rgraph.vk.errors import INSTALL_HINT, VulkanUnavailable
+from rgraph.vk.errors import INSTALL_HINT, ExecutionError, VulkanUnavailable
 from rgraph.vk.loader import vk
 
 _PASS_IN_TEXT = re.compile(r"\[pass (\S+) \(set \d+\)\]")
@@ -40,6 +40,16 @@ def submit_per_pass(validate: bool) -> bool:
     their pass), or asked for with ``RGRAPH_SUBMIT_PER_PASS=1`` (a validated run's submission
     without the layer: tells a layer-timing effect from a submission-structure one)."""
     return validate or os.environ.get("RGRAPH_SUBMIT_PER_PASS", "") not in ("", "0")
+
+
+def batch_cuts() -> str:
+    """Where the lowering cuts batches (``rgraph.vk.lower.batches.BATCH_CUTS``): ``queue``
+    (default), or ``plan`` with ``RGRAPH_BATCH_CUTS=plan`` (the cuts before session 11: an
+    A/B switch for the submit's cost)."""
+    cuts = os.environ.get("RGRAPH_BATCH_CUTS", "") or "queue"
+    if cuts not in ("queue", "plan"):
+        raise ExecutionError(f"RGRAPH_BATCH_CUTS must be queue or plan, not {cuts!r}")
+    return cuts
 
 
 def gpu_assisted() -> bool:

@@ -19,7 +19,9 @@ The render thread's only scene work per frame. What it writes, per frame-in-flig
 
 from __future__ import annotations
 
+import os
 import threading
+from collections.abc import Callable
 from typing import Any
 
 from rgraph.scene import instances as scene_instances
@@ -28,6 +30,7 @@ from rgraph.vk.loader import vk
 from rgraph.vk.runtime.logic import interpolation_alpha
 
 TIME_WORD = packing.FRAME_OFFSETS["time"] // 4  # Frame.time: (seconds, frame, near, fov_y)
+INF = float("inf")
 
 
 def float_words(buffer: Any) -> Any:
@@ -51,6 +54,60 @@ class SceneFrames:
         self.camera_of = [None] * self.scene.sets
 
     # ----------------------------------------------------------------- render thread
+    def frame_update(self) -> Callable[[int, int], None]:
+        """``update`` for one run of frames (the frame loop takes it once per run): with a
+        logic thread and draw modes gpu or cpu, a closure over what ``update`` would look up
+        every frame (the scene's parts, the skin's SkinFrame words, the logic's clock), doing
+        the same writes in the same order with about half its bytecodes; ``update`` itself
+        otherwise, or with ``RGRAPH_FRAME_UPDATE=method``."""
+        sc = self.scene
+        logic, skin, deform = sc.logic, sc.skin, sc.deform
+        if logic is None or sc.mode == "naive" or os.environ.get("RGRAPH_FRAME_UPDATE") == "method":
+            return self.update  # RGRAPH_FRAME_UPDATE=method: the path before session 11 (an A/B switch)
+        lock, latest, clock, hz = self.lock, logic.latest, logic.clock, logic.hz
+        camera, frame_words, camera_tables = sc.data.camera, self.frame_words, self._camera_tables
+        alpha_range, ticks_taken = sc.alpha_range, sc.ticks_taken
+        skinned = skin.active
+        skin_in_use, skin_words = skin.in_use, skin.frame_words
+        header, bones = skin.header, skin.bones
+        word = TIME_WORD
+
+        def update(frame: int, frame_set: int) -> None:
+            with lock:
+                prev, cur = latest()
+                if deform is not None:
+                    deform.in_use[frame_set] = (prev.value[0], cur.value[0])
+                if skinned:
+                    skin_in_use[frame_set] = (a := prev.value[1], b := cur.value[1])
+            alpha = (clock() - cur.wall) * hz  # interpolation_alpha, inlined
+            if not 0.0 < alpha < INF:
+                alpha = 0.0
+            elif alpha > 1.0:
+                alpha = 1.0
+            seconds = prev.seconds + alpha * (cur.seconds - prev.seconds)
+            if alpha < alpha_range[0]:
+                alpha_range[0] = alpha
+            if alpha > alpha_range[1]:
+                alpha_range[1] = alpha
+            cam = camera(frame)
+            if cam is not self.camera_of[frame_set]:
+                camera_tables(frame, frame_set, seconds)
+                self.camera_of[frame_set] = cam
+            else:
+                words = frame_words[frame_set]
+                words[word] = seconds
+                words[word + 1] = frame
+            if skinned:  # SkinGPU.show_slots, inlined (alpha is in [0, 1] already)
+                f, u = skin_words[frame_set]
+                f[0] = alpha
+                u[1] = header + a * bones
+                u[2] = header + b * bones
+            if deform is not None:
+                deform.set_header(frame_set, alpha, prev.value[0], cur.value[0])
+            ticks_taken[frame_set] = (prev.tick, cur.tick)
+
+        return update
+
     def update(self, frame: int, frame_set: int) -> None:
         sc = self.scene
         data, logic, skin, deform = sc.data, sc.logic, sc.skin, sc.deform

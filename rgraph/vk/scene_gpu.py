@@ -288,6 +288,10 @@ class SceneGPU:
         writes one draw command per object."""
         self.frames.update(frame, frame_set)
 
+    def frame_update(self) -> Any:
+        """``update`` as the frame loop calls it during one run (``SceneFrames.frame_update``)."""
+        return self.frames.frame_update()
+
     def prepare(self, frame: int) -> None:
         """Right after the submits of the frame before content frame ``frame``: write what of
         it can be written ahead (``SceneFrames.prepare``)."""

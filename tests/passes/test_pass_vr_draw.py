@@ -170,6 +170,9 @@ def test_vr_benchmark_reports_the_logic_thread_and_the_skinning_worker():
                     "process, 2 thread(s): 9000 us per state, 17000 us CPU, logic thread waits 40 us)")
     assert logic_summary({**base, "skin": {"worker": "thread", "threads": 1}}).endswith(
         "(skinning on the logic thread, 1 thread(s))")
+    kept = {**base, "ticks_per_running_second": 55.2, "runs": 8, "behind_at_stop": 0, "tick_delay_us": 61.0}
+    assert logic_summary(kept) == ("; logic 59.9 Hz of 60 (55.2 ticks per running second over 8 runs, 0 behind at "
+                                   "stop, ticks 61 us past due), 0 late, tick 612 us on the logic thread")
 
 
 @pytest.mark.vulkan

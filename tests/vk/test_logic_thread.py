@@ -79,6 +79,43 @@ def test_ticks_follow_the_fixed_schedule_with_an_injected_clock():
     assert logic.stats()["measured_hz"] == pytest.approx(60.0, rel=0.05)
 
 
+def test_restarts_keep_the_rate_and_the_old_figure_counts_the_part_periods():
+    """Runs of a few ticks each (the benchmarks' warm-up batches): every due tick runs, so the
+    kept rate is the requested one; ticks over the running time (start to stop) reads lower,
+    since each run's first tick is due a period after its start."""
+    clock = FakeClock()
+    logic = LogicThread(lambda s: s, 60.0, clock=clock.now, wait=clock.advance)
+    for _ in range(8):
+        run_until(logic, logic.ticks + 3)
+        clock.advance(0.1)  # stopped: no schedule
+    stats = logic.stats()
+    assert stats["runs"] == 8 and logic.late == 0
+    assert stats["measured_hz"] == pytest.approx(60.0, rel=1e-9)
+    assert stats["behind_at_stop"] <= 8  # at most a tick due at the very moment of a stop
+    assert stats["tick_delay_us"] == pytest.approx(0.0, abs=1e-3)  # the fake clock is never late
+    running = stats["ticks_per_running_second"]
+    assert running is not None and running < 60.0
+
+
+def test_a_lagging_schedule_reads_low_and_counts_ticks_behind_at_stop():
+    """Each step takes 2.5 periods: ticks run back to back, the kept rate is hz / 2.5 and the
+    ticks due but not run when the thread stops are counted."""
+    clock = FakeClock()
+
+    def slow(seconds: float) -> float:
+        if seconds > 0:
+            clock.advance(2.5 / 60)
+        return seconds
+
+    logic = LogicThread(slow, 60.0, clock=clock.now, wait=clock.advance, max_catch_up=10**6)
+    run_until(logic, 20)
+    stats = logic.stats()
+    assert logic.late == 0
+    assert stats["measured_hz"] == pytest.approx(60.0 / 2.5, rel=0.1)
+    assert stats["behind_at_stop"] >= 10
+    assert stats["tick_delay_us"] > 1e4
+
+
 def test_a_slow_step_moves_the_schedule_instead_of_bursting():
     clock = FakeClock()
 
@@ -193,14 +230,19 @@ def test_failing_logic_and_interrupts_shut_down_cleanly(monkeypatch):
 
         exe = gpu.load(plan, logic_hz=60)
         scene = exe.executor.scene_gpu
-        real = scene.update
+        real = scene.frame_update  # the per-frame update the frame loop takes for a run
 
-        def interrupted(frame: int, frame_set: int) -> None:
-            if frame == 3:
-                raise KeyboardInterrupt
-            real(frame, frame_set)
+        def interrupting() -> object:
+            update = real()
 
-        monkeypatch.setattr(scene, "update", interrupted)
+            def interrupted(frame: int, frame_set: int) -> None:
+                if frame == 3:
+                    raise KeyboardInterrupt
+                update(frame, frame_set)
+
+            return interrupted
+
+        monkeypatch.setattr(scene, "frame_update", interrupting)
         exe.executor.scene_gpu = scene
         with pytest.raises(KeyboardInterrupt):
             exe.run(50)

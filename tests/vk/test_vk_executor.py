@@ -171,12 +171,17 @@ def test_syncval_1_3_239_misses_a_buffer_drop_beside_an_image_barrier():
     assert _caught(_execute(drop_barrier(plan, "consume", "counts"))) == set()
 
 
-def test_unvalidated_frames_group_submits_and_keep_data_exact():
+@pytest.mark.parametrize("cuts", ["queue", "plan"])
+def test_unvalidated_frames_group_submits_and_keep_data_exact(cuts, monkeypatch):
     """Without validation, consecutive batches on one VkQueue go in one vkQueueSubmit2 (an
-    array of submit infos, semaphores between them): data stays exact, timestamps are read."""
+    array of submit infos, semaphores between them): data stays exact, timestamps are read.
+    On one VkQueue (lavapipe) the plan's cross-queue waits need no semaphore: the default
+    cuts (``queue``) give the frame one batch, one command buffer; ``RGRAPH_BATCH_CUTS=plan``
+    (the cuts before session 11) cuts at every plan wait and signal."""
     from rgraph.vk.executor import Executor, marks_per_frame
     from rgraph.vk.loader import vk
 
+    monkeypatch.setenv("RGRAPH_BATCH_CUTS", cuts)
     plan, _ = cross_queue()
     result = _execute_unvalidated(plan, frames=4)
     assert result.data_ok is True, [str(m) for m in result.mismatches]
@@ -187,16 +192,34 @@ def test_unvalidated_frames_group_submits_and_keep_data_exact():
         pytest.skip(str(exc))
     try:
         calls = executor.submit_calls[0]
-        assert sum(c.count for c in calls) == len(executor.batches) >= 2
         ffi = vk().ffi
-        if len({int(ffi.cast("uintptr_t", c.queue)) for c in calls}) == 1:
+        one_queue = len({int(ffi.cast("uintptr_t", c.queue)) for c in calls}) == 1
+        assert sum(c.count for c in calls) == len(executor.batches) >= (1 if one_queue and cuts == "queue" else 2)
+        if one_queue:
             assert len(calls) == 1  # one VkQueue (lavapipe): one call per frame
+            assert not executor.semaphores  # one VkQueue: no semaphore
+            if cuts == "queue":
+                assert len(executor.batches) == 1
         marks: list[float] = []
         timings = executor.run_frames(5, marks=marks)
         assert len(marks) == 5 * marks_per_frame(len(calls)) and marks == sorted(marks)
         assert timings["frames"] == 5 and timings["total_ms"] is not None
     finally:
         executor.close()
+
+
+def test_polled_fence_wait_keeps_data_exact(monkeypatch):
+    """``RGRAPH_FENCE_WAIT=poll`` (a diagnostic: the frame loop polls its fences instead of
+    sleeping in vkWaitForFences) runs the same frames; an unknown way is refused."""
+    from rgraph.vk.errors import ExecutionError
+
+    plan, _ = cross_queue()
+    monkeypatch.setenv("RGRAPH_FENCE_WAIT", "poll")
+    result = _execute_unvalidated(plan, frames=4)
+    assert result.data_ok is True, [str(m) for m in result.mismatches]
+    monkeypatch.setenv("RGRAPH_FENCE_WAIT", "spin")
+    with pytest.raises(ExecutionError, match="RGRAPH_FENCE_WAIT must be block or poll"):
+        _execute_unvalidated(plan, frames=1)
 
 
 def _execute_unvalidated(plan, frames):

@@ -12,15 +12,38 @@ class PlanBatch:
     passes: list[dict] = field(default_factory=list)
 
 
-def make_batches(plan: dict, queues: Any, one_per_pass: bool = False) -> list[PlanBatch]:
+#: ``make_batches`` cuts: ``queue`` (default) only where a semaphore is needed (a wait on, or
+#: a signal waited by, another VkQueue); ``plan`` at every plan wait and signal (before
+#: session 11: with one VkQueue a frame still had two command buffers and two VkSubmitInfo2).
+BATCH_CUTS = ("queue", "plan")
+
+
+def make_batches(plan: dict, queues: Any, one_per_pass: bool = False, cuts: str = "queue") -> list[PlanBatch]:
     """Contiguous runs (in plan order) on one VkQueue (``queues.same_queue``), cut before a
-    pass with waits and after a pass with signals; ``one_per_pass`` (under validation) gives
-    each pass its own command buffer so that validation messages name the pass."""
+    pass that waits for another VkQueue and after a pass whose signal another VkQueue waits for
+    (``cuts="plan"``: before every pass with waits and after every pass with signals);
+    ``one_per_pass`` (under validation) gives each pass its own command buffer so that
+    validation messages name the pass."""
+    if cuts not in BATCH_CUTS:
+        raise ValueError(f"batch cuts must be one of {', '.join(BATCH_CUTS)}, not {cuts!r}")
+    by_plan = cuts == "plan"
+    waiters: dict[tuple[str, int], list[str]] = {}  # (signalling queue, value) -> the waiting passes' queues
+    for p in plan["passes"]:
+        for w in p["waits"]:
+            waiters.setdefault((w["queue"], w["value"]), []).append(p["queue"])
+
+    def waits_across(p: dict) -> bool:
+        return any(by_plan or not queues.same_queue(w["queue"], p["queue"]) for w in p["waits"])
+
+    def signals_across(p: dict) -> bool:
+        return any(by_plan or not queues.same_queue(q, p["queue"])
+                   for s in p["signals"] for q in waiters.get((p["queue"], s["value"]), ()))
+
     batches: list[PlanBatch] = []
     for p in plan["passes"]:
         last = batches[-1] if batches else None
-        if (one_per_pass or last is None or not queues.same_queue(last.queue, p["queue"]) or p["waits"]
-                or last.passes[-1]["signals"]):
+        if (one_per_pass or last is None or not queues.same_queue(last.queue, p["queue"]) or waits_across(p)
+                or signals_across(last.passes[-1])):
             batches.append(PlanBatch(p["queue"], [p]))
         else:
             last.passes.append(p)

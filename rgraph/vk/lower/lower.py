@@ -25,10 +25,11 @@ class LoweringError(ValueError):
 
 
 def lower(plan: Plan | dict, queues: QueueLayout, *, one_batch_per_pass: bool = False,
-          workarounds: Iterable[str] = LAYER_WORKAROUNDS) -> Recording:
+          workarounds: Iterable[str] = LAYER_WORKAROUNDS, batch_cuts: str = "queue") -> Recording:
     """The recording of ``plan`` on ``queues``: per pass its barrier calls, the batches (one
     command buffer each; ``one_batch_per_pass`` under validation, so that messages name the
-    pass), the frame's semaphore edges and the host submission order. ``workarounds``: the
+    pass; ``batch_cuts``: ``rgraph.vk.lower.batches.make_batches``), the frame's semaphore
+    edges and the host submission order. ``workarounds``: the
     validation-layer rewrites to apply (``rgraph.vk.lower.workarounds``; () for none).
 
     ``plan`` is a typed ``rgraph.plan.Plan`` or its JSON document; the rewrites read the
@@ -52,11 +53,12 @@ def lower(plan: Plan | dict, queues: QueueLayout, *, one_batch_per_pass: bool = 
         before = lower_barriers(p["barriers"], "barrier", families, waited, caps, additions[i], handoffs[i], disabled)
         after = lower_barriers(p["releases"], "release", families, (), caps, None, frozenset(), disabled)
         passes.append(PassRecording(i, p["name"], p["queue"], tuple(map(tuple, before)), tuple(map(tuple, after))))
-    plan_batches = make_batches(plan, queues, one_per_pass=one_batch_per_pass)
+    plan_batches = make_batches(plan, queues, one_per_pass=one_batch_per_pass, cuts=batch_cuts)
     index_of = {id(p): i for i, p in enumerate(plan["passes"])}
     batches = tuple(Batch(b.queue, tuple(index_of[id(p)] for p in b.passes)) for b in plan_batches)
     syncs = [BatchSync(b.queue, key(b.queue),
-                       tuple((w["queue"], w["value"], frozenset(w["stages"])) for w in b.passes[0]["waits"]),
+                       tuple((w["queue"], w["value"], frozenset(w["stages"])) for w in b.passes[0]["waits"]
+                             if not queues.same_queue(w["queue"], b.queue)),  # one VkQueue: no semaphore
                        tuple((s["queue"], s["value"], frozenset(s["stages"])) for s in b.passes[-1]["signals"]),
                        touched_resources(b.passes))
              for b in plan_batches]

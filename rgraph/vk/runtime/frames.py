@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from typing import Any
@@ -80,7 +81,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     update_s = [0.0] * frames
     submitted = [False] * FRAMES_IN_FLIGHT
     scene, updaters = ex.scene_gpu, ex.updaters
-    update = scene.update if scene is not None else None
+    update = scene.frame_update() if scene is not None else None
     records = scene is not None and scene.records_per_frame
     prepare = scene.prepare if scene is not None and scene.deform is not None and ex.logic is None else None
     wait_fences, reset_fences, submit2 = lib.vkWaitForFences, lib.vkResetFences, lib.vkQueueSubmit2
@@ -90,6 +91,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
                 for k in range(FRAMES_IN_FLIGHT)]
     slots_of = ex.value_slots
     timeout = 10**11
+    poll, not_yet = fence_wait() == "poll", v.VK_TIMEOUT
     perf = time.perf_counter
     timed = marks is not None
     mark = marks.append if marks is not None else None
@@ -115,7 +117,11 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
             if timed:
                 mark(perf())
             if count:
-                result = wait_fences(handle, count, fence_arrays[s], 1, timeout)
+                if poll:  # diagnostic (RGRAPH_FENCE_WAIT=poll): the thread never sleeps in the wait
+                    while (result := wait_fences(handle, count, fence_arrays[s], 1, 0)) == not_yet:
+                        pass
+                else:
+                    result = wait_fences(handle, count, fence_arrays[s], 1, timeout)
                 if result:
                     check_result(result, "vkWaitForFences")
             if timed:
@@ -210,6 +216,19 @@ def timings(ex: Any, rows: Any, frames: int, cpu_s: Any) -> dict[str, Any]:
     return {"passes": per_pass, "total_ms": total, "frames": frames,
             "cpu_submit_ms": float(np.median(cpu_s)) * 1000.0 if frames else None,
             "intervals": pass_intervals(ex.plan, rows, period)}
+
+
+def fence_wait() -> str:
+    """How the frame loop waits for a frame set's fences: ``block`` (default: one
+    vkWaitForFences that sleeps until they signal) or ``poll`` (``RGRAPH_FENCE_WAIT=poll``, a
+    diagnostic: vkWaitForFences with timeout 0 until they signal, so the thread stays on its
+    core with its caches warm; the wait then burns CPU, which ``render_thread.cpu_us_per_frame``
+    shows, and the frame's work after the wait runs warm: on the H200, whether the render
+    thread's time after a long wait is the cold wake-up's)."""
+    way = os.environ.get("RGRAPH_FENCE_WAIT", "") or "block"
+    if way not in ("block", "poll"):
+        raise ExecutionError(f"RGRAPH_FENCE_WAIT must be block or poll, not {way!r}")
+    return way
 
 
 def check_result(result: int, call: str) -> None:

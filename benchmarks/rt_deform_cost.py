@@ -24,7 +24,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path.cwd()))  # the checkout it is run from, not an installed rgraph
 
-from rgraph.compiler.pipeline import compile_graph  # noqa: E402
 from rgraph.resources import builtin_passes  # noqa: E402
 from rgraph.scene.build import load_scene_data  # noqa: E402
 
@@ -39,9 +38,11 @@ def min_cpu_ms(fn, repeats: int) -> float:
 
 
 def run(graph: str, scene: str, size: tuple[int, int], frames: int) -> dict:
+    from rgraph.api import compile_for_device
     from rgraph.vk.executor import execute_plan
 
-    result = execute_plan(compile_graph(graph, scene_path=scene, size=size), frames=frames)
+    # sized for the device it runs on (accel scratch sizes differ between drivers)
+    result = execute_plan(compile_for_device(graph, scene_path=scene, size=size), frames=frames)
     return result.timings["render_thread"]
 
 

@@ -92,6 +92,21 @@ def logic_rate(text: str) -> float:
     return hz
 
 
+def rest_pose_note(plan: dict) -> str | None:
+    """A line when the plan traces rays against a scene with skinned meshes: acceleration
+    structures hold them in their rest pose (docs/raytracing.md), though raster passes animate them."""
+    if not plan.get("scene_source") or not any(
+            r["kind"] == "accel" and r.get("accel", {}).get("geometry") == "scene" for r in plan["resources"]):
+        return None
+    from rgraph.spec.scene import load_scene
+
+    skinned = sum(1 for m in load_scene(plan["scene_source"]).model.meshes if m.skinned is not None)
+    if not skinned:
+        return None
+    return (f"rgraph: note: the scene's {skinned} skinned mesh(es) are traced in their rest pose "
+            "(acceleration structures do not follow skinning)")
+
+
 def render_thread_line(timings: dict) -> str:
     """One stderr line: the render thread's CPU per frame, and the logic thread's ticks."""
     r = timings.get("render_thread") or {}
@@ -304,6 +319,9 @@ def run(args: argparse.Namespace) -> int:
         print("rgraph: nothing to execute: every pass was culled", file=sys.stderr)
     for entry in plan.get("culled", []):
         print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
+    note = rest_pose_note(plan)
+    if note:
+        print(note, file=sys.stderr)
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)

@@ -163,7 +163,7 @@ def synchronize(
                 if kept is not None:
                     kept.append((st, end[4]))
         if multi:
-            _rectangles(name, multi, bars, rels)
+            _rectangles(name, multi, bars, rels, (0, res.mips), (0, res.layers))
         per_cell = lifetime != "transient" or name in outputs
         initial[name] = _end_state(per_cell, starts)
         final[name] = _end_state(per_cell, finals)
@@ -342,12 +342,16 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
     return layout, cq, write, reads, last_pass, visible
 
 
-def _rectangles(res: str, by_pass: dict[int, list[list]], bars: list, rels: list) -> None:
-    """A resource of several cells: per pass, its cells with one key and release pass (grouped
-    by the walks: [key, release pass, first cell position, (mip, layer) cells]) merged into
-    mip x layer rectangles (an acquire's rectangles equal its release's: the layer pairs
-    ownership transfers by exact subresource range)."""
+def _rectangles(res: str, by_pass: dict[int, list[list]], bars: list, rels: list,
+                all_mips: tuple[int, int], all_layers: tuple[int, int]) -> None:
+    """A resource of several cells (``all_mips`` x ``all_layers``): per pass, its cells with
+    one key and release pass (grouped by the walks: [key, release pass, first cell position,
+    (mip, layer) cells], each cell once) merged into mip x layer rectangles (an acquire's
+    rectangles equal its release's: the layer pairs ownership transfers by exact subresource
+    range). A group of every cell (most groups of several) is the one whole rectangle."""
     get_sub = get_subresource
+    count = (all_mips[1] - all_mips[0]) * (all_layers[1] - all_layers[0])
+    whole = None  # the whole resource's subresource, once needed
     for i, groups in by_pass.items():
         for (src, dst, names), release_at, first, cells in groups:
             ps = get_state(src) or plan_state(src)
@@ -357,6 +361,10 @@ def _rectangles(res: str, by_pass: dict[int, list[list]], bars: list, rels: list
                 mips, layers = (mip, mip + 1), (layer, layer + 1)
                 sub = get_sub((mips, layers)) or subresource(mips, layers)
                 entries = [(res, mips, layers, make_barrier(res, sub, ps, pd, names))]
+            elif len(cells) == count:
+                if whole is None:
+                    whole = subresource(all_mips, all_layers)
+                entries = [(res, all_mips, all_layers, make_barrier(res, whole, ps, pd, names))]
             else:
                 entries = [(res, mips, layers, make_barrier(res, subresource(mips, layers), ps, pd, names))
                            for mips, layers in mip_layer_rectangles(cells)]

@@ -43,6 +43,7 @@ class ResourceTrace:
     code: int  # format part of the scope's key: image + 2 * depth + 4 * stencil
     group: list[tuple[int, int, bool, str, str | None]] | None  # read_layouts candidates: (pass, access, write,
     # usage, layout)
+    single: bool = False  # one cell (buffers, accels, one-mip one-layer images): its uses are ``cells[0][1]``
 
 
 _new_trace = builder(ResourceTrace)
@@ -65,7 +66,8 @@ def _start(res: ResourceSpec, i: int, usage: str) -> ResourceTrace:
     depth, stencil = bool(fmt and fmt.has_depth), bool(fmt and fmt.has_stencil)
     # read_layouts' candidates: transient colour images
     group = [] if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil else None
-    return _new_trace({usage}, i, i, [], image + 2 * depth + 4 * stencil, group)
+    single = not image or res.mips * res.layers == 1
+    return _new_trace({usage}, i, i, [], image + 2 * depth + 4 * stencil, group, single)
 
 
 def _scope(key: tuple) -> tuple[Sync, tuple[str, ...], tuple[str, ...]]:
@@ -126,6 +128,27 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                     r.group = None
                 else:
                     group.append((i, j, w, usage, s.layout))
+            if r.single:  # most resources: the one cell's uses without a lookup by cell
+                cells = r.cells
+                if not cells:
+                    cells.append((a.cells[0], [(i, s, w, queue, pos)]))
+                    pos += 1
+                    continue
+                uses = cells[0][1]
+                prev = uses[-1]
+                if prev[0] == i:  # a second access to the cell in this pass: one merged use
+                    uses[-1] = (i, merge(prev[1], s), prev[2] or w, queue, prev[4])
+                    continue
+                q = prev[3]
+                if q != queue:  # the dedicated plan waits for that use
+                    found = waits.get(i)
+                    if found is None:
+                        waits[i] = {q: prev[0]}
+                    elif found.get(q, -1) < prev[0]:
+                        found[q] = prev[0]
+                uses.append((i, s, w, queue, pos))
+                pos += 1
+                continue
             for c in a.cells:
                 uses = get_uses(c)
                 if uses is None:
@@ -162,7 +185,7 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
         v = plan_accesses[i][j]
         plan_accesses[i][j] = _new_access(v.resource, v.subresource, v.usage, v.stages, v.access, "GENERAL", v.write)
     for i, j in moved:
-        _repatch(passes[i], i, passes[i].accesses[j].cells, rows[i], timeline)
+        _repatch(passes[i], i, passes[i].accesses[j].cells, rows[i], timeline, info)
     return Trace(plan_accesses, info, waits)
 
 
@@ -176,14 +199,18 @@ def _row(p: PassSpec, info: Mapping[str, ResourceTrace]) -> list[Sync]:
     return out
 
 
-def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], timeline: dict[Cell, list[Use]]) -> None:
-    """Pass ``i``'s use of ``cells`` with its accesses' (changed) syncs merged again."""
+def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], timeline: dict[Cell, list[Use]],
+             info: Mapping[str, ResourceTrace]) -> None:
+    """Pass ``i``'s use of ``cells`` with its accesses' (changed) syncs merged again
+    (``timeline``: the uses of the cells of resources of several cells)."""
     for c in cells:
         merged = None
         for a, s in zip(p.accesses, row, strict=True):
             if c in a.cells:
                 merged = s if merged is None else merge(merged, s)
-        uses = timeline[c]
+        uses = timeline.get(c)
+        if uses is None:  # a resource of one cell
+            uses = info[c[0]].cells[0][1]
         for k in range(len(uses) - 1, -1, -1):
             if uses[k][0] == i:
                 _, _, w, queue, pos = uses[k]

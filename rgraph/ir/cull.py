@@ -74,11 +74,14 @@ def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
     ``wanted`` holds the cells that live passes read and whose producer is not met yet,
     ``claimed`` the cells of kept resources that a later pass writes last. (Within a pass,
     a write's cells overlap no other access's: ``specialize`` checks it. So a live pass's
-    writes and reads update ``wanted`` in one loop, a read-write access as a read.)"""
+    writes and reads update ``wanted`` in one loop, a read-write access as a read.) A
+    resource of one cell (every buffer) stands in both sets as its name, whose hash is
+    cached (a cell tuple's is computed at each lookup); names and cells never compare equal."""
     keep = {n for n, r in spec.resources.items() if r.lifetime in ("persistent", "imported", "output")}
     keep.update(spec.outputs)
-    wanted: set[Cell] = set()
-    claimed: set[Cell] = set()
+    single = {n for n, r in spec.resources.items() if r.kind != "image" or r.mips * r.layers == 1}
+    wanted: set[Cell | str] = set()
+    claimed: set[Cell | str] = set()
     alive: set[str] = set()
     rw = READ_WRITE_USAGES
     for p in reversed(kept):
@@ -86,8 +89,17 @@ def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
         accesses = p.accesses
         for access in accesses:
             if access.write:
+                name = access.resource
+                if name in single:
+                    if name in keep:
+                        if not live and (name not in claimed or name in wanted):
+                            live = True
+                        claimed.add(name)
+                    elif not live and name in wanted:
+                        live = True
+                    continue
                 cs = access.cells
-                if access.resource in keep:
+                if name in keep:
                     if not live and (not claimed.issuperset(cs) or not wanted.isdisjoint(cs)):
                         live = True
                     claimed.update(cs)
@@ -97,7 +109,13 @@ def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
             continue
         alive.add(p.name)
         for access in accesses:
-            if access.write and access.usage not in rw:
+            name = access.resource
+            if name in single:
+                if access.write and access.usage not in rw:
+                    wanted.discard(name)
+                else:
+                    wanted.add(name)
+            elif access.write and access.usage not in rw:
                 wanted.difference_update(access.cells)
             else:  # ``reads(access)``
                 wanted.update(access.cells)

@@ -43,3 +43,21 @@ def test_degenerate_meshes_ray_traced(degenerate: Path, tmp_path: Path) -> None:
     rgba = matplotlib.image.imread(out)
     assert rgba.shape == (9, 16, 4) and (rgba[..., 3] == 1.0).all()
     assert np.isfinite(rgba).all() and rgba[..., :3].max() > 0.2  # sky and a lit floor, not all zero
+
+
+MANY_LIGHTS = """scene: 1
+camera: {position: [0, 0.8, 2.5], look_at: [0, 0.2, 0]}
+lights: [{generate: point, count: 1100, seed: 1, bounds: [[-2, 0.1, -2], [2, 1.5, 2]]}]
+materials: {m: {}}
+meshes: [{shape: plane, params: {size: [4, 4]}, material: m}]
+"""
+
+
+def test_more_lights_than_a_uniform_buffer_binds(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """surgery's forward pass reads ``lights`` as a uniform buffer: 1,100 lights (70,400 bytes)
+    were bound past maxUniformBufferRange (65,536 on lavapipe: a validation error)."""
+    path = tmp_path / "lights.yaml"
+    path.write_text(MANY_LIGHTS)
+    assert main(["run", "surgery", "--scene", str(path), "--size", "7x3", "--frames", "2", "--validate"]) == 0
+    err = capsys.readouterr().err
+    assert "1,024 of 1,100 lights are shaded" in err and "0 validation message(s)" in err

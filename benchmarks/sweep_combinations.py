@@ -2,16 +2,17 @@
 ``benchmarks/sweep_scenes/`` at small and odd sizes, through ``rgraph run`` on the default
 device (lavapipe here), one subprocess per combination; prints one classified row each.
 
-    python benchmarks/sweep_combinations.py [--sizes 32x18] [--odd-sizes 1x1,7x3,33x17]
-        [--odd-scenes rt_tiny,cct,tiny_mesh] [--graphs a,b] [--scenes a,b] [--heavy]
+    python benchmarks/sweep_combinations.py [--sizes 32x18] [--odd-sizes 1x1,2x2,7x3,33x17]
+        [--odd-scenes rt_tiny,cct,tiny_mesh,lights_17] [--extreme-sizes 4096x1,1x4096]
+        [--extreme-scenes rt_tiny] [--graphs a,b] [--scenes a,b] [--skip a,b]
         [--timeout 60] [--jobs 2] [--frames 2]
 
 Every combination runs ``rgraph run G --scene S --size WxH --frames F --validate --json --out
 PNG``; a graph with ray tracing passes, which the installed validation layer cannot take
 (``rgraph run`` refuses ``--validate`` for them), is rerun with ``--check-data`` instead (mode
 ``data``). ``--sizes`` cross every graph with every scene; ``--odd-sizes`` only with
-``--odd-scenes``. The VR scenes (thousands of objects, minutes on lavapipe) are left out
-unless ``--heavy``.
+``--odd-scenes``, ``--extreme-sizes`` with ``--extreme-scenes``. The VR scenes (thousands
+of objects) take a few seconds at these sizes on lavapipe; ``--skip`` leaves scenes out.
 
 Classes: ``OK`` (exit 0, no validation message, data check ok or not applicable, a finite
 image); ``REFUSED`` (exit 2 with one ``FILE:LINE:COL: error:`` diagnostic, no traceback: bad
@@ -35,7 +36,6 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 EDGE_SCENES = ROOT / "benchmarks" / "sweep_scenes"
-HEAVY_PREFIXES = ("vr_",)
 RT_REFUSAL = "vkCreateRayTracingPipelinesKHR"
 
 
@@ -137,8 +137,7 @@ def _names(folder: Path) -> dict[str, Path]:
 def cases(args: argparse.Namespace) -> list[Case]:
     graphs = sorted(_names(ROOT / "graphs"))
     scenes = {**_names(ROOT / "graphs" / "scenes"), **_names(EDGE_SCENES)}
-    if not args.heavy:
-        scenes = {k: v for k, v in scenes.items() if not k.startswith(HEAVY_PREFIXES)}
+    scenes = {k: v for k, v in scenes.items() if k not in args.skip.split(",")}
     if args.graphs:
         graphs = [g for g in graphs if g in args.graphs.split(",")]
     if args.scenes:
@@ -146,17 +145,21 @@ def cases(args: argparse.Namespace) -> list[Case]:
     out = [Case(g, s, size) for size in args.sizes.split(",") if size for g in graphs for s in scenes.values()]
     odd = [s for k, s in scenes.items() if k in args.odd_scenes.split(",")]
     out += [Case(g, s, size) for size in args.odd_sizes.split(",") if size for g in graphs for s in odd]
+    extreme = [s for k, s in scenes.items() if k in args.extreme_scenes.split(",")]
+    out += [Case(g, s, size) for size in args.extreme_sizes.split(",") if size for g in graphs for s in extreme]
     return out
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sizes", default="32x18")
-    parser.add_argument("--odd-sizes", default="1x1,7x3,33x17")
+    parser.add_argument("--odd-sizes", default="1x1,2x2,7x3,33x17")
     parser.add_argument("--odd-scenes", default="rt_tiny,cct,tiny_mesh,lights_17")
     parser.add_argument("--graphs", default="")
     parser.add_argument("--scenes", default="")
-    parser.add_argument("--heavy", action="store_true", help="include the VR scenes")
+    parser.add_argument("--extreme-sizes", default="4096x1,1x4096")
+    parser.add_argument("--extreme-scenes", default="rt_tiny")
+    parser.add_argument("--skip", default="", help="scene names to leave out")
     parser.add_argument("--timeout", type=float, default=60.0)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--frames", type=int, default=2)

@@ -111,7 +111,7 @@ def _classify(proc: subprocess.CompletedProcess[str]) -> tuple[str, str]:
 def run_case(case: Case, frames: int, timeout: float) -> Result:
     with tempfile.TemporaryDirectory() as tmp:
         png = Path(tmp) / "out.png"
-        base = [*_rgraph(), "run", case.graph, "--scene", str(case.scene), "--size", case.size,
+        base = [*_rgraph(), "run", case.graph, "--scene", str(case.scene.relative_to(ROOT)), "--size", case.size,
                 "--frames", str(frames), "--json", "--out", str(png)]
         start = time.perf_counter()
         mode = "validate"

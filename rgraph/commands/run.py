@@ -52,7 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="Khronos validation + synchronization validation; exit 1 on any message")
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
-    parser.add_argument("--out", type=output_path, help="write the first output image as PNG")
+    parser.add_argument("--out", type=output_path,
+                        help="write the first output image as PNG (a rendered float image clamped to [0, 1] as stored)")
     parser.add_argument("--timings", type=output_path,
                         help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
     parser.add_argument("--heatmap", type=output_path,

@@ -14,10 +14,12 @@ PNG``; a graph with ray tracing passes, which the installed validation layer can
 ``--odd-scenes``, ``--extreme-sizes`` with ``--extreme-scenes``. The VR scenes (thousands
 of objects) take a few seconds at these sizes on lavapipe; ``--skip`` leaves scenes out.
 
-Classes: ``OK`` (exit 0, no validation message, data check ok or not applicable, a finite
-image); ``REFUSED`` (exit 2 with one ``FILE:LINE:COL: error:`` diagnostic, no traceback: bad
-input refused as docs/format.md says); ``BUG`` (anything else: a traceback, another exit
-status, validation messages, a failed data check, a timeout, a refusal without a location).
+Classes: ``OK`` (exit 0, no validation message, data check ok or not applicable, an image
+that is not all transparent; its mean colour and colour count are printed for a look);
+``REFUSED`` (exit 2 with one ``FILE:LINE:COL: error:`` diagnostic, no traceback: bad input
+refused as docs/format.md says); ``BUG`` (anything else: a traceback, another exit status,
+validation messages, a failed data check, a timeout, a refusal without a location, an
+all-transparent PNG).
 Exits 1 if any row is a BUG. Not part of CI (minutes of lavapipe time).
 """
 
@@ -69,7 +71,10 @@ def _image_note(png: Path) -> str:
         return ""
     if not png.exists():
         return "no image"
-    pixels = np.asarray(Image.open(png).convert("RGB")).reshape(-1, 3)
+    rgba = np.asarray(Image.open(png).convert("RGBA")).reshape(-1, 4)
+    if not rgba[:, 3].any():
+        return "BUG: an all-transparent image (the PNG writer did not understand the output)"
+    pixels = rgba[:, :3]
     colours = len(np.unique(pixels, axis=0))
     mean = pixels.mean(axis=0)
     return f"img mean {mean[0]:.0f},{mean[1]:.0f},{mean[2]:.0f} {colours} colour(s)"
@@ -126,7 +131,10 @@ def run_case(case: Case, frames: int, timeout: float) -> Result:
         seconds = time.perf_counter() - start
         verdict, detail = _classify(proc)
         if verdict == "OK":
-            detail = "; ".join(x for x in (_image_note(png), detail) if x)
+            image = _image_note(png)
+            if image.startswith("BUG: "):
+                verdict, image = "BUG", image[len("BUG: "):]
+            detail = "; ".join(x for x in (image, detail) if x)
         return Result(case, mode, verdict, seconds, detail)
 
 

@@ -61,3 +61,15 @@ def test_more_lights_than_a_uniform_buffer_binds(tmp_path: Path, capsys: pytest.
     assert main(["run", "surgery", "--scene", str(path), "--size", "7x3", "--frames", "2", "--validate"]) == 0
     err = capsys.readouterr().err
     assert "1,024 of 1,100 lights are shaded" in err and "0 validation message(s)" in err
+
+
+def test_raster_run_locates_a_shape_it_cannot_build(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Was ``<device>:1:1: scene ...: mesh 0 ...``: the scene is built when the device runs."""
+    path = tmp_path / "bad.yaml"
+    path.write_text("scene: 1\nmaterials: {m: {}}\nmeshes:\n  - {shape: segments, params: {turns: 4}, material: m}\n")
+    assert main(["run", "clustered", "--scene", str(path), "--size", "7x3", "--json"]) == 2
+    import json
+
+    diags = json.loads(capsys.readouterr().out)["diagnostics"]
+    assert [(d["file"], d["line"], d["col"]) for d in diags] == [(str(path), 4, 5)]
+    assert "unknown parameter(s) turns" in diags[0]["message"]

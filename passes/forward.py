@@ -31,6 +31,14 @@ COLOR_OUTPUTS = ("diffuse", "specular", "normal_sss")
 LIGHT_BYTES = 64
 
 
+def light_capacity(light_bytes: int, clustered: bool, max_uniform_range: int) -> int:
+    """Lights the shader's ``lights`` array holds: the whole buffer as a storage buffer
+    (clustered), else what one uniform-buffer descriptor binds (``maxUniformBufferRange``,
+    64 KiB = 1,024 lights on lavapipe and NVIDIA; lights past it are not shaded and
+    ``rgraph run`` says so: ``uniform_range_note``)."""
+    return (light_bytes if clustered else min(light_bytes, max_uniform_range)) // LIGHT_BYTES
+
+
 def color_locations(setup: PassSetup, names: tuple[str, ...]) -> dict[str, int]:
     """Fragment output location of each colour attachment (the plan's colour access order)."""
     colors = [a["resource"] for a in setup.plan_pass["accesses"] if a["usage"].startswith("color_attachment")]
@@ -83,7 +91,8 @@ class ForwardPBR(PassImpl):
         cull = str(setup.param("depth_prepass.cull", "back")).upper()
         defines = {
             "LOC_DIFFUSE": loc["diffuse"], "LOC_SPECULAR": loc["specular"], "LOC_NORMAL_SSS": loc["normal_sss"],
-            "LIGHT_COUNT": max(1, light_bytes // LIGHT_BYTES), "ENV_MIPS": env_mips,
+            "LIGHT_COUNT": max(1, light_capacity(light_bytes, self.clustered, setup.max_uniform_range)),
+            "ENV_MIPS": env_mips,
             "HAS_AO": int(self.has_ao), "HAS_SHADOWS": int(self.has_shadows),
             "PCF_TAPS": int(setup.param("shadow.pcf_taps", 16)),
             "IBL_INTENSITY": float(setup.param("forward.ibl_intensity", 0.5)),

@@ -114,9 +114,12 @@ def build_layout(scene: Any | None, meshes: int = 0, segments: int = 0, deformab
                       phase % (2 * math.pi), deformable.astype(bool))
 
 
-def helix_vertices(layout: MeshLayout, indices: np.ndarray) -> list[np.ndarray]:
-    """LINE_LIST vertices (2 x segments, 4) float32 of each mesh in ``indices``: xyz and the
-    colour key (w: hue in [0, 1), +1 for deformable meshes). Vectorised per segment count."""
+def helix_vertices(layout: MeshLayout, indices: np.ndarray, origin=(0.0, 0.0, 0.0)) -> list[np.ndarray]:
+    """LINE_LIST vertices (2 x segments, 4) float32 of each mesh in ``indices``: xyz relative
+    to ``origin`` (the pass gives the camera position: float32 keeps its precision far from
+    the world origin) and the colour key (w: hue in [0, 1), +1 for deformable meshes).
+    Vectorised per segment count."""
+    ox, oy, oz = (float(c) for c in origin)
     out: list[np.ndarray | None] = [None] * len(indices)
     indices = np.asarray(indices)
     seg_of = layout.segments[indices]
@@ -126,9 +129,9 @@ def helix_vertices(layout: MeshLayout, indices: np.ndarray) -> list[np.ndarray]:
         t = np.linspace(0.0, 1.0, int(s) + 1)[None, :]  # (1, s+1)
         angle = 2 * math.pi * layout.turns[m, None] * t + layout.phase[m, None]
         points = np.empty((len(m), int(s) + 1, 4), dtype=np.float64)
-        points[..., 0] = layout.positions[m, 0, None] + layout.radius[m, None] * np.cos(angle)
-        points[..., 1] = layout.positions[m, 1, None] + layout.height[m, None] * t
-        points[..., 2] = layout.positions[m, 2, None] + layout.radius[m, None] * np.sin(angle)
+        points[..., 0] = (layout.positions[m, 0, None] - ox) + layout.radius[m, None] * np.cos(angle)
+        points[..., 1] = (layout.positions[m, 1, None] - oy) + layout.height[m, None] * t
+        points[..., 2] = (layout.positions[m, 2, None] - oz) + layout.radius[m, None] * np.sin(angle)
         points[..., 3] = (m[:, None] * 0.618034) % 1.0 + layout.deformable[m, None]
         lines = np.empty((len(m), 2 * int(s), 4), dtype=np.float32)
         lines[:, 0::2] = points[:, :-1]
@@ -138,16 +141,26 @@ def helix_vertices(layout: MeshLayout, indices: np.ndarray) -> list[np.ndarray]:
     return out  # type: ignore[return-value]
 
 
-def view_projection(camera: Any | None, aspect: float) -> np.ndarray:
-    """Row-major view-projection: look-at view, reversed-Z infinite perspective, Vulkan y-down clip."""
-    eye = np.array(camera.position if camera else (0.0, 55.0, 80.0), dtype=np.float64)
-    target = np.array(camera.look_at if camera else (0.0, 0.0, 0.0), dtype=np.float64)
+def camera_position(camera: Any | None) -> np.ndarray:
+    return np.array(camera.position if camera else (0.0, 55.0, 80.0), dtype=np.float64)
+
+
+def view_projection(camera: Any | None, aspect: float, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Row-major view-projection of positions relative to ``origin``: look-at view (a view
+    direction parallel to ``up`` picks another reference axis), reversed-Z infinite
+    perspective, Vulkan y-down clip."""
+    from rgraph.scene.camera import orthonormal_basis
+
+    eye = camera_position(camera) - np.asarray(origin, dtype=np.float64)
+    target = np.array(camera.look_at if camera else (0.0, 0.0, 0.0), dtype=np.float64) - np.asarray(origin)
     up = np.array(camera.up if camera else (0.0, 1.0, 0.0), dtype=np.float64)
     fov_y = math.radians(camera.fov_y if camera else 50.0)
     near = float(camera.near if camera else 0.1)
     f = target - eye
     f /= np.linalg.norm(f)
     r = np.cross(f, up)
+    if np.linalg.norm(r) <= 1e-3 * np.linalg.norm(up):  # looking along up: no cross product
+        r, _, _ = orthonormal_basis(f, up)
     r /= np.linalg.norm(r)
     u = np.cross(r, f)
     view = np.eye(4)
@@ -262,11 +275,13 @@ class MeshLines(PassImpl):
         order = np.arange(len(self.layout))
         self.rigid = order[~self.layout.deformable]
         self.deformable = order[self.layout.deformable]
-        rigid_vertices = helix_vertices(self.layout, self.rigid)
-        deform_vertices = helix_vertices(self.layout, self.deformable)
+        camera = scene.camera if scene else None
+        eye = camera_position(camera)  # camera-relative vertices (scenes far from the origin)
+        rigid_vertices = helix_vertices(self.layout, self.rigid, eye)
+        deform_vertices = helix_vertices(self.layout, self.deformable, eye)
         geometry_ms = (time.perf_counter() - t0) * 1e3
         w, h = setup.extent
-        self.view_proj = view_projection(scene.camera if scene else None, w / h).T.astype(np.float32).tobytes()
+        self.view_proj = view_projection(camera, w / h, eye).T.astype(np.float32).tobytes()
         self.pipeline = setup.graphics_pipeline(
             "lines/mesh.vert", "lines/mesh.frag", [], push_constant_bytes=64,
             vertex_input=VertexInput(16, [(0, "r32g32b32a32_sfloat", 0)]), topology="LINE_LIST",

@@ -25,7 +25,7 @@ TABLES = ("instances", "positions", "normals", "indices", "materials", "lights")
 
 def pack_tables(data) -> dict[str, bytes]:
     """The std430 tables of ``shaders/rt/common.glsl`` (instances in TLAS order)."""
-    from rgraph.scene.camera import model_matrix
+    from rgraph.scene.camera import inverse_transpose3, model_matrix
 
     cam, _basis, _tan = camera_basis(data)
     first_index, first_vertex, inst = [], [], []
@@ -38,7 +38,7 @@ def pack_tables(data) -> dict[str, bytes]:
     for k, mesh in enumerate(data.meshes):
         for p in mesh.positions:
             m = model_matrix(p - cam, mesh.rotation, mesh.scale)
-            nm = np.linalg.inv(m[:3, :3]).T
+            nm = inverse_transpose3(m)
             rows = np.concatenate([m[:3, :4], np.concatenate([nm, np.zeros((3, 1))], axis=1)]).astype(np.float32)
             inst.append(rows.tobytes() + struct.pack("<4I", first_index[k], mesh.material, first_vertex[k], 0))
     mats = []

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rgraph.scene.build import SceneData
-from rgraph.scene.camera import model_matrix
+from rgraph.scene.camera import inverse_transpose3, model_matrix
 
 SKY_ZENITH = np.array([0.20, 0.40, 0.90])
 SKY_HORIZON = np.array([0.75, 0.80, 0.95])
@@ -142,7 +142,7 @@ def build_tables(data: SceneData, seconds: float | None = None) -> Tables:
         positions, normals = object_geometry(mesh, seconds)
         for p in mesh.positions:
             m = model_matrix(p - cam, mesh.rotation, mesh.scale)
-            nm = np.linalg.inv(m[:3, :3]).T
+            nm = inverse_transpose3(m)
             pos = positions @ m[:3, :3].T + m[:3, 3]
             nrm = normals @ nm.T
             tris.append(pos[mesh.data.indices])

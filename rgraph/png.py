@@ -41,16 +41,40 @@ def write_png(path: Path, rgba: np.ndarray) -> None:
     Path(path).write_bytes(png)
 
 
+#: Float formats whose channels are all 16- or 32-bit IEEE floats: (channels, numpy dtype).
+_FLOAT_LAYOUTS = {"".join(f"{c}{bits}" for c in "rgba"[:n]) + "_sfloat": (n, dtype)
+                  for bits, dtype in (("16", np.float16), ("32", np.float32)) for n in (1, 2, 3, 4)}
+
+
+def float_rgba8(raw: bytes, fmt: str, w: int, h: int) -> np.ndarray | None:
+    """RGBA8 of a rendered float image (linear values clamped to [0, 1] as stored, like
+    ``rgraph sweep``'s images of float outputs; NaN as 0; one channel as grey), or None
+    when ``fmt`` is not an all-16-bit or all-32-bit float format."""
+    layout = _FLOAT_LAYOUTS.get(fmt.lower())
+    if layout is None:
+        return None
+    channels, dtype = layout
+    values = np.frombuffer(raw, dtype=dtype, count=w * h * channels).reshape(h, w, channels).astype(np.float64)
+    values = np.nan_to_num(np.clip(values, 0.0, 1.0), nan=0.0)
+    rgba = np.full((h, w, 4), 255, dtype=np.uint8)
+    rgb = values[..., [0, 0, 0]] if channels == 1 else values[..., [0, 1, min(2, channels - 1)]]
+    if channels == 2:
+        rgb[..., 2] = 0.0
+    rgba[..., :3] = np.rint(rgb * 255.0).astype(np.uint8)
+    return rgba
+
+
 def output_rgba(res: dict, raw: bytes, w: int, h: int, implemented: bool) -> np.ndarray:
-    """RGBA8 for a PNG: the stored bytes of an 8-bit colour image rendered by real passes,
-    else the probe's value visualisation."""
+    """RGBA8 for a PNG: the stored bytes of an 8-bit colour image rendered by real passes (a
+    float one clamped: :func:`float_rgba8`), else the probe's value visualisation."""
     channel_order = {"r8g8b8a8": [0, 1, 2, 3], "b8g8r8a8": [2, 1, 0, 3]}
     head, _, kind = res["format"].lower().rpartition("_")
     if implemented and head in channel_order and kind in ("srgb", "unorm"):
         rgba = np.frombuffer(raw, dtype=np.uint8, count=w * h * 4).reshape(h, w, 4)[..., channel_order[head]].copy()
         rgba[..., 3] = 255
         return rgba
-    return image_to_rgba8(res, raw, w, h)
+    rendered = float_rgba8(raw, res["format"], w, h) if implemented else None
+    return rendered if rendered is not None else image_to_rgba8(res, raw, w, h)
 
 
 def first_output_image(plan: dict) -> dict | None:

@@ -52,7 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         help="Khronos validation + synchronization validation; exit 1 on any message")
     parser.add_argument("--check-data", dest="check_data", action=argparse.BooleanOptionalAction, default=None,
                         help="compare outputs with the probe's CPU simulation (default: on with --validate)")
-    parser.add_argument("--out", type=output_path, help="write the first output image as PNG")
+    parser.add_argument("--out", type=output_path,
+                        help="write the first output image as PNG (a rendered float image clamped to [0, 1] as stored)")
     parser.add_argument("--timings", type=output_path,
                         help="write per-pass GPU times as JSON (median ms; start/end within the frame per queue)")
     parser.add_argument("--heatmap", type=output_path,
@@ -105,6 +106,23 @@ def rest_pose_note(plan: dict) -> str | None:
         return None
     return (f"rgraph: note: the scene's {skinned} skinned mesh(es) are traced in their rest pose "
             "(acceleration structures do not follow skinning)")
+
+
+def uniform_range_note(plan: dict, max_uniform_range: int) -> str | None:
+    """A warning when a pass reads a buffer larger than ``maxUniformBufferRange`` as
+    ``uniform``: one descriptor binds only that much of it (forward shades the first
+    1,024 lights of a larger ``lights`` buffer; the clustered graphs read it as storage)."""
+    sizes = {r["name"]: int(r.get("bytes") or 0) for r in plan["resources"] if r["kind"] == "buffer"}
+    over = [(p["name"], a["resource"]) for p in plan["passes"] for a in p["accesses"]
+            if a["usage"] == "uniform" and sizes.get(a["resource"], 0) > max_uniform_range]
+    if not over:
+        return None
+    name, res = over[0]
+    return (f"rgraph: warning: pass {name!r} reads buffer {res!r} ({sizes[res]:,} bytes) as a uniform buffer; "
+            f"the device binds its first {max_uniform_range:,} bytes (maxUniformBufferRange)"
+            + (" and the rest is not read" if name != "forward" or res != "lights" else
+               f": {max_uniform_range // 64:,} of {sizes[res] // 64:,} lights are shaded "
+               "(graphs/surgery_clustered.yaml shades any count)"))
 
 
 def render_thread_line(timings: dict) -> str:
@@ -292,6 +310,7 @@ def run(args: argparse.Namespace) -> int:
             result = exe.run_and_check(args.frames, check_data=args.validate if args.check_data is None
                                        else args.check_data, out_png=args.out, warmup_s=args.warmup,
                                        read_outputs=bool(args.heatmap) or "cluster_stats" in outputs)
+            uniform_note = uniform_range_note(plan, int(gpu.device.properties.limits.maxUniformBufferRange))
             result.messages = gpu.close()  # the device's teardown included
     except (VulkanUnavailable, ExecutionError) as exc:
         if args.json:
@@ -319,9 +338,9 @@ def run(args: argparse.Namespace) -> int:
         print("rgraph: nothing to execute: every pass was culled", file=sys.stderr)
     for entry in plan.get("culled", []):
         print(f"rgraph: culled {entry['pass']}: {entry['reason']}", file=sys.stderr)
-    note = rest_pose_note(plan)
-    if note:
-        print(note, file=sys.stderr)
+    for note in (rest_pose_note(plan), uniform_note):
+        if note:
+            print(note, file=sys.stderr)
     status = 0
     for message in result.messages:
         print(str(message), file=sys.stderr)

@@ -29,6 +29,15 @@ BUILTIN_DECALS = {
 AMBIENT = (0.03, 0.03, 0.035)
 
 
+class SceneBuildError(ValueError):
+    """A scene file item the builder cannot make; ``where`` is its key path in the file
+    (``load_scene_data`` turns it into a located ``RGraphError``)."""
+
+    def __init__(self, where: tuple, message: str) -> None:
+        super().__init__(message)
+        self.where = where
+
+
 @dataclass
 class SceneMesh:
     """One mesh of the scene file: its geometry and the world placement of each instance."""
@@ -253,6 +262,16 @@ def pick_camera(model: SceneFile, camera: int) -> SceneFile:
     return model.model_copy(update={"camera": model.cameras[camera]})
 
 
+def _check_shadow_lights(model: SceneFile) -> None:
+    """At most :data:`MAX_SHADOW_LIGHTS` directional lights with ``shadows: true`` (shadow map layers)."""
+    shadowed = [j for j, li in enumerate(model.lights)
+                if getattr(li, "type", None) == "directional" and getattr(li, "shadows", False)]
+    if len(shadowed) > MAX_SHADOW_LIGHTS:
+        raise SceneBuildError(("lights", shadowed[MAX_SHADOW_LIGHTS]),
+                              f"at most {MAX_SHADOW_LIGHTS} shadow-casting lights are supported; this is shadow "
+                              f"light {MAX_SHADOW_LIGHTS + 1} of {len(shadowed)} (set 'shadows: false' on the rest)")
+
+
 def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str | None = None,
                 camera: int = 0) -> SceneData:
     """Geometry and tables of a scene file for an output of ``extent`` (w, h), seen from camera
@@ -272,11 +291,12 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
             else:
                 data = make_shape(m.shape, dict(m.params), seed=m.seed)
         except (ValueError, TypeError) as exc:
-            raise ValueError(f"mesh {i} ({m.shape}): {exc}") from None
+            raise SceneBuildError(("meshes", i), f"mesh {i} ({m.shape}): {exc}") from None
         scale = np.broadcast_to(np.asarray(m.scale, dtype=np.float64), (3,)).copy()
         if m.unique:
             if m.deformable or animator is not None:
-                raise ValueError(f"mesh {i} ({m.shape}): unique meshes cannot be deformable or skinned")
+                raise SceneBuildError(("meshes", i), f"mesh {i} ({m.shape}): unique meshes cannot be deformable or "
+                                                     "skinned")
             group = _unique_meshes(f"{i}:{m.shape}", data, material_names.index(m.material), tuple(m.rotation),
                                    scale, positions, m.seed, draw)
             draw += len(group)
@@ -287,6 +307,7 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
         draw += mesh.instances
         bones += animator.bones * mesh.instances if animator is not None else 0
         meshes.append(mesh)
+    _check_shadow_lights(model)
     lights, layer = [], 0
     for li in expand_lights(model.lights):
         kind = LIGHT_TYPES[li.type]
@@ -295,8 +316,6 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
         direction = direction / norm if norm > 0 else np.array([0.0, -1.0, 0.0])
         shadow = -1
         if li.type == "directional" and li.shadows:
-            if layer >= MAX_SHADOW_LIGHTS:
-                raise ValueError(f"at most {MAX_SHADOW_LIGHTS} shadow-casting lights are supported")
             shadow, layer = layer, layer + 1
         cos_inner, cos_outer = (float(np.cos(np.radians(a))) for a in li.cone)
         lights.append(SceneLightData(kind, _vec(li.position if li.position is not None else (0, 0, 0)), direction,
@@ -311,5 +330,14 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
 
 
 def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64), camera: int = 0) -> SceneData:
+    """:func:`build_scene` of the scene file at ``path``; an item it cannot build is a located
+    ``RGraphError`` (bad input), not a ValueError."""
     scene = load_scene(path)
-    return build_scene(scene.model, extent, scene.name, camera)
+    try:
+        return build_scene(scene.model, extent, scene.name, camera)
+    except SceneBuildError as exc:
+        from rgraph.errors import RGraphError
+        from rgraph.spec.yaml_source import load_yaml
+
+        _, smap = load_yaml(Path(path), str(path))
+        raise RGraphError.at(smap.value(exc.where), str(exc)) from None

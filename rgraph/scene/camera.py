@@ -75,10 +75,24 @@ def model_matrix(translation, rotation_deg=(0, 0, 0), scale=1.0) -> np.ndarray:
     return m
 
 
+def inverse_transpose3(a: np.ndarray) -> np.ndarray:
+    """The inverse-transpose of the 3x3 ``a`` (normals; rescale after use). A singular ``a``
+    (a zero scale: a flattened or vanished mesh) gives its cofactor matrix, ``det(a) *
+    inverse-transpose`` where that exists: the same directions, and normals of the faces that
+    keep an area (a mesh flattened to a plane keeps the plane's normal)."""
+    a = np.asarray(a, dtype=np.float64)[:3, :3]
+    try:
+        return np.linalg.inv(a).T
+    except np.linalg.LinAlgError:
+        c0, c1, c2 = a[:, 0], a[:, 1], a[:, 2]
+        return np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=1)
+
+
 def normal_matrix(model: np.ndarray) -> np.ndarray:
-    """4x4 holding the inverse-transpose of ``model``'s 3x3 (normals; rescale after use)."""
+    """4x4 holding the inverse-transpose of ``model``'s 3x3 (normals; rescale after use;
+    :func:`inverse_transpose3`)."""
     m = np.eye(4)
-    m[:3, :3] = np.linalg.inv(model[:3, :3]).T
+    m[:3, :3] = inverse_transpose3(model)
     return m
 
 

@@ -136,6 +136,13 @@ class PassSetup:
         self._accesses = {a["resource"]: a for a in plan_pass["accesses"]}
         self._res_plan = {r["name"]: r for r in plan["resources"]}
 
+    @property
+    def max_uniform_range(self) -> int:
+        """The device's ``maxUniformBufferRange``: the most bytes one uniform-buffer descriptor
+        binds (a larger plan buffer is bound up to it; unknown limits: no cap)."""
+        props = getattr(self.device, "properties", None)
+        return int(props.limits.maxUniformBufferRange) if props is not None else (1 << 32) - 1
+
     # ------------------------------------------------------------- plan lookups
     @property
     def scene(self) -> Any:
@@ -289,6 +296,8 @@ class PassSetup:
                         handle, size = b.buffers[s] if len(b.buffers) > 1 else b.buffers[0]
                     else:
                         raise ExecutionError(f"pass {self.name!r}: buffer binding {b.binding} has no buffer")
+                    if b.kind == "uniform_buffer":  # a larger range is invalid (VUID-VkWriteDescriptorSet-00332)
+                        size = min(int(size), self.max_uniform_range)
                     info = v.VkDescriptorBufferInfo(buffer=handle, offset=0, range=int(size))
                     writes.append(v.VkWriteDescriptorSet(dstSet=sets[s], dstBinding=b.binding, descriptorCount=1,
                                                          descriptorType=types[b.kind], pBufferInfo=[info]))

@@ -236,3 +236,36 @@ def test_cli_reports_the_limit_without_a_traceback(capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert "allocations needed, but the limit is 10" in err and "Traceback" not in err
+
+
+def test_camera_relative_vertices_far_from_the_origin():
+    """Helices 1e7 m from the origin project as they do at the origin (vertices and view are
+    camera-relative; world-space float32 vertices collapsed them to a few lines)."""
+    import types
+
+    m = module()
+
+    def clip(offset: float) -> np.ndarray:
+        layout = m.build_layout(None, meshes=4, segments=8, deformable_fraction=0.0)
+        layout.positions[:, [0, 2]] += offset
+        camera = types.SimpleNamespace(position=(offset, 3.0, offset + 6.0), look_at=(offset, 0.0, offset),
+                                       up=(0.0, 1.0, 0.0), fov_y=50.0, near=0.1)
+        eye = m.camera_position(camera)
+        verts = np.concatenate(m.helix_vertices(layout, np.arange(4), eye))
+        vp = m.view_projection(camera, 16 / 9, eye).astype(np.float32)
+        c = np.c_[verts[:, :3], np.ones(len(verts), np.float32)] @ vp.T
+        return c[:, :3] / c[:, 3:]
+
+    np.testing.assert_allclose(clip(1e7), clip(0.0), atol=1e-4)
+
+
+def test_view_projection_looking_along_up_is_finite():
+    import types
+
+    m = module()
+    camera = types.SimpleNamespace(position=(0.0, 5.0, 0.0), look_at=(0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0),
+                                   fov_y=50.0, near=0.1)
+    vp = m.view_projection(camera, 1.0)
+    assert np.isfinite(vp).all()
+    below = vp @ np.array([0.0, 0.0, 0.0, 1.0])
+    assert below[0] / below[3] == pytest.approx(0, abs=1e-9) and below[1] / below[3] == pytest.approx(0, abs=1e-9)

@@ -69,6 +69,8 @@ class DeformedTables:
             self.destroy()
             raise
         self.frame_of: list[int | None] = [None] * sets  # per set: the content frame its geometry shows
+        self._writers = [(meshes[k].deformer, int(self.first_vertex[k]), int(self.first_vertex[k + 1]))
+                         for k in self.deformable]  # (deformer, first vertex, end): the per-frame writes
 
     def update(self, frame: int, frame_set: int) -> None:
         """Set ``frame_set`` shows the deformable meshes at content frame ``frame``'s scene time
@@ -77,9 +79,8 @@ class DeformedTables:
             return
         seconds = self.data.seconds(frame)
         view = self._views[frame_set]
-        for k in self.deformable:
-            lo, hi = int(self.first_vertex[k]), int(self.first_vertex[k + 1])
-            self.data.meshes[k].deformer.write_positions(seconds, view[lo:hi])  # mapped memory: only written
+        for deformer, lo, hi in self._writers:
+            deformer.write_positions(seconds, view[lo:hi])  # mapped memory: only written
         self.frame_of[frame_set] = frame
 
     def record_normals(self, cb: Any, frame_set: int) -> None:

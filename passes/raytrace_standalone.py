@@ -100,6 +100,9 @@ class RayTracingImpl(PassImpl):
     the sky (binding 6), the pass's own images from binding 7, the TLAS (set 1)."""
 
     raygen = "rt/standalone.rgen"
+    #: A pass that reads ``light_maps`` tests its shadow rays against them first
+    #: (``passes.raytrace_lightmap``); the pass that traces the maps binds them itself.
+    reads_light_maps = True
 
     def __init__(self, setup: Any, images: list[Binding]) -> None:
         super().__init__(setup)
@@ -118,6 +121,12 @@ class RayTracingImpl(PassImpl):
                 continue
             bindings.append(Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)))
         bindings.append(Binding(6, "sampled", "sky", array=True, sampler="nearest"))
+        self.light_defines: dict[str, object] = {}
+        if self.reads_light_maps and setup.has("light_maps"):
+            from .raytrace_lightmap import light_map_bindings
+
+            maps, self.light_defines = light_map_bindings(setup, self.data)
+            images = [*images, *maps]
         self.sets = setup.descriptors(bindings + images)
         self.accel = next(a["resource"] for a in setup.plan_pass["accesses"] if a["usage"] == "accel_read")
         self.as_layout, self.as_sets = self._tlas_sets()
@@ -150,7 +159,7 @@ class RayTracingImpl(PassImpl):
         from rgraph.vk.shaders import compile_shader, find_shader
 
         def spirv(path: str) -> bytes:
-            return compile_shader(find_shader(path), defines=self.shader_defines()).spirv
+            return compile_shader(find_shader(path), defines={**self.shader_defines(), **self.light_defines}).spirv
 
         return create_rt_pipeline(self.setup.device, {
             "raygen": [spirv(self.raygen)], "miss": [spirv("rt/miss.rmiss"), spirv("rt/shadow.rmiss")],

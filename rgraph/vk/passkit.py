@@ -198,13 +198,14 @@ class PassSetup:
         self._objects.append((destroy, handle))
         return handle
 
-    def host_buffer(self, size: int, usage: str | int = "uniform") -> HostBuffer:
-        """A mapped, coherent host-visible buffer (``usage``: uniform, storage, vertex, index or flags)."""
+    def host_buffer(self, size: int, usage: str | int = "uniform", allocate_flags: int = 0) -> HostBuffer:
+        """A mapped, coherent host-visible buffer (``usage``: uniform, storage, vertex, index or
+        flags; ``allocate_flags``: VkMemoryAllocateFlags of its memory, e.g. device address)."""
         v = vk()
         flags = usage if isinstance(usage, int) else {
             "uniform": v.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, "storage": v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
             "vertex": v.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, "index": v.VK_BUFFER_USAGE_INDEX_BUFFER_BIT}[usage]
-        buf = HostBuffer.create(self.device, size, flags)
+        buf = HostBuffer.create(self.device, size, flags, allocate_flags=allocate_flags)
         self._host_buffers.append(buf)
         return buf
 

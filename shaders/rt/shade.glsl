@@ -1,6 +1,10 @@
 // The ray tree (needs payloads `hit` at location 0 and `visible` at location 1), walked depth
 // first with an explicit stack: passes/rt_ref.py trace_pixel, line for line.
+// With LIGHT_MAPS (the hybrid) shadow rays are traced only where light_maps.glsl cannot tell.
 const uint MAX_STACK = 17u;
+#ifdef LIGHT_MAPS
+#include "light_maps.glsl"
+#endif
 
 struct Ray { vec3 o; vec3 d; vec3 w; uint depth; };
 Ray stack[MAX_STACK];
@@ -31,7 +35,13 @@ vec3 shade_local(vec3 p, vec3 ng, vec3 ns, vec3 d, uint m) {
         if (l.w < 0.5) { to_light = normalize(l.xyz); dist = T_MAX; falloff = 1.0; }
         else { vec3 rel = l.xyz - p; dist = length(rel); to_light = rel / max(dist, 1e-20); falloff = 1.0 / max(dist * dist, 1e-8); }
         float n_dot_l = dot(ns, to_light);
-        if (n_dot_l <= 0.0 || !lit(o, to_light, dist)) continue;
+        if (n_dot_l <= 0.0) continue;
+#ifdef LIGHT_MAPS
+        int known = i < MAPPED_LIGHTS ? light_map_test(i, p, ng, to_light) : -1;
+        if (known == 0 || (known < 0 && !lit(o, to_light, dist))) continue;
+#else
+        if (!lit(o, to_light, dist)) continue;
+#endif
         vec3 r = 2.0 * n_dot_l * ns - to_light;
         float spec = ks * pow(max(dot(r, -d), 0.0), shininess);
         c += radiance * falloff * (albedo * n_dot_l + spec);

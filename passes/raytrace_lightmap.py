@@ -1,0 +1,157 @@
+"""The hybrid's light maps (graphs/rt_hybrid.yaml, ``shaders/rt/light_maps.glsl``): shadow
+rays only where a cached light-space depth cannot decide.
+
+- ``rt_light_maps`` (raytrace): per mapped light (the first :data:`MAPPED_LIGHTS`), one ray per
+  texel from the light to the first surface, its distance stored in ``light_maps`` (r32f,
+  6 layers per light: a point light's cube faces, a directional light's first layer holds
+  parallel rays from a plane outside the scene's bounds). Traced once per frame set (an
+  indirect trace whose arguments are zero afterwards): the maps depend on the scene and its
+  lights, not on the frame, like the accel built once at load. Scenes with deformable meshes
+  (refitted every frame) and ``rt.light_maps: 0`` trace nothing and map no light.
+- The shading passes that read ``light_maps`` (``light_map_bindings``) test each shadow ray
+  first: every ray of the 3x3 texels around the point reaches the point's plane -> lit; all stop
+  well before it -> in shadow; else the shadow ray is traced. Exact except for occluders (or
+  holes) narrower than a texel between the taps.
+"""
+
+from __future__ import annotations
+
+import struct
+from typing import Any
+
+import numpy as np
+
+from rgraph.impl import register
+from rgraph.vk.passkit import Binding
+
+from .raytrace_standalone import RayTracingImpl, deformed_tables
+from .rt_model import MAX_LIGHTS, camera_basis
+
+#: Lights with a map (6 layers each); the graph's ``light_maps`` layers are sized for them.
+MAPPED_LIGHTS = 4
+INFO_BYTES = 64  # 4 vec4 per mapped light (shaders/rt/light_maps.glsl)
+
+
+def mapped_lights(setup: Any, data) -> int:
+    """Lights with a map: none without ``light_maps`` in the pass, with ``rt.light_maps`` 0,
+    over deformable meshes (the maps would go stale) or past the image's layers."""
+    if not setup.has("light_maps") or int(setup.param("rt.light_maps", 1)) == 0 or deformed_tables(setup) is not None:
+        return 0
+    layers = int(setup.resource_plan("light_maps").get("layers", 1))
+    return min(len(data.lights), MAX_LIGHTS, MAPPED_LIGHTS, layers // 6)
+
+
+def scene_bounds(data) -> tuple[np.ndarray, np.ndarray]:
+    """Camera-relative bounding box (min, max) of every instance of every mesh."""
+    from rgraph.scene.camera import model_matrix
+
+    cam, _basis, _tan = camera_basis(data)
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for mesh in data.meshes:
+        if not len(mesh.positions) or not mesh.data.vertex_count:
+            continue
+        pos = np.asarray(mesh.data.positions, dtype=np.float64).reshape(-1, 3)
+        a, b = pos.min(axis=0), pos.max(axis=0)
+        corners = np.array([[x, y, z] for x in (a[0], b[0]) for y in (a[1], b[1]) for z in (a[2], b[2])])
+        linear = model_matrix(np.zeros(3), mesh.rotation, mesh.scale)[:3, :3]
+        box = corners @ linear.T
+        offsets = np.asarray(mesh.positions, dtype=np.float64).reshape(-1, 3) - cam
+        lo = np.minimum(lo, box.min(axis=0) + offsets.min(axis=0))
+        hi = np.maximum(hi, box.max(axis=0) + offsets.max(axis=0))
+    if not np.all(np.isfinite(lo)):
+        return np.zeros(3), np.zeros(3)
+    return lo, hi
+
+
+def directional_frame(to_light: np.ndarray, lo: np.ndarray, hi: np.ndarray, size: tuple[int, int]) -> list[float]:
+    """The 4 vec4 of a directional light's map: grid corner C0, (U, du), (V, dv), (W, 0); W the
+    rays' direction (away from the light), the grid's plane outside the scene's box, two
+    texels of margin on every side."""
+    w = -to_light / np.linalg.norm(to_light)
+    helper = np.array([0.0, 1.0, 0.0]) if abs(w[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(w, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(w, u)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    pu, pv, pw = corners @ u, corners @ v, corners @ w
+    extent = max(float(np.ptp(pu)), float(np.ptp(pv)), float(np.ptp(pw)), 1e-6)
+    du = max(float(np.ptp(pu)), 1e-6 * extent) / max(size[0] - 4, 1)
+    dv = max(float(np.ptp(pv)), 1e-6 * extent) / max(size[1] - 4, 1)
+    c0 = (pu.min() - 2 * du) * u + (pv.min() - 2 * dv) * v + (pw.min() - 0.01 * extent) * w
+    return [*c0, 0.0, *u, du, *v, dv, *w, 0.0]
+
+
+def light_map_info(data, size: tuple[int, int], mapped: int) -> bytes:
+    """The std430 table of binding 17 for the first ``mapped`` lights (camera-relative, as the
+    lights table of ``pack_tables``)."""
+    cam, _basis, _tan = camera_basis(data)
+    lo, hi = scene_bounds(data)
+    rows: list[float] = []
+    for li in data.lights[:mapped]:
+        if li.type == 0:
+            vec = np.asarray(-li.direction, dtype=np.float32).astype(np.float64)  # as the shader's table
+            rows += directional_frame(vec, lo, hi, size)
+        else:
+            rows += [*(np.asarray(li.position, dtype=np.float64) - cam), 1.0] + [0.0] * 12
+    return struct.pack(f"<{len(rows)}f", *rows) if rows else bytes(INFO_BYTES)
+
+
+def light_map_bindings(setup: Any, data) -> tuple[list[Binding], dict[str, object]]:
+    """Bindings 16-17 and the defines of a shading pass that reads ``light_maps`` (nothing
+    when no light is mapped: every shadow ray is traced)."""
+    mapped = mapped_lights(setup, data)
+    if not mapped:
+        return [], {}
+    info = setup.device_buffer(light_map_info(data, setup.extent_of("light_maps"), mapped))
+    return ([Binding(16, "storage_image", "light_maps", array=True), Binding(17, "storage_buffer", buffers=(info,))],
+            {"LIGHT_MAPS": 1, "MAPPED_LIGHTS": f"{mapped}u"})
+
+
+@register("rt_light_maps")
+class LightMaps(RayTracingImpl):
+    """Traces the maps of ``light_maps`` (storage_rw: kept between frames) once per set."""
+
+    raygen = "rt/light_map.rgen"
+    reads_light_maps = False
+
+    def __init__(self, setup: Any) -> None:
+        from rgraph.scene.build import load_scene_data
+
+        if not setup.plan.get("scene_source"):
+            raise ValueError(f"pass {setup.name!r}: ray tracing needs a scene (--scene)")
+        data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
+        self.mapped = mapped_lights(setup, data)
+        self.size = setup.extent_of("light_maps")
+        info = setup.device_buffer(light_map_info(data, self.size, self.mapped))
+        super().__init__(setup, [Binding(16, "storage_image", "light_maps", array=True),
+                                 Binding(17, "storage_buffer", buffers=(info,))])
+        self.built: set[int] = set()
+        self.args = self._indirect_args(setup) if self.mapped else None
+
+    def shader_defines(self) -> dict[str, object]:
+        return {"MAPPED_LIGHTS": f"{self.mapped}u"}
+
+    @staticmethod
+    def _indirect_args(setup: Any) -> Any:
+        """Per set the (width, height, depth) of its trace: host-written, device-addressed."""
+        from rgraph.vk import names
+        from rgraph.vk.loader import vk
+
+        v = vk()
+        usage = v.VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | v.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | names.SHADER_DEVICE_ADDRESS
+        return setup.host_buffer(16 * setup.sets, usage, allocate_flags=names.MEMORY_ALLOCATE_DEVICE_ADDRESS)
+
+    def update(self, frame: int, frame_set: int) -> None:
+        if self.args is None:
+            return
+        build = frame_set not in self.built  # the set's first frame: its submit has not run yet
+        self.built.add(frame_set)
+        dims = (self.size[0], self.size[1], 6 * self.mapped) if build else (0, 1, 1)
+        self.args.write(struct.pack("<3I", *dims), 16 * frame_set)
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        if self.args is None:
+            return
+        self._bind(rec, frame_set)
+        rec.push(self.pipeline, bytes(64))
+        rec.trace_rays_indirect(self.pipeline, rec.buffer_address(self.args.handle) + 16 * frame_set)

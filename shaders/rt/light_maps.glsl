@@ -1,0 +1,86 @@
+// Light maps of the hybrid (passes/raytrace_lightmap.py): per mapped light, the distance along
+// each texel's ray from the light to the first surface (3e38: none), traced once at load by
+// light_map.rgen. Point lights: six cube faces (layers 6 i .. 6 i + 5) of rays from the light;
+// directional lights: layer 6 i, parallel rays from a plane outside the scene's bounds.
+// light_map_test tells, without tracing, whether a point's shadow ray is certainly unblocked
+// (every ray of the 3x3 texels around the point reaches the point's own plane) or certainly
+// blocked (all of them stop well before it); anything else is traced (shade.glsl: shade_local).
+// Set 0 binding 16: the maps (r32f array); binding 17: 4 vec4 per mapped light:
+//   point:       (light position, 1), unused x 3
+//   directional: (grid corner C0, 0), (U, du), (V, dv), (W ray direction, 0)
+#ifdef LIGHT_MAP_BUILD
+layout(set = 0, binding = 16, r32f) uniform writeonly image2DArray light_maps;
+#else
+layout(set = 0, binding = 16, r32f) uniform readonly image2DArray light_maps;
+#endif
+layout(set = 0, binding = 17, std430) readonly buffer LightMapInfo { vec4 maps[]; };
+
+const float LIGHT_MAP_FAR = 3.0e38;  // a texel whose ray hits nothing
+const float LIT_TOLERANCE = 2e-4;     // of the distance: the point's plane reached
+const float SHADOW_MARGIN = 0.02;     // of the distance: an occluder well before the point
+
+// Cube face `face` (2 axis + negative) at face coordinates (a, b) in [-1, 1]: a direction.
+vec3 face_direction(uint face, float a, float b) {
+    uint axis = face >> 1u;
+    float s = (face & 1u) == 0u ? 1.0 : -1.0;
+    return axis == 0u ? vec3(s, a, b) : axis == 1u ? vec3(a, s, b) : vec3(a, b, s);
+}
+
+// The cube face of direction v and its face coordinates.
+uint face_of(vec3 v, out vec2 ab) {
+    vec3 m = abs(v);
+    if (m.x >= m.y && m.x >= m.z) { ab = v.yz / max(m.x, 1e-30); return v.x >= 0.0 ? 0u : 1u; }
+    if (m.y >= m.z) { ab = v.xz / max(m.y, 1e-30); return v.y >= 0.0 ? 2u : 3u; }
+    ab = v.xy / max(m.z, 1e-30); return v.z >= 0.0 ? 4u : 5u;
+}
+
+#ifndef LIGHT_MAP_BUILD
+// One texel: its ray reaches the plane (distance `expected` along it) or stops well before.
+void light_map_tap(float stored, float expected, inout bool clear, inout bool blocked) {
+    clear = clear && stored >= expected * (1.0 - LIT_TOLERANCE);
+    blocked = blocked && stored < expected * (1.0 - SHADOW_MARGIN);
+}
+
+// Mapped light `li` at point p with facing geometric normal ng (the shadow ray starts on the
+// ng side) and direction to the light to_light: 1 unblocked, 0 blocked, -1 not known (trace).
+int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
+    if (dot(ng, to_light) < 1e-3) return -1;  // the ray would start off the lit side: trace it
+    ivec2 size = imageSize(light_maps).xy;
+    vec4 m0 = maps[4u * li];
+    bool clear = true, blocked = true;
+    if (m0.w > 0.5) {
+        vec3 v = p - m0.xyz;
+        vec2 ab;
+        uint face = face_of(v, ab);
+        ivec2 c = ivec2(floor((0.5 * ab + 0.5) * vec2(size)));
+        if (any(lessThan(c, ivec2(1))) || any(greaterThan(c, size - 2))) return -1;  // taps past the face
+        float plane = dot(ng, v);
+        for (int j = -1; j <= 1; ++j)
+            for (int i = -1; i <= 1; ++i) {
+                ivec2 t = c + ivec2(i, j);
+                vec2 tab = 2.0 * (vec2(t) + 0.5) / vec2(size) - 1.0;
+                vec3 w = normalize(face_direction(face, tab.x, tab.y));
+                float den = dot(ng, w);
+                if (abs(den) < 1e-3 || plane / den <= 0.0) return -1;
+                light_map_tap(imageLoad(light_maps, ivec3(t, int(6u * li + face))).r, plane / den, clear, blocked);
+            }
+    } else {
+        vec4 mu = maps[4u * li + 1u], mv = maps[4u * li + 2u];
+        vec3 W = maps[4u * li + 3u].xyz;
+        vec3 r = p - m0.xyz;
+        ivec2 c = ivec2(floor(vec2(dot(r, mu.xyz) / mu.w, dot(r, mv.xyz) / mv.w)));
+        if (any(lessThan(c, ivec2(1))) || any(greaterThan(c, size - 2))) return -1;
+        float den = dot(ng, W);
+        if (abs(den) < 1e-3) return -1;
+        for (int j = -1; j <= 1; ++j)
+            for (int i = -1; i <= 1; ++i) {
+                ivec2 t = c + ivec2(i, j);
+                vec3 o = m0.xyz + (float(t.x) + 0.5) * mu.w * mu.xyz + (float(t.y) + 0.5) * mv.w * mv.xyz;
+                float e = dot(ng, p - o) / den;
+                if (e <= 0.0) return -1;
+                light_map_tap(imageLoad(light_maps, ivec3(t, int(6u * li))).r, e, clear, blocked);
+            }
+    }
+    return clear ? 1 : blocked ? 0 : -1;
+}
+#endif

@@ -16,8 +16,15 @@ layout(set = 0, binding = 16, r32f) uniform readonly image2DArray light_maps;
 layout(set = 0, binding = 17, std430) readonly buffer LightMapInfo { vec4 maps[]; };
 
 const float LIGHT_MAP_FAR = 3.0e38;  // a texel whose ray hits nothing
-const float LIT_TOLERANCE = 2e-4;     // of the distance: the point's plane reached
-const float SHADOW_MARGIN = 0.02;     // of the distance: an occluder well before the point
+#ifndef LIT_TOLERANCE
+#define LIT_TOLERANCE 2e-4   // of the distance: the point's plane reached
+#endif
+#ifndef LIGHT_MAP_GUARD
+#define LIGHT_MAP_GUARD 2.0  // a texel may be at most this many pixel footprints at the point
+#endif
+#ifndef SHADOW_MARGIN
+#define SHADOW_MARGIN 0.02   // of the distance: an occluder well before the point
+#endif
 
 // Cube face `face` (2 axis + negative) at face coordinates (a, b) in [-1, 1]: a direction.
 vec3 face_direction(uint face, float a, float b) {
@@ -43,13 +50,18 @@ void light_map_tap(float stored, float expected, inout bool clear, inout bool bl
 
 // Mapped light `li` at point p with facing geometric normal ng (the shadow ray starts on the
 // ng side) and direction to the light to_light: 1 unblocked, 0 blocked, -1 not known (trace).
+// Only where a texel is no wider than LIGHT_MAP_GUARD pixel footprints at p (the camera is at
+// the origin; a reflected point's path is longer, so its footprint larger): an occluder the
+// taps miss is then narrower than a pixel there.
 int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
     if (dot(ng, to_light) < 1e-3) return -1;  // the ray would start off the lit side: trace it
     ivec2 size = imageSize(light_maps).xy;
     vec4 m0 = maps[4u * li];
+    float footprint = LIGHT_MAP_GUARD * length(p) * 2.0 * frame.right.w / float(frame.counts.y);
     bool clear = true, blocked = true;
     if (m0.w > 0.5) {
         vec3 v = p - m0.xyz;
+        if (2.0 * length(v) / float(min(size.x, size.y)) > footprint) return -1;
         vec2 ab;
         uint face = face_of(v, ab);
         ivec2 c = ivec2(floor((0.5 * ab + 0.5) * vec2(size)));
@@ -66,6 +78,7 @@ int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
             }
     } else {
         vec4 mu = maps[4u * li + 1u], mv = maps[4u * li + 2u];
+        if (max(mu.w, mv.w) > footprint) return -1;
         vec3 W = maps[4u * li + 3u].xyz;
         vec3 r = p - m0.xyz;
         ivec2 c = ivec2(floor(vec2(dot(r, mu.xyz) / mu.w, dot(r, mv.xyz) / mv.w)));

@@ -128,11 +128,12 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
             hybrid_params: dict[str, str] | None = None, async_shade: bool = False,
-            dump: Path | None = None) -> dict[str, Any]:
+            dump: Path | None = None, traced: bool = False) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
-    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns).
+    (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns);
+    with ``traced`` also the hybrid with ``rt.light_maps: 0`` (every shadow ray traced: ``traced_``).
     ``dump``: a folder for ``SCENE_CAMERA.npz`` (the colour images as float16, the visibility ids)."""
     from rgraph.passes.raytrace_hybrid import prim_bits
 
@@ -147,8 +148,10 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         graphs["raster"] = (RASTER_GRAPH, ("visibility",))
     if async_shade:
         graphs["async"] = (str(ASYNC_GRAPH), ("ray_args",))
-    plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera,
-                                 params={**params, **(hybrid_params or {})} if name == "hybrid" else params,
+    if traced:
+        graphs["traced"] = ("rt_hybrid", ())
+    own = {"hybrid": {**params, **(hybrid_params or {})}, "traced": {**params, **(hybrid_params or {}), "rt.light_maps": "0"}}
+    plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=own.get(name, params),
                                  extra_outputs=list(extra), memory=gpu.memory_requirements())
              for name, (graph, extra) in graphs.items()}
     runs = side_by_side(gpu, plans, frames, warmup_s, chunk)
@@ -176,6 +179,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
     if async_shade:
         row.update(_hybrid_columns(runs["async"]["timings"], T, runs["async"]["outputs"], alone["outputs"], "async_"))
+    if traced:
+        row.update(_hybrid_columns(runs["traced"]["timings"], T, runs["traced"]["outputs"], alone["outputs"], "traced_"))
     if raster:
         raster_out = runs["raster"]["outputs"]
         row.update(_hybrid_columns(runs["raster"]["timings"], T, raster_out, alone["outputs"], "raster_"))
@@ -246,11 +251,13 @@ def _levels(row: dict[str, Any]) -> str:
 def table(rows: list[dict[str, Any]]) -> str:
     raster = any("raster_t_ms" in r for r in rows)
     extra = any("async_t_ms" in r for r in rows)
+    traced = any("traced_t_ms" in r for r in rows)
     head = ("| scene | camera | T (ms) | t_a (ms) | t_a/T | t_b (ms) | t (ms) | t/T | PSNR (dB) | SSIM | FLIP "
             "| traced | rays per level | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
             + (" async t (ms) | async t/T | async PSNR (dB) |" if extra else "")
+            + (" traced t (ms) | traced t/T | traced PSNR (dB) |" if traced else "")
             + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else "")
-            + ("---:|---:|---:|" if extra else ""))
+            + ("---:|---:|---:|" if extra else "") + ("---:|---:|---:|" if traced else ""))
     lines = [head]
     for r in rows:
         line = (f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
@@ -263,6 +270,9 @@ def table(rows: list[dict[str, Any]]) -> str:
         if extra:
             line += (f" {r['async_t_ms']:.3f} | {r['async_t_over_T']:.2f} | {_fmt(r['async_psnr_db'], '.1f')} |"
                      if "async_t_ms" in r else " - | - | - |")
+        if traced:
+            line += (f" {r['traced_t_ms']:.3f} | {r['traced_t_over_T']:.2f} | {_fmt(r['traced_psnr_db'], '.1f')} |"
+                     if "traced_t_ms" in r else " - | - | - |")
         lines.append(line)
     return "\n".join(lines)
 
@@ -298,6 +308,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                         help="a param of graphs/rt_hybrid.yaml for the hybrid (repeatable), e.g. rt.wave_subgroup=1")
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
+    parser.add_argument("--traced", action="store_true",
+                        help="also time the hybrid with rt.light_maps=0 (every shadow ray traced)")
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
     parser.add_argument("--dump", type=Path, help="write each camera's two images (SCENE_CAMERA.npz) here")
     args = parser.parse_args(argv)
@@ -320,7 +332,7 @@ def main(argv: list[str] | None = None) -> int:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
                                         chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
-                                        async_shade=args.async_shade, dump=args.dump))
+                                        async_shade=args.async_shade, dump=args.dump, traced=args.traced))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

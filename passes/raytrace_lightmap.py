@@ -3,20 +3,23 @@ rays only where a cached light-space depth cannot decide.
 
 - ``rt_light_maps`` (raytrace): per mapped light (the first :data:`MAPPED_LIGHTS`), one ray per
   texel from the light to the first surface, its distance stored in ``light_maps`` (r32f,
-  6 layers per light: a point light's cube faces, a directional light's first layer holds
-  parallel rays from a plane outside the scene's bounds). Traced once per frame set (an
-  indirect trace whose arguments are zero afterwards): the maps depend on the scene and its
-  lights, not on the frame, like the accel built once at load. Scenes with deformable meshes
+  6 layers per light: a point light's cube faces; a directional light's cascades, parallel
+  rays from a plane outside the scene's bounds over the view frustum between two depths).
+  Traced once per frame set (an indirect trace whose arguments are zero afterwards): the maps
+  depend on the scene, its lights and the run's camera (the camera-relative world of the
+  accel), not on the frame, like the accel built once at load. Scenes with deformable meshes
   (refitted every frame) and ``rt.light_maps: 0`` trace nothing and map no light.
 - The shading passes that read ``light_maps`` (``light_map_bindings``) test each shadow ray
-  first: every ray of the 3x3 texels around the point reaches the point's plane -> lit; all stop
-  well before it -> in shadow; else the shadow ray is traced. Exact except for occluders (or
-  holes) narrower than a texel between the taps.
+  first: every ray of the 2x2 texels around the point reaches the point's plane -> lit; all stop
+  well before it -> in shadow; else the shadow ray is traced. Only where a texel is at most two
+  pixel footprints wide at the point (``LIGHT_MAP_GUARD``): an occluder (or a hole) the taps
+  miss is narrower than a texel, so its shadow is narrower than two pixels there.
 """
 
 from __future__ import annotations
 
 import struct
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -29,7 +32,9 @@ from .rt_model import MAX_LIGHTS, camera_basis
 
 #: Lights with a map (6 layers each); the graph's ``light_maps`` layers are sized for them.
 MAPPED_LIGHTS = 4
-INFO_BYTES = 64  # 4 vec4 per mapped light (shaders/rt/light_maps.glsl)
+#: A directional light's cascades: one layer each (a point light's six are its cube faces).
+CASCADES = 6
+INFO_FLOATS = 64  # 16 vec4 per mapped light (shaders/rt/light_maps.glsl)
 
 
 def mapped_lights(setup: Any, data) -> int:
@@ -63,37 +68,94 @@ def scene_bounds(data) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def directional_frame(to_light: np.ndarray, lo: np.ndarray, hi: np.ndarray, size: tuple[int, int]) -> list[float]:
-    """The 4 vec4 of a directional light's map: grid corner C0, (U, du), (V, dv), (W, 0); W the
-    rays' direction (away from the light), the grid's plane outside the scene's box, two
-    texels of margin on every side."""
+def light_basis(to_light: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(U, V, W) of a directional light: W the maps' ray direction (away from the light)."""
     w = -to_light / np.linalg.norm(to_light)
     helper = np.array([0.0, 1.0, 0.0]) if abs(w[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
     u = np.cross(w, helper)
     u /= np.linalg.norm(u)
-    v = np.cross(w, u)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    pu, pv, pw = corners @ u, corners @ v, corners @ w
-    extent = max(float(np.ptp(pu)), float(np.ptp(pv)), float(np.ptp(pw)), 1e-6)
-    du = max(float(np.ptp(pu)), 1e-6 * extent) / max(size[0] - 4, 1)
-    dv = max(float(np.ptp(pv)), 1e-6 * extent) / max(size[1] - 4, 1)
-    c0 = (pu.min() - 2 * du) * u + (pv.min() - 2 * dv) * v + (pw.min() - 0.01 * extent) * w
-    return [*c0, 0.0, *u, du, *v, dv, *w, 0.0]
+    return u, np.cross(w, u), w
+
+
+def box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+@dataclass(frozen=True)
+class View:
+    """The camera of the maps' frame (camera-relative: at the origin)."""
+
+    basis: np.ndarray  # rows right, up, forward
+    tan_half: float    # of the vertical field of view
+    aspect: float
+    near: float
+
+
+def slice_corners(view: View, d0: float, d1: float) -> np.ndarray:
+    """The 8 corners of the view frustum between depths d0 and d1."""
+    right, up, fwd = view.basis
+    out = []
+    for d in (d0, d1):
+        for sx in (-1.0, 1.0):
+            for sy in (-1.0, 1.0):
+                out.append(d * (fwd + sx * view.tan_half * view.aspect * right + sy * view.tan_half * up))
+    return np.array(out)
+
+
+def cascade_depths(view: View, lo: np.ndarray, hi: np.ndarray) -> list[float]:
+    """CASCADES + 1 depths from the near plane to the scene's farthest corner, in geometric
+    steps (each cascade's texels then grow as the pixels' footprints do)."""
+    far = max(float((box_corners(lo, hi) @ view.basis[2]).max()), 2.0 * view.near)
+    return [view.near * (far / view.near) ** (k / CASCADES) for k in range(CASCADES + 1)]
+
+
+def directional_frame(to_light: np.ndarray, lo: np.ndarray, hi: np.ndarray, size: tuple[int, int],
+                      view: View | None = None) -> list[float]:
+    """The 16 vec4 of a directional light's maps (shaders/rt/light_maps.glsl): (0, 0, 0, 0),
+    (U, 0), (V, 0), (W, cascades), then per cascade (grid corner C0, du), (0, 0, 0, dv). Cascade k
+    covers the view frustum between the k-th and (k+1)-th of ``cascade_depths`` (all of the scene's
+    box without a view), clipped to the box, with two texels of margin; every grid's plane lies
+    outside the box, so its rays see every occluder before the points they reach."""
+    u, v, w = light_basis(to_light)
+    box = box_corners(lo, hi)
+    bu, bv, bw = box @ u, box @ v, box @ w
+    extent = max(float(np.ptp(bu)), float(np.ptp(bv)), float(np.ptp(bw)), 1e-6)
+    plane = float(bw.min()) - 0.01 * extent
+    if view is None:
+        regions = [box]
+    else:
+        depths = cascade_depths(view, lo, hi)
+        regions = [slice_corners(view, depths[k], depths[k + 1]) for k in range(CASCADES)]
+    rows = [0.0] * 4 + [*u, 0.0, *v, 0.0, *w, float(len(regions))]
+    for corners in regions:
+        pu = np.clip(corners @ u, bu.min(), bu.max())
+        pv = np.clip(corners @ v, bv.min(), bv.max())
+        du = max(float(np.ptp(pu)), 1e-6 * extent) / max(size[0] - 4, 1)
+        dv = max(float(np.ptp(pv)), 1e-6 * extent) / max(size[1] - 4, 1)
+        c0 = (pu.min() - 2 * du) * u + (pv.min() - 2 * dv) * v + plane * w
+        rows += [*c0, du, 0.0, 0.0, 0.0, dv]
+    return rows + [0.0] * (INFO_FLOATS - len(rows))
+
+
+def map_view(data, size: tuple[int, int]) -> View:
+    _cam, basis, tan_half = camera_basis(data)
+    return View(basis, tan_half, size[0] / size[1], max(float(data.model.camera.near), 1e-4))
 
 
 def light_map_info(data, size: tuple[int, int], mapped: int) -> bytes:
     """The std430 table of binding 17 for the first ``mapped`` lights (camera-relative, as the
-    lights table of ``pack_tables``)."""
+    lights table of ``pack_tables``): INFO_FLOATS floats each."""
     cam, _basis, _tan = camera_basis(data)
     lo, hi = scene_bounds(data)
+    view = map_view(data, size)
     rows: list[float] = []
     for li in data.lights[:mapped]:
         if li.type == 0:
             vec = np.asarray(-li.direction, dtype=np.float32).astype(np.float64)  # as the shader's table
-            rows += directional_frame(vec, lo, hi, size)
+            rows += directional_frame(vec, lo, hi, size, view)
         else:
-            rows += [*(np.asarray(li.position, dtype=np.float64) - cam), 1.0] + [0.0] * 12
-    return struct.pack(f"<{len(rows)}f", *rows) if rows else bytes(INFO_BYTES)
+            rows += [*(np.asarray(li.position, dtype=np.float64) - cam), 1.0] + [0.0] * (INFO_FLOATS - 4)
+    return struct.pack(f"<{len(rows)}f", *rows) if rows else bytes(4 * INFO_FLOATS)
 
 
 def light_map_bindings(setup: Any, data) -> tuple[list[Binding], dict[str, object]]:

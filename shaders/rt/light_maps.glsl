@@ -1,13 +1,15 @@
 // Light maps of the hybrid (passes/raytrace_lightmap.py): per mapped light, the distance along
 // each texel's ray from the light to the first surface (3e38: none), traced once at load by
 // light_map.rgen. Point lights: six cube faces (layers 6 i .. 6 i + 5) of rays from the light;
-// directional lights: layer 6 i, parallel rays from a plane outside the scene's bounds.
+// directional lights: up to six cascades (layers 6 i + k), parallel rays from a plane outside
+// the scene's bounds over the view frustum between two depths, finest first.
 // light_map_test tells, without tracing, whether a point's shadow ray is certainly unblocked
-// (every ray of the 3x3 texels around the point reaches the point's own plane) or certainly
+// (every ray of the 2x2 texels around the point reaches the point's own plane) or certainly
 // blocked (all of them stop well before it); anything else is traced (shade.glsl: shade_local).
-// Set 0 binding 16: the maps (r32f array); binding 17: 4 vec4 per mapped light:
-//   point:       (light position, 1), unused x 3
-//   directional: (grid corner C0, 0), (U, du), (V, dv), (W ray direction, 0)
+// Set 0 binding 16: the maps (r32f array); binding 17: 16 vec4 per mapped light (base b = 16 i):
+//   point:       [b] (light position, 1)
+//   directional: [b] (0, 0), [b + 1] (U, 0), [b + 2] (V, 0), [b + 3] (W ray direction, cascades),
+//                cascade k: [b + 4 + 2 k] (grid corner C0, du), [b + 5 + 2 k] (0, 0, 0, dv)
 #ifdef LIGHT_MAP_BUILD
 layout(set = 0, binding = 16, r32f) uniform writeonly image2DArray light_maps;
 #else
@@ -56,7 +58,8 @@ void light_map_tap(float stored, float expected, inout bool clear, inout bool bl
 int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
     if (dot(ng, to_light) < 1e-3) return -1;  // the ray would start off the lit side: trace it
     ivec2 size = imageSize(light_maps).xy;
-    vec4 m0 = maps[4u * li];
+    uint b = 16u * li;
+    vec4 m0 = maps[b];
     float footprint = LIGHT_MAP_GUARD * length(p) * 2.0 * frame.right.w / float(frame.counts.y);
     bool clear = true, blocked = true;
     if (m0.w > 0.5) {
@@ -64,11 +67,11 @@ int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
         if (2.0 * length(v) / float(min(size.x, size.y)) > footprint) return -1;
         vec2 ab;
         uint face = face_of(v, ab);
-        ivec2 c = ivec2(floor((0.5 * ab + 0.5) * vec2(size)));
-        if (any(lessThan(c, ivec2(1))) || any(greaterThan(c, size - 2))) return -1;  // taps past the face
+        ivec2 c = ivec2(floor((0.5 * ab + 0.5) * vec2(size) - 0.5));  // the taps around p: c .. c + 1
+        if (any(lessThan(c, ivec2(0))) || any(greaterThan(c, size - 2))) return -1;  // taps past the face
         float plane = dot(ng, v);
-        for (int j = -1; j <= 1; ++j)
-            for (int i = -1; i <= 1; ++i) {
+        for (int j = 0; j <= 1; ++j)
+            for (int i = 0; i <= 1; ++i) {
                 ivec2 t = c + ivec2(i, j);
                 vec2 tab = 2.0 * (vec2(t) + 0.5) / vec2(size) - 1.0;
                 vec3 w = normalize(face_direction(face, tab.x, tab.y));
@@ -76,24 +79,29 @@ int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
                 if (abs(den) < 1e-3 || plane / den <= 0.0) return -1;
                 light_map_tap(imageLoad(light_maps, ivec3(t, int(6u * li + face))).r, plane / den, clear, blocked);
             }
-    } else {
-        vec4 mu = maps[4u * li + 1u], mv = maps[4u * li + 2u];
-        if (max(mu.w, mv.w) > footprint) return -1;
-        vec3 W = maps[4u * li + 3u].xyz;
-        vec3 r = p - m0.xyz;
-        ivec2 c = ivec2(floor(vec2(dot(r, mu.xyz) / mu.w, dot(r, mv.xyz) / mv.w)));
-        if (any(lessThan(c, ivec2(1))) || any(greaterThan(c, size - 2))) return -1;
-        float den = dot(ng, W);
-        if (abs(den) < 1e-3) return -1;
-        for (int j = -1; j <= 1; ++j)
-            for (int i = -1; i <= 1; ++i) {
+        return clear ? 1 : blocked ? 0 : -1;
+    }
+    vec3 U = maps[b + 1u].xyz, V = maps[b + 2u].xyz, W = maps[b + 3u].xyz;
+    uint cascades = uint(maps[b + 3u].w);
+    float den = dot(ng, W);
+    if (abs(den) < 1e-3) return -1;
+    for (uint k = 0u; k < cascades; ++k) {
+        vec4 grid = maps[b + 4u + 2u * k];
+        float du = grid.w, dv = maps[b + 5u + 2u * k].w;
+        if (max(du, dv) > footprint) continue;  // coarser than the guard allows
+        vec3 r = p - grid.xyz;
+        ivec2 c = ivec2(floor(vec2(dot(r, U) / du, dot(r, V) / dv) - 0.5));
+        if (any(lessThan(c, ivec2(0))) || any(greaterThan(c, size - 2))) continue;  // p outside this cascade
+        for (int j = 0; j <= 1; ++j)
+            for (int i = 0; i <= 1; ++i) {
                 ivec2 t = c + ivec2(i, j);
-                vec3 o = m0.xyz + (float(t.x) + 0.5) * mu.w * mu.xyz + (float(t.y) + 0.5) * mv.w * mv.xyz;
+                vec3 o = grid.xyz + (float(t.x) + 0.5) * du * U + (float(t.y) + 0.5) * dv * V;
                 float e = dot(ng, p - o) / den;
                 if (e <= 0.0) return -1;
-                light_map_tap(imageLoad(light_maps, ivec3(t, int(6u * li))).r, e, clear, blocked);
+                light_map_tap(imageLoad(light_maps, ivec3(t, int(6u * li + k))).r, e, clear, blocked);
             }
+        return clear ? 1 : blocked ? 0 : -1;
     }
-    return clear ? 1 : blocked ? 0 : -1;
+    return -1;
 }
 #endif

@@ -54,14 +54,15 @@ def face_direction(face: int, a: float, b: float) -> np.ndarray:
 def reference_ray(data, li: int, face: int, x: int, y: int, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray] | None:
     """Origin and direction of texel (x, y) of light ``li``'s layer ``face`` (light_map.rgen)."""
     info = np.frombuffer(raytrace_lightmap.light_map_info(data, size, len(data.lights)), dtype=np.float32)
-    m = info[16 * li:16 * li + 16].astype(np.float64).reshape(4, 4)
+    m = info[64 * li:64 * li + 64].astype(np.float64).reshape(16, 4)
     if m[0, 3] > 0.5:
         a, b = 2.0 * (np.array([x, y]) + 0.5) / np.array(size) - 1.0
         d = face_direction(face, a, b)
         return m[0, :3], d / np.linalg.norm(d)
-    if face:
+    if face >= m[3, 3]:
         return None
-    return m[0, :3] + (x + 0.5) * m[1, 3] * m[1, :3] + (y + 0.5) * m[2, 3] * m[2, :3], m[3, :3]
+    grid, dv = m[4 + 2 * face], m[5 + 2 * face, 3]
+    return grid[:3] + (x + 0.5) * grid[3] * m[1, :3] + (y + 0.5) * dv * m[2, :3], m[3, :3]
 
 
 @pytest.mark.vulkan
@@ -112,8 +113,8 @@ def test_shading_passes_consult_the_maps(monkeypatch):
     def moved(data, size, mapped):
         info = np.frombuffer(original(data, size, mapped), dtype=np.float32).copy()
         for li in range(mapped):
-            if info[16 * li + 3] > 0.5:
-                info[16 * li:16 * li + 3] += np.float32(3.0)
+            if info[64 * li + 3] > 0.5:
+                info[64 * li:64 * li + 3] += np.float32(3.0)
         return info.tobytes()
 
     _plan, honest = _run("rt_hybrid", TIR, 32)
@@ -147,14 +148,27 @@ def test_lights_are_mapped_only_where_the_maps_stay_valid():
     assert raytrace_lightmap.mapped_lights(Setup(1), lights) == 0
 
 
-def test_directional_grid_lies_outside_the_scene_and_covers_it():
-    lo, hi = np.array([-1.0, -2.0, 0.5]), np.array([3.0, 1.0, 2.0])
+def test_directional_cascades_lie_outside_the_scene_and_cover_the_view():
+    from rgraph.passes.raytrace_lightmap import View, cascade_depths, slice_corners
+
+    lo, hi = np.array([-1.0, -2.0, 0.5]), np.array([3.0, 1.0, 6.0])
     to_light = np.array([0.3, 0.9, -0.2])
-    frame = np.array(raytrace_lightmap.directional_frame(to_light, lo, hi, (40, 30)))
-    c0, u, du, v, dv, w = frame[0:3], frame[4:7], frame[7], frame[8:11], frame[11], frame[12:15]
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    rel = corners - c0
-    assert np.allclose(w, -to_light / np.linalg.norm(to_light))
-    assert (rel @ w > 0).all()  # every corner in front of the grid's plane
-    i, j = rel @ u / du, rel @ v / dv
-    assert (i >= 2 - 1e-9).all() and (i <= 38 + 1e-9).all() and (j >= 2 - 1e-9).all() and (j <= 28 + 1e-9).all()
+    view = View(np.eye(3), 0.5, 1.5, 0.1)  # looking along +z from the origin
+    rows = np.array(raytrace_lightmap.directional_frame(to_light, lo, hi, (40, 30), view)).reshape(16, 4)
+    u, v, w, cascades = rows[1, :3], rows[2, :3], rows[3, :3], int(rows[3, 3])
+    assert np.allclose(w, -to_light / np.linalg.norm(to_light)) and cascades == raytrace_lightmap.CASCADES
+    depths = cascade_depths(view, lo, hi)
+    assert depths[0] == 0.1 and np.isclose(depths[-1], 6.0) and np.all(np.diff(np.log(depths)) > 0)
+    box = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    sizes = []
+    for k in range(cascades):
+        c0, du, dv = rows[4 + 2 * k, :3], rows[4 + 2 * k, 3], rows[5 + 2 * k, 3]
+        assert ((box - c0) @ w > 0).all()  # the grid's plane lies outside the scene's box
+        inside = slice_corners(view, depths[k], depths[k + 1])
+        inside = inside[np.all((inside >= lo) & (inside <= hi), axis=1)]  # the slice's corners in the box
+        i, j = (inside - c0) @ u / du, (inside - c0) @ v / dv
+        assert (i >= 2 - 1e-9).all() and (i <= 38 + 1e-9).all() and (j >= 2 - 1e-9).all() and (j <= 28 + 1e-9).all()
+        sizes.append(max(du, dv))
+    assert sizes == sorted(sizes)  # finest first
+    whole = np.array(raytrace_lightmap.directional_frame(to_light, lo, hi, (40, 30))).reshape(16, 4)
+    assert int(whole[3, 3]) == 1  # without a view: one grid over the whole box

@@ -128,12 +128,12 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
             hybrid_params: dict[str, str] | None = None, async_shade: bool = False,
-            dump: Path | None = None, traced: bool = False) -> dict[str, Any]:
+            dump: Path | None = None, every_shadow_ray: bool = False) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
     (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns);
-    with ``traced`` also the hybrid with ``rt.light_maps: 0`` (every shadow ray traced: ``traced_``).
+    with ``every_shadow_ray`` also the hybrid with ``rt.light_maps: 0`` (every shadow ray traced: ``traced_``).
     ``dump``: a folder for ``SCENE_CAMERA.npz`` (the colour images as float16, the visibility ids)."""
     from rgraph.passes.raytrace_hybrid import prim_bits
 
@@ -148,7 +148,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         graphs["raster"] = (RASTER_GRAPH, ("visibility",))
     if async_shade:
         graphs["async"] = (str(ASYNC_GRAPH), ("ray_args",))
-    if traced:
+    if every_shadow_ray:
         graphs["traced"] = ("rt_hybrid", ())
     own = {"hybrid": {**params, **(hybrid_params or {})}, "traced": {**params, **(hybrid_params or {}), "rt.light_maps": "0"}}
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=own.get(name, params),
@@ -179,7 +179,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         row.update(vis_jobs=int(header[0]), vis_overflow=bool(header[1]))
     if async_shade:
         row.update(_hybrid_columns(runs["async"]["timings"], T, runs["async"]["outputs"], alone["outputs"], "async_"))
-    if traced:
+    if every_shadow_ray:
         row.update(_hybrid_columns(runs["traced"]["timings"], T, runs["traced"]["outputs"], alone["outputs"], "traced_"))
     if raster:
         raster_out = runs["raster"]["outputs"]
@@ -332,7 +332,7 @@ def main(argv: list[str] | None = None) -> int:
                 for camera in (int(c) for c in args.cameras.split(",") if c):
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
                                         chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
-                                        async_shade=args.async_shade, dump=args.dump, traced=args.traced))
+                                        async_shade=args.async_shade, dump=args.dump, every_shadow_ray=args.traced))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

@@ -12,7 +12,7 @@ rays only where a cached light-space depth cannot decide.
 - The shading passes that read ``light_maps`` (``light_map_bindings``) test each shadow ray
   first: every ray of the 2x2 texels around the point reaches the point's plane -> lit; all stop
   well before it -> in shadow; else the shadow ray is traced. Only where a texel is at most two
-  pixel footprints wide at the point (``LIGHT_MAP_GUARD``): an occluder (or a hole) the taps
+  pixel footprints wide at the point (``rt.light_map_guard``, default 2): an occluder (or a hole) the taps
   miss is narrower than a texel, so its shadow is narrower than two pixels there.
 """
 
@@ -165,8 +165,11 @@ def light_map_bindings(setup: Any, data) -> tuple[list[Binding], dict[str, objec
     if not mapped:
         return [], {}
     info = setup.device_buffer(light_map_info(data, setup.extent_of("light_maps"), mapped))
+    guard = float(setup.param("rt.light_map_guard", 2.0))
+    if not 0.0 <= guard <= 1e6:
+        raise ValueError(f"pass {setup.name!r}: rt.light_map_guard must be in [0, 1e6] pixel footprints, got {guard}")
     return ([Binding(16, "storage_image", "light_maps", array=True), Binding(17, "storage_buffer", buffers=(info,))],
-            {"LIGHT_MAPS": 1, "MAPPED_LIGHTS": f"{mapped}u"})
+            {"LIGHT_MAPS": 1, "MAPPED_LIGHTS": f"{mapped}u", "LIGHT_MAP_GUARD": repr(guard)})
 
 
 @register("rt_light_maps")

@@ -77,6 +77,7 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
     count = 0  # blocks placed so far
     placed_set: set[int] = set()
     cover = _Cover(n)
+    cut, holders, alone = cover.cut, cover.holders, cover.alone
     union_lo: list[int] = []  # the union of the placed blocks' byte ranges: disjoint, sorted
     union_hi: list[int] = []
     limit = give_up_at if give_up_at is not None else -1
@@ -87,7 +88,7 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
         else:
             others = far[i].intersection(placed_set)  # placed blocks it may share bytes with
             if others:
-                off = _fit_runs(cover.free(others, placed, far[i], union_lo, union_hi), cover.cut[-1], need, a)
+                off = _fit_runs(cover.free(others, placed, far[i], union_lo, union_hi), cut[-1], need, a)
             elif len(union_lo) == 1 and union_lo[0] == 0:  # every placed block a neighbour, no gap: on top
                 top = union_hi[0]
                 off = top if top % a == 0 else top + a - top % a
@@ -100,6 +101,12 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
         placed[i] = (off, top, i)
         count += 1
         placed_set.add(i)
+        if off == cut[-1] and union_hi:  # right on top of every placed block, the usual case
+            cut.append(top)  # _Cover.add's first case, inline
+            holders.append((i,))
+            alone[i] = True
+            union_hi[-1] = top
+            continue
         cover.add(off, top, i)
         if len(union_lo) == 1 and off <= union_hi[0] and union_lo[0] <= top:  # joins the one range
             if off < union_lo[0]:

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from heapq import heappop, heappush
 from itertools import accumulate
+from typing import Any
 
 import numpy as np
 
@@ -26,13 +27,14 @@ def time_overlaps(start: Sequence[int], end: Sequence[int]) -> np.ndarray:
     return overlap
 
 
-def _rows(matrix: np.ndarray) -> list[list[int]]:
-    """The column indices of each row's true entries, ascending (a square matrix)."""
+def _rows(matrix: np.ndarray, make: Callable[[list[int]], Any] = list) -> list[Any]:
+    """``make`` of the column indices of each row's true entries, ascending (a square
+    matrix)."""
     n = len(matrix)
     flat = np.flatnonzero(matrix)  # row by row, ascending within a row (2-D nonzero: 7x slower)
     columns = (flat % n).tolist() if n else []
     bounds = np.searchsorted(flat, np.arange(0, n * n + 1, max(n, 1))).tolist()
-    return [columns[bounds[i] : bounds[i + 1]] for i in range(n)]
+    return [make(columns[bounds[i] : bounds[i + 1]]) for i in range(n)]
 
 
 def time_neighbors(start: Sequence[int], end: Sequence[int]) -> list[list[int]]:
@@ -227,7 +229,7 @@ class Instance:
     def far(self) -> list[set[int]]:
         """For each block, the blocks, itself included, that it may share bytes with."""
         if self.adjacency is not None:
-            return [set(row) for row in _rows(~self.adjacency)]
+            return _rows(~self.adjacency, set)
         everything = range(self.n)
         return [set(everything).difference(row) for row in self.neighbors]
 

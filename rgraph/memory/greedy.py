@@ -104,7 +104,7 @@ def _dense_best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None
         if off == cut[-1] and union_hi:  # right on top of every placed block, the usual case
             cut.append(top)  # _Cover.add's first case, inline
             holders.append((i,))
-            alone[i] = True
+            alone[i] = (off, top)
             union_hi[-1] = top
             continue
         cover.add(off, top, i)
@@ -123,16 +123,16 @@ class _Cover:
     ``[cut[k], cut[k+1])`` and ``holders[k]`` the blocks whose range holds it (none: a gap
     between them); ``cut[-1]`` is the highest top. Blocks of a dense class mostly conflict,
     so their ranges seldom overlap: a block's range spans few segments. Per block, so that
-    ``free`` seldom has to look its segments up: ``alone`` (its range is one segment held
-    by it only) and ``inside`` (blocks whose range holds all of its range, as found when it
-    was placed inside one segment)."""
+    ``free`` seldom has to look its segments up: ``alone`` (its range ``(offset, top)``
+    while that is one segment held by it only, else None) and ``inside`` (blocks whose
+    range holds all of its range, as found when it was placed inside one segment)."""
 
     __slots__ = ("cut", "holders", "alone", "inside")
 
     def __init__(self, n: int) -> None:
         self.cut: list[int] = [0]
         self.holders: list[tuple[int, ...]] = []
-        self.alone = [False] * n
+        self.alone: list[tuple[int, int] | None] = [None] * n
         self.inside: list[tuple[int, ...]] = [()] * n
 
     def add(self, lo: int, hi: int, block: int) -> None:
@@ -145,7 +145,7 @@ class _Cover:
                 holders.append(())
             cut.append(hi)
             holders.append((block,))
-            alone[block] = True
+            alone[block] = (lo, hi)
             return
         k = bisect_right(cut, lo) - 1  # the segment holding lo
         if cut[k] < lo:
@@ -163,11 +163,11 @@ class _Cover:
             if holders[k]:
                 self.inside[block] = holders[k]
             else:
-                alone[block] = True
+                alone[block] = (lo, hi)
         for m in range(k, end):
             held = holders[m]
             for h in held:
-                alone[h] = False
+                alone[h] = None
             holders[m] = held + (block,)
 
     def free(self, others: Iterable[int], placed: Sequence[tuple[int, int, int] | None], allowed: set[int],
@@ -183,12 +183,12 @@ class _Cover:
             pieces.append((0, union_lo[0]))
         is_allowed = allowed.issuperset
         for f in others:
-            lo, hi, _ = placed[f]  # type: ignore[misc]
-            if alone[f]:
-                pieces.append((lo, hi))
+            if alone[f] is not None:
+                pieces.append(alone[f])
                 continue
             if inside[f] and not is_allowed(inside[f]):
                 continue  # a block outside ``allowed`` holds all of its range
+            lo, hi, _ = placed[f]  # type: ignore[misc]
             k = bisect_left(cut, lo)
             if cut[k + 1] >= hi:  # one segment
                 if is_allowed(holders[k]):

@@ -21,8 +21,8 @@ def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None
 
     Each block's placed neighbours are visited in offset order (the gap scan depends only
     on the first of equal offsets and on the highest top so far): sorted per block, or, on
-    instances where blocks overlap a quarter of the others or more (cross-queue conflicts),
-    by ``_dense_best_fit``."""
+    instances where blocks overlap a quarter of the others or more (cross-queue conflicts)
+    and none is empty, by ``_dense_best_fit``."""
     if 4 * inst.pair_count >= inst.n * inst.n and 0 not in inst.size:
         return _dense_best_fit(inst, order, give_up_at)
     offsets = [-1] * inst.n

@@ -1,7 +1,8 @@
-"""Best fit's ways of visiting a block's placed neighbours (their union; the union's gaps
-and the bytes only its placed non-neighbours hold, ``greedy._Cover``; its own neighbours
-sorted) give the offsets of the plain algorithm: sort the placed neighbours by (offset,
-top), take the smallest fitting gap."""
+"""Best fit's ways of visiting a block's placed neighbours (their union; the sorted list of
+every placed block; where blocks overlap 90% of the others, the union's gaps and the bytes
+only its placed non-neighbours hold, ``greedy._Cover``; its own neighbours sorted) give the
+offsets of the plain algorithm: sort the placed neighbours by (offset, top), take the
+smallest fitting gap. ``dense`` 0.6 gives about 70% overlapping pairs, 0.9 about 92%."""
 
 from __future__ import annotations
 

@@ -180,18 +180,15 @@ class LightMaps(RayTracingImpl):
     reads_light_maps = False
 
     def __init__(self, setup: Any) -> None:
-        from rgraph.scene.build import load_scene_data
-
-        if not setup.plan.get("scene_source"):
-            raise ValueError(f"pass {setup.name!r}: ray tracing needs a scene (--scene)")
-        data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
-        self.mapped = mapped_lights(setup, data)
         self.size = setup.extent_of("light_maps")
-        info = setup.device_buffer(light_map_info(data, self.size, self.mapped))
-        super().__init__(setup, [Binding(16, "storage_image", "light_maps", array=True),
-                                 Binding(17, "storage_buffer", buffers=(info,))])
+        super().__init__(setup, [Binding(16, "storage_image", "light_maps", array=True)])
         self.built: set[int] = set()
         self.args = self._indirect_args(setup) if self.mapped else None
+
+    def scene_bindings(self) -> list[Binding]:
+        self.mapped = mapped_lights(self.setup, self.data)
+        info = self.setup.device_buffer(light_map_info(self.data, self.size, self.mapped))
+        return [Binding(17, "storage_buffer", buffers=(info,))]
 
     def shader_defines(self) -> dict[str, object]:
         return {"MAPPED_LIGHTS": f"{self.mapped}u"}

@@ -121,6 +121,7 @@ class RayTracingImpl(PassImpl):
                 continue
             bindings.append(Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)))
         bindings.append(Binding(6, "sampled", "sky", array=True, sampler="nearest"))
+        images = [*images, *self.scene_bindings()]
         self.light_defines: dict[str, object] = {}
         if self.reads_light_maps and setup.has("light_maps"):
             from .raytrace_lightmap import light_map_bindings
@@ -153,6 +154,10 @@ class RayTracingImpl(PassImpl):
     def shader_defines(self) -> dict[str, object]:
         """Defines of the pipeline's shaders (``self.data`` is loaded)."""
         return {}
+
+    def scene_bindings(self) -> list[Binding]:
+        """More bindings of the pass that depend on the scene (``self.data`` is loaded)."""
+        return []
 
     def _pipeline(self) -> Any:
         from rgraph.vk.rt_pipeline import create_rt_pipeline

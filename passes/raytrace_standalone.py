@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from rgraph.impl import PassImpl, register
+from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.passkit import Binding
 
 from .rt_model import MAX_LIGHTS, MAX_STACK, camera_basis, material_of
@@ -100,6 +100,8 @@ class RayTracingImpl(PassImpl):
     the sky (binding 6), the pass's own images from binding 7, the TLAS (set 1)."""
 
     raygen = "rt/standalone.rgen"
+    param_schema = {"rt.max_depth": Param(int, 1, MAX_STACK - 1), "rt.light_maps": Param(int, choices=(0, 1)),
+                    "rt.light_map_guard": Param(float, 0, 1e6)}
     #: A pass that reads ``light_maps`` tests its shadow rays against them first
     #: (``passes.raytrace_lightmap``); the pass that traces the maps binds them itself.
     reads_light_maps = True

@@ -172,3 +172,13 @@ def test_directional_cascades_lie_outside_the_scene_and_cover_the_view():
     assert sizes == sorted(sizes)  # finest first
     whole = np.array(raytrace_lightmap.directional_frame(to_light, lo, hi, (40, 30))).reshape(16, 4)
     assert int(whole[3, 3]) == 1  # without a view: one grid over the whole box
+
+
+@pytest.mark.parametrize("param", ["rt.light_map_guard=-1", "rt.light_map_guard=nan", "rt.light_maps=3",
+                                   "rt.max_depth=0"])
+def test_bad_ray_tracing_params_are_refused_before_the_device_opens(capsys, param):
+    from rgraph.cli import main
+
+    assert main(["run", "rt_hybrid", "--scene", str(TINY), "--size", "8x8", "-p", param]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("<command line>:1:1: error: param ") and "Traceback" not in err and "device 0" not in err

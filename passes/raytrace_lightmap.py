@@ -46,6 +46,11 @@ def mapped_lights(setup: Any, data) -> int:
     return min(len(data.lights), MAX_LIGHTS, MAPPED_LIGHTS, layers // 6)
 
 
+def box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The 8 corners of the box [lo, hi]."""
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
 def scene_bounds(data) -> tuple[np.ndarray, np.ndarray]:
     """Camera-relative bounding box (min, max) of every instance of every mesh."""
     from rgraph.scene.camera import model_matrix
@@ -56,8 +61,7 @@ def scene_bounds(data) -> tuple[np.ndarray, np.ndarray]:
         if not len(mesh.positions) or not mesh.data.vertex_count:
             continue
         pos = np.asarray(mesh.data.positions, dtype=np.float64).reshape(-1, 3)
-        a, b = pos.min(axis=0), pos.max(axis=0)
-        corners = np.array([[x, y, z] for x in (a[0], b[0]) for y in (a[1], b[1]) for z in (a[2], b[2])])
+        corners = box_corners(pos.min(axis=0), pos.max(axis=0))
         linear = model_matrix(np.zeros(3), mesh.rotation, mesh.scale)[:3, :3]
         box = corners @ linear.T
         offsets = np.asarray(mesh.positions, dtype=np.float64).reshape(-1, 3) - cam
@@ -75,10 +79,6 @@ def light_basis(to_light: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     u = np.cross(w, helper)
     u /= np.linalg.norm(u)
     return u, np.cross(w, u), w
-
-
-def box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
 
 
 @dataclass(frozen=True)

@@ -38,13 +38,13 @@ from rgraph.memory.search import PREORDERINGS, preorder, solve_capacity
 #: time taken varies with the machine.
 OPS_PER_SECOND = 4_000_000
 
-#: Elastic dive operations (``rgraph.memory.elastic``: each dive's own plus
-#: ``DIVE_BLOCK_OPS`` per block and dive) granted per second of the budget the dives take
-#: (session 13): what the compiled dive (``rgraph/memory/_dive.pyx``) does on the MiniMalloc
-#: traces, from minimum CPU times on the 2-core development machine (0.64-0.96 s of CPU per
-#: second charged, per trace). The same count with or without the compiled dive: plans do
-#: not depend on it, the pure-Python dives only take about 40 times longer.
-DIVE_OPS_PER_SECOND = 175_000_000
+#: Elastic dive operations (``rgraph.memory.elastic.STEP_OPS``) granted per second of the
+#: budget the dives take (session 13): what the compiled dive (``rgraph/memory/_dive.pyx``)
+#: does on the MiniMalloc traces, fitted to the minimum CPU times of whole ``improve`` runs
+#: on the 2-core development machine (124 M a second; 104-145 M by trace) and rounded down.
+#: The same count with or without the compiled dive, so plans do not depend on it; the
+#: pure-Python dives take about 25 times longer than charged.
+DIVE_OPS_PER_SECOND = 120_000_000
 
 
 def dive_ops(ops: int) -> int:

@@ -248,11 +248,6 @@ def squeak(order: Sequence[int], blamed: Sequence[int]) -> list[int]:
     return [i for i in order if i in front] + [i for i in order if i not in front]
 
 
-#: Operations ``improve`` charges per dive and block besides the dive's own: the Python work
-#: around each dive (squeak, hash, the dive's arrays and results), fitted with
-#: ``aliased.DIVE_OPS_PER_SECOND`` to the compiled dives' CPU times.
-DIVE_BLOCK_OPS = 12
-
 #: ``improve`` stops after this many dives per chain in a row that did not lower the best
 #: peak (the chains go round in circles on small instances, where the search can prove).
 STALL_PER_CHAIN = 25
@@ -268,8 +263,7 @@ class Improved:
 
 def improve(inst: Instance, orders: Sequence[Sequence[int]], incumbent: int, ops_budget: int) -> Improved:
     """Elastic dives from the lower bound, round robin over ``orders`` (one squeaky-wheel
-    chain each), until ``ops_budget`` dive operations (the dives' own plus
-    :data:`DIVE_BLOCK_OPS` per block and dive) are spent, the bound is reached or the
+    chain each), until ``ops_budget`` dive operations are spent, the bound is reached or the
     chains stall (:data:`STALL_PER_CHAIN`; a chain whose order comes back is dropped).
     Dives give up once their capacity reaches the best peak so far (``incumbent`` at first)."""
     bound = inst.lower_bound()
@@ -289,12 +283,11 @@ def improve(inst: Instance, orders: Sequence[Sequence[int]], incumbent: int, ops
             continue
         seen[c].add(key)
         k += 1
-        around = DIVE_BLOCK_OPS * inst.n  # the squeak, the order's hash, the dive's setup
-        found = dive(inst, chains[c], bound, ops_budget - spent - around, give_up_at=peak)
+        found = dive(inst, chains[c], bound, ops_budget - spent, give_up_at=peak)
         if found is None:  # out of operations: they were spent
             spent = ops_budget
             break
-        spent += found.ops + around
+        spent += found.ops
         dives += 1
         blamed[c] = found.blamed
         if found.offsets is not None and found.peak < peak:

@@ -41,9 +41,9 @@ OPS_PER_SECOND = 4_000_000
 #: Elastic dive operations (``rgraph.memory.elastic.STEP_OPS``) granted per second of the
 #: budget the dives take (session 13): what the compiled dive (``rgraph/memory/_dive.pyx``)
 #: does on the MiniMalloc traces, fitted to the minimum CPU times of whole ``improve`` runs
-#: on the 2-core development machine (124 M a second; 104-145 M by trace) and rounded down.
+#: on the 2-core development machine (124 and 166 M a second in two runs) and rounded down.
 #: The same count with or without the compiled dive, so plans do not depend on it; the
-#: pure-Python dives take about 25 times longer than charged.
+#: pure-Python dives (4-8 M a second) take 15-30 times longer than charged.
 DIVE_OPS_PER_SECOND = 120_000_000
 
 

@@ -31,12 +31,30 @@ from rgraph.memory.model import Block
 from rgraph.memory.search import PREORDERINGS, preorder, solve_capacity
 
 #: Search operations (blocks scanned per node, neighbours and sections per placement:
-#: ``CapacitySearch.ops``; the elastic dives charge theirs in the same unit, see
-#: ``rgraph.memory.elastic.STEP_OPS``) granted per second of budget, about what this 2-core
-#: machine does (search 2.3-6 M/s, dives 4.5-7.7 M/s measured on the MiniMalloc traces).
+#: ``CapacitySearch.ops``) granted per second of budget, about what this 2-core machine does
+#: (search 2.3-6 M/s measured on the MiniMalloc traces; the elastic dives' operations have
+#: their own rate, ``DIVE_OPS_PER_SECOND``).
 #: The budget is counted in operations, so results are the same on every machine; the real
 #: time taken varies with the machine.
 OPS_PER_SECOND = 4_000_000
+
+#: Elastic dive operations (``rgraph.memory.elastic.STEP_OPS``) granted per second of the
+#: budget the dives take (session 13): what the compiled dive (``rgraph/memory/_dive.pyx``)
+#: does on the MiniMalloc traces, fitted to the minimum CPU times of whole ``improve`` runs
+#: on the 2-core development machine (124 and 166 M a second in two runs) and rounded down.
+#: The same count with or without the compiled dive, so plans do not depend on it; the
+#: pure-Python dives (4-8 M a second) take 15-30 times longer than charged.
+DIVE_OPS_PER_SECOND = 120_000_000
+
+
+def dive_ops(ops: int) -> int:
+    """The elastic dive operations that ``ops`` search operations of budget buy."""
+    return ops * DIVE_OPS_PER_SECOND // OPS_PER_SECOND
+
+
+def search_ops(dive: int) -> int:
+    """The search operations of budget that ``dive`` elastic dive operations use (rounded up)."""
+    return -(-dive * OPS_PER_SECOND // DIVE_OPS_PER_SECOND)
 
 #: The greedy orderings cost about linearly in the pairs of blocks alive at the same time
 #: (each block is fitted among its neighbours). Past this many (ordered) pairs per second of
@@ -110,7 +128,7 @@ def place_class(inst: Instance, time_budget_s: float, exact: bool = False) -> Cl
         # reach: the search could only burn its budget proving nothing, so greedy it is.
         return best
     budget = int(time_budget_s * OPS_PER_SECOND)
-    if budget < inst.n * inst.n // 2 + inst.pair_count:
+    if dive_ops(budget) < inst.n * inst.n // 2 + inst.pair_count:
         return best  # not even one dive (each step scans the blocks left) would finish
     search = _Bisection(inst, best)
     if exact:
@@ -164,12 +182,12 @@ class _Bisection:
             return max(budget, 0)
         orders = {h: o for h, o in zip(PREORDERINGS, self.orders, strict=True)}
         found = improve(self.inst, [orders.get(h) or preorder(self.inst, h) for h in ELASTIC_ORDERS],
-                        self.best.peak, budget)
+                        self.best.peak, dive_ops(budget))
         if found.offsets is not None:
             self.best = ClassResult(found.offsets, found.peak, self.lb, f"elastic:{found.dives}")
             if found.peak <= self.lb:
                 self.best.proven = True
-        return budget - found.ops
+        return budget - search_ops(found.ops)
 
     def attempt(self, capacity: int, rounds: int | None, budget: int) -> int:
         """Try one capacity; returns the budget left."""

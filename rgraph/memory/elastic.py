@@ -16,27 +16,34 @@ needs it, so the peak lands close to what the packing of the lower sections allo
 sections that forced a raise to the front of the preorder (squeaky wheel: they get the
 low offsets next time), round robin over chains started from different preorders.
 
-Work is counted in the search's unit of operations (weighted: :data:`STEP_OPS`), so
-results do not depend on the machine.
+Work is counted in operations (weighted: :data:`STEP_OPS`), so results do not depend on the
+machine. The dives run compiled (``rgraph/memory/_dive.pyx``, same results and operations)
+where built; their operations are granted at ``aliased.DIVE_OPS_PER_SECOND``, the search's at
+``aliased.OPS_PER_SECOND``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from types import ModuleType
 
 from rgraph.memory.instance import Instance
+from rgraph.native import load
+
+#: The compiled mirror of :func:`dive_python` (``rgraph/memory/_dive.pyx``), None where it is
+#: not built or ``RGRAPH_NATIVE=0``: then :func:`dive` runs the Python code.
+NATIVE = load("rgraph.memory._dive")
 
 #: Candidates tried per step (by lowest offset, then preorder rank); also the ones whose
 #: needed capacity is compared when none fits.
 CANDIDATES = 8
 
-#: Operations charged (in the search's unit, ``aliased.OPS_PER_SECOND`` of them a second):
-#: per step, plus half an operation per unplaced block scanned; per candidate tried, plus
-#: half per neighbour and per section visited; one per ``ROW_SHARE`` blocks of a section
-#: scanned for its floor (a comprehension). Fitted to CPU times of dives on the MiniMalloc
-#: traces and rounded up, so a dive charged ``x`` operations takes at most about
-#: ``x / OPS_PER_SECOND`` seconds on the 2-core development machine.
+#: Operations charged: per step, plus half an operation per unplaced block scanned; per
+#: candidate tried, plus half per neighbour and per section visited; one per ``ROW_SHARE``
+#: blocks of a section scanned for its floor. Fitted (session 10) to CPU times of the Python
+#: dives on the MiniMalloc traces (about 4 M a second); the compiled dive does the same
+#: operations about 40 times faster (``aliased.DIVE_OPS_PER_SECOND``, session 13).
 STEP_OPS = 20
 TRY_OPS = 25
 ROW_SHARE = 8
@@ -56,7 +63,29 @@ def dive(inst: Instance, order: Sequence[int], capacity: int, ops_limit: int | N
          give_up_at: int | None = None) -> Dive | None:
     """One elastic dive over ``order`` (a preorder of all blocks) starting at ``capacity``;
     None if it would spend more than ``ops_limit`` operations. When the capacity reaches
-    ``give_up_at`` the dive stops (``offsets`` None) with what it blamed so far."""
+    ``give_up_at`` the dive stops (``offsets`` None) with what it blamed so far.
+    The compiled dive (:data:`NATIVE`) where built, else :func:`dive_python`: same results."""
+    if NATIVE is None:
+        return dive_python(inst, order, capacity, ops_limit, give_up_at)
+    return native_dive(NATIVE, inst, order, capacity, ops_limit, give_up_at)
+
+
+def native_dive(module: ModuleType, inst: Instance, order: Sequence[int], capacity: int,
+                ops_limit: int | None = None, give_up_at: int | None = None) -> Dive | None:
+    """:func:`dive_python` run by the compiled ``module`` (``rgraph.memory._dive``); its flat
+    copy of ``inst`` is made once and kept on the instance."""
+    flat = inst.accelerated.get("dive")
+    if flat is None:
+        flat = inst.accelerated["dive"] = module.Flat(
+            inst.size, inst.align, inst.neighbors, inst.sec_lo, inst.sec_hi, inst.section_blocks,
+            inst.section_totals())
+    found = module.dive(flat, order, capacity, ops_limit, give_up_at, CANDIDATES, STEP_OPS, TRY_OPS, ROW_SHARE)
+    return None if found is None else Dive(*found)
+
+
+def dive_python(inst: Instance, order: Sequence[int], capacity: int, ops_limit: int | None = None,
+                give_up_at: int | None = None) -> Dive | None:
+    """:func:`dive` in Python (``rgraph/memory/_dive.pyx`` mirrors it: change both)."""
     n = inst.n
     size, align, neighbors = inst.size, inst.align, inst.neighbors
     sec_lo, sec_hi, rows = inst.sec_lo, inst.sec_hi, inst.section_blocks
@@ -234,7 +263,7 @@ class Improved:
 
 def improve(inst: Instance, orders: Sequence[Sequence[int]], incumbent: int, ops_budget: int) -> Improved:
     """Elastic dives from the lower bound, round robin over ``orders`` (one squeaky-wheel
-    chain each), until ``ops_budget`` operations are spent, the bound is reached or the
+    chain each), until ``ops_budget`` dive operations are spent, the bound is reached or the
     chains stall (:data:`STALL_PER_CHAIN`; a chain whose order comes back is dropped).
     Dives give up once their capacity reaches the best peak so far (``incumbent`` at first)."""
     bound = inst.lower_bound()

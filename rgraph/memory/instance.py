@@ -237,6 +237,12 @@ class Instance:
         """The blocks, ``i`` included, that ``i`` may share bytes with."""
         return self.far[i]
 
+    @cached_property
+    def accelerated(self) -> dict[str, Any]:
+        """Flat copies of this instance made by the compiled accelerators (``rgraph.native``),
+        by use (e.g. ``"dive"``: ``rgraph.memory._dive.Flat``), kept for the next call."""
+        return {}
+
     def lower_bound(self) -> int:
         return max(self.section_totals(), default=0)
 

@@ -2,6 +2,9 @@
 
 Each block, in turn, goes into the smallest gap between already placed blocks that overlap
 it in time and can hold it (aligned); when no gap fits it goes on top of them.
+
+``best_fit`` runs compiled (``rgraph/memory/_fit.pyx``: the same offsets, the same give-up)
+where built; ``best_fit_python`` is the reference and the fallback (``RGRAPH_NATIVE=0``).
 """
 
 from __future__ import annotations
@@ -9,10 +12,17 @@ from __future__ import annotations
 from bisect import bisect_left, bisect_right, insort
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from itertools import repeat
+from types import ModuleType
+from typing import Any
 
 import numpy as np
 
 from rgraph.memory.instance import Instance
+from rgraph.native import load
+
+#: The compiled best fit (``rgraph/memory/_fit.pyx``), None where it is not built or
+#: ``RGRAPH_NATIVE=0``: then :func:`best_fit` runs :func:`best_fit_python`.
+NATIVE = load("rgraph.memory._fit")
 
 #: ``_cover_best_fit`` is used where blocks overlap all but one in this many of the others
 #: (on average): it visits a block's placed non-neighbours, each about ten times dearer
@@ -23,7 +33,31 @@ NEARLY_ALL = 10
 
 def best_fit(inst: Instance, order: Sequence[int], give_up_at: int | None = None) -> list[int] | None:
     """Offsets for every block, placing blocks in ``order``; None as soon as a block's top
-    reaches ``give_up_at`` (the peak could then only be at least that).
+    reaches ``give_up_at`` (the peak could then only be at least that). Compiled
+    (:data:`NATIVE`) where built, else :func:`best_fit_python`: the same results."""
+    if NATIVE is not None:
+        flat = native_flat(NATIVE, inst)
+        if flat is not None:
+            return NATIVE.best_fit(flat, order, give_up_at)  # type: ignore[no-any-return]
+    return best_fit_python(inst, order, give_up_at)
+
+
+def native_flat(module: ModuleType, inst: Instance) -> Any:
+    """``module.Flat`` (``rgraph.memory._fit``) of ``inst``, made once and kept on the
+    instance; None where sizes or alignments pass 64 bits (the Python code then runs)."""
+    flat = inst.accelerated.get("fit")
+    if flat is None:
+        try:
+            matrix = None if inst.adjacency is None else np.ascontiguousarray(inst.adjacency).view(np.uint8)
+            flat = module.Flat(inst.size, inst.align, matrix, inst.neighbors if matrix is None else None)
+        except OverflowError:
+            flat = False
+        inst.accelerated["fit"] = flat
+    return flat or None
+
+
+def best_fit_python(inst: Instance, order: Sequence[int], give_up_at: int | None = None) -> list[int] | None:
+    """:func:`best_fit` in Python (``rgraph/memory/_fit.pyx`` gives the same offsets).
 
     Each block's placed neighbours are visited in offset order (the gap scan depends only
     on the first of equal offsets and on the highest top so far): sorted per block, or, on

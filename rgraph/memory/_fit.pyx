@@ -1,0 +1,257 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Compiled greedy best fit: ``rgraph.memory.greedy.best_fit_python``'s offsets on C arrays.
+
+Not a line-by-line mirror: the Python module has four ways of visiting a block's placed
+neighbours (for speed in Python); all give the offsets of the plain algorithm, which this
+module runs (tests/memory/test_best_fit_paths.py and test_best_fit_native.py compare them):
+each block, in turn, goes to the start (aligned) of the smallest gap, between its placed
+neighbours sorted by offset, that holds it (the first of equal gaps), else on top of them;
+as soon as a block's top reaches ``give_up_at`` the placement is given up (None).
+
+A block's placed neighbours come in offset order either from a scan of every placed block
+(kept sorted by offset; on dense instances, when the block overlaps a good share of them)
+or by sorting its own placed neighbours. Which way is used changes the time only: the gap
+scan depends only on the first of equal offsets and the highest top so far. ``Flat`` is
+one instance's arrays, made once per ``Instance`` (``greedy.native_flat``)."""
+
+from libc.stdlib cimport free, malloc, qsort
+from libc.string cimport memmove
+
+ctypedef long long i64
+
+#: Sizes plus alignments must stay below this (offsets and tops then fit in 64 bits).
+cdef i64 LIMIT = (<i64> 1) << 62
+
+
+cdef struct Range:
+    i64 lo
+    i64 hi
+
+
+cdef int by_lo(const void *a, const void *b) noexcept nogil:
+    cdef i64 x = (<const Range *> a).lo, y = (<const Range *> b).lo
+    return (x > y) - (x < y)
+
+
+cdef class Flat:
+    """An ``Instance``'s sizes, alignments and neighbour lists (CSR) as C arrays, from its
+    conflict matrix (``adjacency``, uint8, kept for membership tests) or its neighbour lists
+    (``neighbors``, used when ``adjacency`` is None). Dense (a quarter of all pairs or more
+    may not share bytes, as in ``greedy.best_fit_python``): every placed block is kept sorted."""
+
+    cdef int n
+    cdef bint dense
+    cdef i64 *size
+    cdef i64 *align
+    cdef int *nbr_ptr
+    cdef int *nbr_idx
+    cdef const unsigned char *adj
+    cdef object matrix  # owns adj
+
+    def __cinit__(self, size, align, adjacency, neighbors):
+        cdef int n = len(size), i, j, k
+        cdef Py_ssize_t pairs = 0
+        cdef i64 total = 0
+        cdef const unsigned char[:, ::1] m
+        self.n, self.adj = n, NULL
+        if len(align) != n:
+            raise ValueError("inconsistent instance arrays")
+        self.size = <i64 *> malloc(max(n, 1) * sizeof(i64))
+        self.align = <i64 *> malloc(max(n, 1) * sizeof(i64))
+        self.nbr_ptr = <int *> malloc((n + 1) * sizeof(int))
+        if not (self.size and self.align and self.nbr_ptr):
+            raise MemoryError()
+        for i in range(n):
+            if not (0 <= size[i] < LIMIT and 1 <= align[i] < LIMIT):
+                raise OverflowError("sizes and alignments must be in [0, 2**62), alignments positive")
+            self.size[i] = size[i]
+            self.align[i] = align[i]
+            total += self.size[i] + self.align[i]
+            if total >= LIMIT:
+                raise OverflowError("sizes and alignments sum past 2**62")
+        if adjacency is not None:
+            m = adjacency
+            if m.shape[0] != n or m.shape[1] != n:
+                raise ValueError("adjacency must be n by n")
+            self.matrix = adjacency
+            self.adj = &m[0, 0] if n else NULL
+            for i in range(n):
+                for j in range(n):
+                    pairs += self.adj[<Py_ssize_t> i * n + j] != 0
+            self.nbr_idx = <int *> malloc(max(pairs, 1) * sizeof(int))
+            if not self.nbr_idx:
+                raise MemoryError()
+            k = 0
+            with nogil:
+                for i in range(n):
+                    self.nbr_ptr[i] = k
+                    for j in range(n):
+                        if self.adj[<Py_ssize_t> i * n + j] and j != i:
+                            self.nbr_idx[k] = j
+                            k += 1
+        else:
+            if len(neighbors) != n:
+                raise ValueError("inconsistent instance arrays")
+            for row in neighbors:
+                pairs += len(row)
+            self.nbr_idx = <int *> malloc(max(pairs, 1) * sizeof(int))
+            if not self.nbr_idx:
+                raise MemoryError()
+            k = 0
+            for i in range(n):
+                self.nbr_ptr[i] = k
+                for x in neighbors[i]:
+                    j = x
+                    if not (0 <= j < n) or j == i:
+                        raise ValueError("neighbour out of range")
+                    self.nbr_idx[k] = j
+                    k += 1
+        self.nbr_ptr[n] = k
+        self.dense = 4 * k >= <Py_ssize_t> n * n
+
+    def __dealloc__(self):
+        free(self.size)
+        free(self.align)
+        free(self.nbr_ptr)
+        free(self.nbr_idx)
+
+
+cdef inline i64 align_up(i64 x, i64 a) noexcept nogil:
+    return x if x % a == 0 else x + a - x % a
+
+
+cdef int place(Flat flat, const int *order, int count, i64 limit, i64 *offsets) noexcept nogil:
+    """Best fit of ``order[:count]`` into ``offsets`` (all -1 on entry); 1 if given up at
+    ``limit`` (negative: never), -1 out of memory, else 0."""
+    cdef int n = flat.n, i, j, k, e, placed = 0, lo_k, hi_k, mid, deg, found
+    cdef const i64 *size = flat.size
+    cdef const i64 *align = flat.align
+    cdef const int *ptr = flat.nbr_ptr
+    cdef const int *idx = flat.nbr_idx
+    cdef const unsigned char *row = NULL
+    cdef i64 need, a, cursor, best_off, best_gap, lo, hi, aligned, off, top
+    cdef bint dense = flat.dense, scan
+    # every placed block by offset (dense instances): starts, tops, blocks
+    cdef i64 *e_lo = NULL
+    cdef i64 *e_hi = NULL
+    cdef int *e_blk = NULL
+    cdef int *stamp = NULL  # stamp[j] == i + 1: j is a neighbour of i (no matrix)
+    cdef Range *taken = <Range *> malloc(max(n, 1) * sizeof(Range))
+    cdef int code = 0
+    if dense:
+        e_lo = <i64 *> malloc(max(n, 1) * sizeof(i64))
+        e_hi = <i64 *> malloc(max(n, 1) * sizeof(i64))
+        e_blk = <int *> malloc(max(n, 1) * sizeof(int))
+        if flat.adj == NULL:
+            stamp = <int *> malloc(max(n, 1) * sizeof(int))
+    if not taken or (dense and not (e_lo and e_hi and e_blk and (flat.adj != NULL or stamp))):
+        code = -1
+    else:
+        if stamp:
+            for j in range(n):
+                stamp[j] = 0
+        for k in range(count):
+            i = order[k]
+            need, a = size[i], align[i]
+            deg = ptr[i + 1] - ptr[i]
+            scan = dense and placed <= 2 * deg + 16
+            best_off, best_gap, cursor = -1, -1, 0
+            if scan:  # every placed block in offset order, skipping non-neighbours
+                if flat.adj != NULL:
+                    row = flat.adj + <Py_ssize_t> i * n
+                else:
+                    for e in range(ptr[i], ptr[i + 1]):
+                        stamp[idx[e]] = i + 1
+                for e in range(placed):
+                    j = e_blk[e]
+                    if (row[j] == 0) if flat.adj != NULL else (stamp[j] != i + 1):
+                        continue
+                    lo = e_lo[e]
+                    if lo > cursor:
+                        aligned = align_up(cursor, a)
+                        if aligned + need <= lo and (best_gap < 0 or lo - cursor < best_gap):
+                            best_off, best_gap = aligned, lo - cursor
+                    if e_hi[e] > cursor:
+                        cursor = e_hi[e]
+            else:  # its placed neighbours, sorted
+                found = 0
+                for e in range(ptr[i], ptr[i + 1]):
+                    j = idx[e]
+                    if offsets[j] >= 0:
+                        taken[found].lo = offsets[j]
+                        taken[found].hi = offsets[j] + size[j]
+                        found += 1
+                qsort(taken, found, sizeof(Range), by_lo)
+                for e in range(found):
+                    lo = taken[e].lo
+                    if lo > cursor:
+                        aligned = align_up(cursor, a)
+                        if aligned + need <= lo and (best_gap < 0 or lo - cursor < best_gap):
+                            best_off, best_gap = aligned, lo - cursor
+                    if taken[e].hi > cursor:
+                        cursor = taken[e].hi
+            off = best_off if best_off >= 0 else align_up(cursor, a)
+            top = off + need
+            if 0 <= limit <= top:
+                code = 1
+                break
+            offsets[i] = off
+            if dense:  # insert after the last entry at or below off
+                lo_k, hi_k = 0, placed
+                while lo_k < hi_k:
+                    mid = (lo_k + hi_k) >> 1
+                    if e_lo[mid] <= off:
+                        lo_k = mid + 1
+                    else:
+                        hi_k = mid
+                memmove(e_lo + lo_k + 1, e_lo + lo_k, (placed - lo_k) * sizeof(i64))
+                memmove(e_hi + lo_k + 1, e_hi + lo_k, (placed - lo_k) * sizeof(i64))
+                memmove(e_blk + lo_k + 1, e_blk + lo_k, (placed - lo_k) * sizeof(int))
+                e_lo[lo_k], e_hi[lo_k], e_blk[lo_k] = off, top, i
+            placed += 1
+    free(taken)
+    free(e_lo)
+    free(e_hi)
+    free(e_blk)
+    free(stamp)
+    return code
+
+
+def best_fit(Flat flat, order, give_up_at):
+    """``greedy.best_fit_python(inst, order, give_up_at)``: the offsets (-1 for blocks not in
+    ``order``), or None once a block's top reaches ``give_up_at``."""
+    cdef int n = flat.n, count = len(order), i, k, code
+    cdef i64 limit
+    cdef int *blocks
+    cdef i64 *offsets
+    if give_up_at is None or give_up_at < 0 or give_up_at >= LIMIT:
+        limit = -1  # never reached: every top stays below 2**62
+    else:
+        limit = give_up_at
+    blocks = <int *> malloc(max(count, 1) * sizeof(int))
+    offsets = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    try:
+        if not (blocks and offsets):
+            raise MemoryError()
+        for i in range(n):
+            offsets[i] = -1
+        k = 0
+        for x in order:
+            i = x
+            if not (0 <= i < n) or offsets[i] != -1:
+                raise ValueError("order must hold distinct blocks of the instance")
+            offsets[i] = -2  # seen
+            blocks[k] = i
+            k += 1
+        for i in range(n):
+            offsets[i] = -1
+        with nogil:
+            code = place(flat, blocks, count, limit, offsets)
+        if code < 0:
+            raise MemoryError()
+        if code == 1:
+            return None
+        return [offsets[i] for i in range(n)]
+    finally:
+        free(blocks)
+        free(offsets)

@@ -62,10 +62,10 @@ cdef class Flat:
         if not (self.size and self.align and self.nbr_ptr):
             raise MemoryError()
         for i in range(n):
-            if not (0 <= size[i] < LIMIT and 1 <= align[i] < LIMIT):
-                raise OverflowError("sizes and alignments must be in [0, 2**62), alignments positive")
-            self.size[i] = size[i]
+            self.size[i] = size[i]  # OverflowError past 64 bits
             self.align[i] = align[i]
+            if not (0 <= self.size[i] < LIMIT and 1 <= self.align[i] < LIMIT):
+                raise OverflowError("sizes and alignments must be in [0, 2**62), alignments positive")
             total += self.size[i] + self.align[i]
             if total >= LIMIT:
                 raise OverflowError("sizes and alignments sum past 2**62")

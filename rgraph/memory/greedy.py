@@ -339,12 +339,17 @@ def _merge(los: list[int], his: list[int], lo: int, hi: int) -> None:
 
 def range_max(values: Sequence[int], lo: Sequence[int], hi: Sequence[int]) -> list[int]:
     """``max(values[lo[k]:hi[k]])`` for each ``k`` (every range non-empty)."""
+    return _range_max(values, lo, hi).tolist()  # type: ignore[no-any-return]
+
+
+def _range_max(values: Sequence[int], lo: Sequence[int], hi: Sequence[int]) -> np.ndarray:
+    """``range_max`` as an int64 array (OverflowError past 64 bits)."""
     if not lo:
-        return []
+        return np.zeros(0, dtype=np.int64)
     padded = np.append(np.asarray(values, dtype=np.int64), 0)  # hi may be len(values)
     bounds = np.empty(2 * len(lo), dtype=np.int64)
     bounds[0::2], bounds[1::2] = lo, hi
-    return np.maximum.reduceat(padded, bounds)[0::2].tolist()
+    return np.maximum.reduceat(padded, bounds)[0::2]
 
 
 def _sorted_by(*columns: Sequence[int]) -> list[int]:
@@ -359,6 +364,29 @@ def _sorted_by(*columns: Sequence[int]) -> list[int]:
 def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:
     """The static orderings tried by the heuristic, in turn (all deterministic, ties by
     index); each is sorted only when asked for, so a caller that stops early pays less."""
+    keys = inst.order_keys
+    if keys is None:  # keys past 63 bits
+        yield from _orderings_python(inst)
+        return
+    start, neg_size, neg_area, neg_width = keys  # np.lexsort: the last key most significant
+    yield "size", np.lexsort((start, neg_size)).tolist()
+    yield "area", np.lexsort((neg_area,)).tolist()
+    yield "length", np.lexsort((neg_size, neg_width)).tolist()
+    yield "start", np.lexsort((neg_size, start)).tolist()
+    totals = inst.section_totals()
+    try:
+        neg_contention = -_range_max(totals, inst.sec_lo, inst.sec_hi)
+    except OverflowError:  # totals past 64 bits
+        neg_peaks = [-max(totals[lo:hi]) for lo, hi in zip(inst.sec_lo, inst.sec_hi, strict=True)]
+        yield "contention", _sorted_by(neg_peaks, inst.neg_area)
+        yield "contention_size", _sorted_by(neg_peaks, inst.neg_size)
+        return
+    yield "contention", np.lexsort((neg_area, neg_contention)).tolist()
+    yield "contention_size", np.lexsort((neg_size, neg_contention)).tolist()
+
+
+def _orderings_python(inst: Instance) -> Iterator[tuple[str, list[int]]]:
+    """``orderings`` where a key passes 63 bits (Python's sort where numpy's would overflow)."""
     s = inst.start
     neg_size, neg_area, neg_width = inst.neg_size, inst.neg_area, inst.neg_width
     yield "size", _sorted_by(neg_size, s)

@@ -114,13 +114,13 @@ class Instance:
         js: list[int] = []
         if conflicts:
             index = {b.name: k for k, b in enumerate(blocks)}
-            get = index.get
-            for name, names in conflicts.items():  # any order: only the set of pairs counts
-                k = get(name)
-                if k is not None and names:
-                    found = [j for j in map(get, names) if j is not None and j != k]
-                    ks.extend([k] * len(found))
-                    js.extend(found)
+            here = set(index)
+            at = index.__getitem__
+            for name in here.intersection(conflicts):  # any order: only the set of pairs counts
+                found = here.intersection(conflicts[name])  # the conflicting blocks of this class
+                found.discard(name)
+                ks.extend([at(name)] * len(found))
+                js.extend(map(at, found))
         separable = True
         adjacency, rows = None, None
         if len(blocks) < SWEEP_FROM:
@@ -192,6 +192,24 @@ class Instance:
     @cached_property
     def neg_size(self) -> list[int]:
         return [-z for z in self.size]
+
+    @cached_property
+    def order_keys(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """``start``, ``neg_size``, ``neg_area`` and ``neg_width`` as int64 arrays (the greedy
+        orderings' sort keys), or None where one of them passes 63 bits."""
+        if not self.n:
+            return None
+        try:
+            start = np.asarray(self.start, dtype=np.int64)
+            end = np.asarray(self.end, dtype=np.int64)
+            size = np.asarray(self.size, dtype=np.int64)
+        except OverflowError:
+            return None
+        width = int(end.max()) - int(start.min()) + 1  # at least every lifetime's
+        if width * max(int(size.max()), 1) >= 1 << 62:
+            return None
+        neg_width = start - end - 1
+        return start, -size, neg_width * size, neg_width
 
     @cached_property
     def members(self) -> np.ndarray:

@@ -53,7 +53,7 @@ cdef class Flat:
         cdef Py_ssize_t pairs = 0
         cdef i64 total = 0
         cdef const unsigned char[:, ::1] m
-        self.n, self.adj = n, NULL
+        self.n, self.adj, self.nbr_idx = n, NULL, NULL
         if len(align) != n:
             raise ValueError("inconsistent instance arrays")
         self.size = <i64 *> malloc(max(n, 1) * sizeof(i64))
@@ -75,9 +75,16 @@ cdef class Flat:
                 raise ValueError("adjacency must be n by n")
             self.matrix = adjacency
             self.adj = &m[0, 0] if n else NULL
-            for i in range(n):
-                for j in range(n):
-                    pairs += self.adj[<Py_ssize_t> i * n + j] != 0
+            with nogil:
+                for i in range(n):
+                    for j in range(n):
+                        pairs += self.adj[<Py_ssize_t> i * n + j] != 0
+            self.dense = 4 * pairs >= <Py_ssize_t> n * n
+            if self.dense:  # every block scans the placed ones against its row: no lists
+                self.nbr_idx = NULL
+                for i in range(n + 1):
+                    self.nbr_ptr[i] = 0
+                return
             self.nbr_idx = <int *> malloc(max(pairs, 1) * sizeof(int))
             if not self.nbr_idx:
                 raise MemoryError()
@@ -86,7 +93,7 @@ cdef class Flat:
                 for i in range(n):
                     self.nbr_ptr[i] = k
                     for j in range(n):
-                        if self.adj[<Py_ssize_t> i * n + j] and j != i:
+                        if self.adj[<Py_ssize_t> i * n + j]:
                             self.nbr_idx[k] = j
                             k += 1
         else:
@@ -102,7 +109,7 @@ cdef class Flat:
                 self.nbr_ptr[i] = k
                 for x in neighbors[i]:
                     j = x
-                    if not (0 <= j < n) or j == i:
+                    if not (0 <= j < n):
                         raise ValueError("neighbour out of range")
                     self.nbr_idx[k] = j
                     k += 1
@@ -154,7 +161,7 @@ cdef int place(Flat flat, const int *order, int count, i64 limit, i64 *offsets) 
             i = order[k]
             need, a = size[i], align[i]
             deg = ptr[i + 1] - ptr[i]
-            scan = dense and placed <= 2 * deg + 16
+            scan = dense and (flat.adj != NULL or placed <= 2 * deg + 16)
             best_off, best_gap, cursor = -1, -1, 0
             if scan:  # every placed block in offset order, skipping non-neighbours
                 if flat.adj != NULL:
@@ -255,3 +262,52 @@ def best_fit(Flat flat, order, give_up_at):
     finally:
         free(blocks)
         free(offsets)
+
+
+def clique_extra(Flat flat, members):
+    """``bounds.clique_bound``'s greedy growth on the conflict matrix: starting from the
+    blocks that may not share bytes with every one of ``members``, add the heaviest (by
+    size as a float, the first of equal ones), keep those in conflict with it, until none
+    is left; the sizes added. Needs the matrix (``adjacency``)."""
+    cdef int n = flat.n, i, j, k, m, count = len(members)
+    cdef Py_ssize_t n_ = n
+    cdef const unsigned char *adj = flat.adj
+    cdef i64 extra = 0
+    cdef double best
+    cdef unsigned char *joinable
+    cdef int *chosen
+    if adj == NULL and n:
+        raise ValueError("clique_extra needs the conflict matrix")
+    joinable = <unsigned char *> malloc(max(n, 1))
+    chosen = <int *> malloc(max(count, 1) * sizeof(int))
+    try:
+        if not (joinable and chosen):
+            raise MemoryError()
+        k = 0
+        for x in members:
+            m = x
+            if not (0 <= m < n):
+                raise IndexError("member out of range")
+            chosen[k] = m
+            k += 1
+        with nogil:
+            for i in range(n):
+                joinable[i] = 1
+                for k in range(count):
+                    if not adj[i * n_ + chosen[k]]:
+                        joinable[i] = 0
+                        break
+            while True:
+                j, best = -1, -1.0
+                for i in range(n):
+                    if joinable[i] and <double> flat.size[i] > best:
+                        j, best = i, <double> flat.size[i]
+                if j < 0:
+                    break
+                extra += flat.size[j]
+                for i in range(n):
+                    joinable[i] = joinable[i] and adj[i * n_ + j]
+        return extra
+    finally:
+        free(joinable)
+        free(chosen)

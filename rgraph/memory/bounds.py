@@ -6,6 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from rgraph.memory import greedy
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block, by_class
 
@@ -43,9 +44,20 @@ def clique_bound(inst: Instance) -> int:
     totals = inst.section_totals()
     if not totals or inst.adjacency is None or inst.separable:
         return max(totals, default=0)
-    busiest = max(range(len(totals)), key=totals.__getitem__)
+    busiest = totals.index(max(totals))  # the first busiest
     weight = totals[busiest]
     members = [i for i, (lo, hi) in enumerate(zip(inst.sec_lo, inst.sec_hi, strict=True)) if lo <= busiest < hi]
+    flat = None if greedy.NATIVE is None else greedy.native_flat(greedy.NATIVE, inst)
+    if flat is not None:  # the same growth, compiled (rgraph/memory/_fit.pyx)
+        return weight + greedy.NATIVE.clique_extra(flat, members)  # type: ignore[no-any-return]
+    return weight + _clique_extra(inst, members)
+
+
+def _clique_extra(inst: Instance, members: list[int]) -> int:
+    """``clique_bound``'s growth from the blocks in conflict with all ``members``: the
+    heaviest joinable one in turn (``_fit.clique_extra`` mirrors it)."""
+    assert inst.adjacency is not None
+    weight = 0
     joinable = inst.adjacency[:, members].all(axis=1)
     sizes = np.asarray(inst.size, dtype=np.float64)  # ranks only: exact weights come from inst.size
     while joinable.any():

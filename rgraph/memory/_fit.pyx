@@ -14,7 +14,7 @@ or by sorting its own placed neighbours. Which way is used changes the time only
 scan depends only on the first of equal offsets and the highest top so far. ``Flat`` is
 one instance's arrays, made once per ``Instance`` (``greedy.native_flat``)."""
 
-from libc.stdlib cimport free, malloc, qsort
+from libc.stdlib cimport free, malloc, qsort, realloc
 from libc.string cimport memmove
 
 ctypedef long long i64
@@ -311,3 +311,73 @@ def clique_extra(Flat flat, members):
     finally:
         free(joinable)
         free(chosen)
+
+
+def conflict_matrix(start, end, names, conflicts):
+    """``instance.time_overlaps(start, end)`` with the ``conflicts`` among ``names`` (a
+    mapping from a name to names it may not share bytes with; names of other classes are
+    skipped) added where some pair is apart in time, as ``Instance.build`` does:
+    ``(adjacency, separable)``, ``separable`` when every conflicting pair overlaps in time
+    (the matrix then holds the time overlaps only). OverflowError where a time passes
+    64 bits."""
+    import numpy as np
+
+    cdef Py_ssize_t n = len(start), i, j, k, count = 0, room = 64
+    cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef Py_ssize_t *pairs = <Py_ssize_t *> malloc(2 * room * sizeof(Py_ssize_t))
+    cdef Py_ssize_t *grown
+    cdef unsigned char[:, ::1] m
+    cdef unsigned char *adj
+    cdef bint separable = True
+    cdef dict index
+    try:
+        if not (s and e and pairs):
+            raise MemoryError()
+        if len(end) != n or len(names) != n:
+            raise ValueError("inconsistent instance arrays")
+        for i in range(n):
+            s[i] = start[i]
+            e[i] = end[i]
+        if conflicts:
+            index = {name: i for i, name in enumerate(names)}
+            get = conflicts.get
+            for i in range(n):
+                row = get(names[i])
+                if not row:
+                    continue
+                for other in row:
+                    found = index.get(other)
+                    if found is None:
+                        continue
+                    j = found
+                    if j == i:
+                        continue
+                    if count == room:
+                        room *= 2
+                        grown = <Py_ssize_t *> realloc(pairs, 2 * room * sizeof(Py_ssize_t))
+                        if not grown:
+                            raise MemoryError()
+                        pairs = grown
+                    pairs[2 * count], pairs[2 * count + 1] = i, j
+                    count += 1
+        matrix = np.empty((n, n), dtype=np.uint8)
+        if n:
+            m = matrix
+            adj = &m[0, 0]
+            with nogil:
+                for i in range(n):
+                    for j in range(n):
+                        adj[i * n + j] = s[i] <= e[j] and e[i] >= s[j] and i != j
+                for k in range(count):
+                    if not adj[pairs[2 * k] * n + pairs[2 * k + 1]]:
+                        separable = False
+                        break
+                if not separable:
+                    for k in range(count):
+                        adj[pairs[2 * k] * n + pairs[2 * k + 1]] = 1
+        return matrix.view(np.bool_), separable
+    finally:
+        free(s)
+        free(e)
+        free(pairs)

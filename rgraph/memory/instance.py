@@ -13,6 +13,10 @@ from typing import Any
 import numpy as np
 
 from rgraph.memory.model import Block
+from rgraph.native import load
+
+#: ``rgraph/memory/_fit.pyx`` (its ``conflict_matrix``), None where not built or ``RGRAPH_NATIVE=0``.
+_NATIVE = load("rgraph.memory._fit")
 
 #: From this many blocks, neighbours come from a sweep over start times (cost in the pairs
 #: found) instead of one numpy row per block (cost n**2, cheap per element).
@@ -76,6 +80,47 @@ def sections(start: Sequence[int], end: Sequence[int]) -> tuple[list[int], list[
             max(len(coords) - 1, 0))
 
 
+def _conflict_graph(blocks: Sequence[Block], start: list[int], end: list[int],
+                    conflicts: Mapping[str, Collection[str]] | None) -> tuple[np.ndarray | None, list[list[int]] | None, bool]:
+    """``Instance.build``'s ``(adjacency, rows, separable)``: the conflict matrix below
+    :data:`SWEEP_FROM` blocks (``rgraph/memory/_fit.pyx``'s ``conflict_matrix`` makes the
+    same), else the neighbour lists; ``separable``: every conflicting pair overlaps in time."""
+    ks: list[int] = []  # conflicting pairs (k, j), some of them overlapping in time as well
+    js: list[int] = []
+    if conflicts:
+        index = {b.name: k for k, b in enumerate(blocks)}
+        here = set(index)
+        at = index.__getitem__
+        for name in here.intersection(conflicts):  # any order: only the set of pairs counts
+            found = here.intersection(conflicts[name])  # the conflicting blocks of this class
+            found.discard(name)
+            ks.extend([at(name)] * len(found))
+            js.extend(map(at, found))
+    separable = True
+    adjacency, rows = None, None
+    if len(blocks) < SWEEP_FROM:
+        adjacency = time_overlaps(start, end)
+        if ks:  # pairs apart in time (not overlapping): beyond what the time sections see
+            pairs = (np.array(ks, dtype=np.intp), np.array(js, dtype=np.intp))
+            separable = bool(adjacency[pairs].all())
+            if not separable:
+                adjacency[pairs] = True  # those overlapping in time are already
+    else:
+        if ks:  # pairs apart in time: beyond what the time sections see
+            starts, ends = np.asarray(start, dtype=np.int64), np.asarray(end, dtype=np.int64)
+            apart = (starts[js] > ends[ks]) | (ends[js] < starts[ks])
+            separable = not apart.any()
+        rows = time_neighbors(start, end)
+        if not separable:
+            by_block: dict[int, set[int]] = {}
+            for k, j, far in zip(ks, js, apart.tolist(), strict=True):
+                if far:
+                    by_block.setdefault(k, set()).add(j)
+            for k, extra in by_block.items():
+                rows[k] = sorted(rows[k] + list(extra))
+    return adjacency, rows, separable
+
+
 @dataclass
 class Instance:
     """Blocks of one memory class, indexed 0..n-1 in input order.
@@ -110,39 +155,14 @@ class Instance:
         blocks = list(blocks)
         start = [b.start for b in blocks]
         end = [b.end for b in blocks]
-        ks: list[int] = []  # conflicting pairs (k, j), some of them overlapping in time as well
-        js: list[int] = []
-        if conflicts:
-            index = {b.name: k for k, b in enumerate(blocks)}
-            here = set(index)
-            at = index.__getitem__
-            for name in here.intersection(conflicts):  # any order: only the set of pairs counts
-                found = here.intersection(conflicts[name])  # the conflicting blocks of this class
-                found.discard(name)
-                ks.extend([at(name)] * len(found))
-                js.extend(map(at, found))
-        separable = True
-        adjacency, rows = None, None
-        if len(blocks) < SWEEP_FROM:
-            adjacency = time_overlaps(start, end)
-            if ks:  # pairs apart in time (not overlapping): beyond what the time sections see
-                pairs = (np.array(ks, dtype=np.intp), np.array(js, dtype=np.intp))
-                separable = bool(adjacency[pairs].all())
-                if not separable:
-                    adjacency[pairs] = True  # those overlapping in time are already
-        else:
-            if ks:  # pairs apart in time: beyond what the time sections see
-                starts, ends = np.asarray(start, dtype=np.int64), np.asarray(end, dtype=np.int64)
-                apart = (starts[js] > ends[ks]) | (ends[js] < starts[ks])
-                separable = not apart.any()
-            rows = time_neighbors(start, end)
-            if not separable:
-                by_block: dict[int, set[int]] = {}
-                for k, j, far in zip(ks, js, apart.tolist(), strict=True):
-                    if far:
-                        by_block.setdefault(k, set()).add(j)
-                for k, extra in by_block.items():
-                    rows[k] = sorted(rows[k] + list(extra))
+        adjacency, rows, separable = None, None, True
+        if len(blocks) < SWEEP_FROM and _NATIVE is not None:
+            try:  # the same matrix, compiled
+                adjacency, separable = _NATIVE.conflict_matrix(start, end, [b.name for b in blocks], conflicts)
+            except OverflowError:  # times past 64 bits
+                pass
+        if adjacency is None:
+            adjacency, rows, separable = _conflict_graph(blocks, start, end, conflicts)
         sec_lo, sec_hi, section_count = sections(start, end)
         return cls(
             blocks=blocks,

@@ -14,8 +14,8 @@ include "../plan/_slots.pxi"
 
 from rgraph.compiler.trace import ResourceTrace
 
-cdef Slots ACCESS = Slots(pm.Access)
-cdef Slots TRACE = Slots(ResourceTrace)
+cdef Slots ACCESS = Slots(pm.Access, ("resource", "subresource", "usage", "stages", "access", "layout", "write"))
+cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group", "single"))
 cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared, never replaced)
 
 

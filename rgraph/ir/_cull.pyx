@@ -90,7 +90,7 @@ def split(list kept, set alive, culled_class):
     """``_split(kept, alive)``; ``culled_class``: ``rgraph.ir.cull.Culled``."""
     global CULLED
     if CULLED is None or CULLED.cls is not culled_class:
-        CULLED = Slots(culled_class)
+        CULLED = Slots(culled_class, ("pass_name", "reason"))
     cdef list final = [], unreached = []
     for p in kept:
         name = p.name

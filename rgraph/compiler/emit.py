@@ -11,6 +11,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from rgraph.defaults import DEFAULT_SCHEDULE
+from rgraph.native import load
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
 
@@ -23,6 +24,11 @@ SIGNAL_STAGES = ("ALL_COMMANDS",)
 # from the sync phase as plan values.
 _Access, _Pass, _Resource = (builder(c) for c in (pm.Access, pm.PlanPass, pm.PlanResource))
 _Wait, _Signal, _Culled = (builder(c) for c in (pm.Wait, pm.Signal, pm.Culled))
+
+#: The compiled mirror of :func:`_passes_python`, :func:`_resources_python` and
+#: :func:`_culled_python` (``rgraph/compiler/_emit.pyx``), None where it is not built or
+#: ``RGRAPH_NATIVE=0``.
+NATIVE = load("rgraph.compiler._emit")
 
 
 def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -39,6 +45,16 @@ def _frozen_json(value: Any) -> Any:
 
 
 def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
+    """The plan's passes (compiled where built)."""
+    if NATIVE is None:
+        return _passes_python(c)
+    sync, trace = c.sync, c.trace
+    assert sync is not None and trace is not None
+    return NATIVE.passes(list(c.passes), trace.accesses, sync.barriers, sync.releases, sync.waits, sync.signals,
+                         sync.signal_values, _frozen, SIGNAL_STAGES)
+
+
+def _passes_python(c: Compilation) -> tuple[pm.PlanPass, ...]:
     passes, sync, trace = c.passes, c.sync, c.trace
     assert sync is not None and trace is not None
     signals, signal_values = sync.signals, sync.signal_values
@@ -56,6 +72,16 @@ def _passes(c: Compilation) -> tuple[pm.PlanPass, ...]:
 
 
 def _resources(c: Compilation) -> tuple[pm.PlanResource, ...]:
+    """The plan's resources, in name order (compiled where built)."""
+    if NATIVE is None:
+        return _resources_python(c)
+    sync, placement = c.sync, c.placement
+    assert sync is not None and placement is not None
+    return NATIVE.resources(c.spec.resources, c.memory, set(c.spec.outputs), sync.initial, sync.final,
+                            placement.offsets, _frozen_json)
+
+
+def _resources_python(c: Compilation) -> tuple[pm.PlanResource, ...]:
     spec, sync, placement, memory = c.spec, c.sync, c.placement, c.memory
     assert sync is not None and placement is not None
     out = []
@@ -111,7 +137,14 @@ def emit(c: Compilation) -> pm.Plan:
 
 def _culled(c: Compilation) -> tuple[pm.Culled, ...]:
     """The culled passes, each with the resources only culled passes used and their bytes
-    (``measure`` found them)."""
+    (``measure`` found them; compiled where built)."""
+    if NATIVE is None:
+        return _culled_python(c)
+    assert c.culling is not None
+    return NATIVE.culled(c.culling.culled, c.culled_only, c.culled_bytes)
+
+
+def _culled_python(c: Compilation) -> tuple[pm.Culled, ...]:
     assert c.culling is not None
     get_only, get_bytes = c.culled_only.get, c.culled_bytes.get
     out = []

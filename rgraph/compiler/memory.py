@@ -15,6 +15,7 @@ from typing import Protocol
 
 from rgraph.errors import RGraphError
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats
+from rgraph.native import load
 from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
 
@@ -55,6 +56,11 @@ class ResourceMemory:
 
 _requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  # one per used resource
 
+#: The compiled mirror of :func:`requirements_python`, :func:`resource_memory_python`,
+#: :func:`alias_sources_python` and ``phases._culled_only_python`` (``rgraph/compiler/_memory.pyx``),
+#: None where it is not built or ``RGRAPH_NATIVE=0``.
+NATIVE = load("rgraph.compiler._memory")
+
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
 _SAME_BUFFER_FLAG = {"storage_read": "storage_rw", "storage_write": "storage_rw",
                      "accel_build": "accel_storage", "accel_read": "accel_storage"}
@@ -83,7 +89,18 @@ def requirements(
     outputs: Sequence[str],
     provider: MemoryRequirementsProvider,
 ) -> dict[str, Requirement]:
-    """The requirement of each used resource, in name order."""
+    """The requirement of each used resource, in name order (compiled where built)."""
+    if NATIVE is None:
+        return requirements_python(resources, used, outputs, provider)
+    return NATIVE.requirements(resources, used, outputs, provider, _SAME_BUFFER_FLAG)
+
+
+def requirements_python(
+    resources: Mapping[str, ResourceSpec],
+    used: Mapping[str, set[str]],
+    outputs: Sequence[str],
+    provider: MemoryRequirementsProvider,
+) -> dict[str, Requirement]:
     out = {}
     kept = set(outputs)  # a list: 5,000 side-effect outputs made this quadratic
     for name in sorted(used):
@@ -121,7 +138,16 @@ def memory_classes(reqs: Mapping[str, Requirement]) -> dict[str, str]:
 def resource_memory(
     reqs: Mapping[str, Requirement], used: Mapping[str, set[str]], spans: Mapping[str, tuple[int, int]]
 ) -> dict[str, ResourceMemory]:
-    """Requirements, classes, usages and lifetimes of the used resources, in name order."""
+    """Requirements, classes, usages and lifetimes of the used resources, in name order
+    (compiled where built)."""
+    if NATIVE is None:
+        return resource_memory_python(reqs, used, spans)
+    return NATIVE.resource_memory(reqs, used, spans)
+
+
+def resource_memory_python(
+    reqs: Mapping[str, Requirement], used: Mapping[str, set[str]], spans: Mapping[str, tuple[int, int]]
+) -> dict[str, ResourceMemory]:
     classes = memory_classes(reqs)
     return {
         name: _resource_memory(r.bytes, r.alignment, r.memory_type_bits, classes[name], tuple(sorted(used[name])),
@@ -165,6 +191,13 @@ def place_resources(
 
 
 def alias_sources(placement: Placement, memory: Mapping[str, ResourceMemory]) -> dict[str, list[str]]:
+    """:func:`alias_sources_python`, compiled where built."""
+    if NATIVE is None:
+        return alias_sources_python(placement, memory)
+    return NATIVE.alias_sources(placement, memory)
+
+
+def alias_sources_python(placement: Placement, memory: Mapping[str, ResourceMemory]) -> dict[str, list[str]]:
     """For each resource, the earlier resources whose memory it reuses and that it must wait for.
 
     An earlier overlapping resource is skipped when a later one, itself overlapping both,

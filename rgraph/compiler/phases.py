@@ -122,7 +122,15 @@ def measure(c: Compilation) -> Compilation:
 def _culled_only(spec: Spec, culled: Sequence[Culled], traced: Mapping[str, object]
                  ) -> tuple[dict[str, tuple[str, ...]], list[PassSpec]]:
     """Per culled pass that uses resources no executed pass uses (not in ``traced``): those,
-    sorted; and those passes (the only ones whose usages size a culled-only resource)."""
+    sorted; and those passes (the only ones whose usages size a culled-only resource).
+    Compiled where built (``memory.NATIVE``)."""
+    if memory.NATIVE is None:
+        return _culled_only_python(spec, culled, traced)
+    return memory.NATIVE.culled_only(spec.passes, culled, traced)
+
+
+def _culled_only_python(spec: Spec, culled: Sequence[Culled], traced: Mapping[str, object]
+                        ) -> tuple[dict[str, tuple[str, ...]], list[PassSpec]]:
     if not culled:
         return {}, []
     by_name = {p.name: p for p in spec.passes}

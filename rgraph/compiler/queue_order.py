@@ -20,10 +20,23 @@ from bisect import bisect_left, bisect_right
 from collections.abc import Collection, Sequence
 
 from rgraph.compiler.trace import Trace
+from rgraph.native import load
 from rgraph.spec.specialize import PassSpec
+
+#: The compiled mirror of :func:`cross_queue_conflicts_python` (``rgraph/compiler/_queue_order.pyx``),
+#: None where it is not built or ``RGRAPH_NATIVE=0``.
+NATIVE = load("rgraph.compiler._queue_order")
 
 
 def cross_queue_conflicts(passes: Sequence[PassSpec], trace: Trace, candidates: Collection[str]) -> dict[str, set[str]]:
+    """:func:`cross_queue_conflicts_python`, compiled where built."""
+    if NATIVE is None:
+        return cross_queue_conflicts_python(passes, trace, candidates)
+    return NATIVE.cross_queue_conflicts(passes, trace, candidates)
+
+
+def cross_queue_conflicts_python(passes: Sequence[PassSpec], trace: Trace, candidates: Collection[str]
+                                 ) -> dict[str, set[str]]:
     """Pairs of ``candidates`` (symmetric) that may not share memory although one ends before
     the other starts: sharing would add a cross-queue wait. Empty for one-queue graphs.
     ``trace``: the passes' (``rgraph.compiler.trace``), whose ``waits`` are the dedicated plan's."""

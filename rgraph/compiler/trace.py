@@ -18,6 +18,7 @@ from rgraph.compiler.plan_values import get_subresource, names, subresource
 from rgraph.compiler.read_layouts import to_general
 from rgraph.compiler.usages import Sync, merge, sync_of
 from rgraph.ir.graph import Cell
+from rgraph.native import load
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, ResourceSpec
@@ -27,8 +28,8 @@ from rgraph.spec.specialize import PassSpec, ResourceSpec
 #: as much to build).
 Use = tuple[int, Sync, bool, str, int]
 
-#: (sync_of, its stage names, its access names) by (usage, kind, stages, format code, refit)
-_SCOPES: dict[tuple, tuple[Sync, tuple[str, ...], tuple[str, ...]]] = {}
+#: (sync_of, its stage names, its access names, its layout) by (usage, kind, stages, format code, refit)
+_SCOPES: dict[tuple, tuple[Sync, tuple[str, ...], tuple[str, ...], str | None]] = {}
 
 
 @dataclass(slots=True)
@@ -48,6 +49,10 @@ class ResourceTrace:
 
 _new_trace = builder(ResourceTrace)
 _new_access = builder(pm.Access)
+
+#: The compiled mirror of :func:`walk_python` (``rgraph/compiler/_trace.pyx``), None where it
+#: is not built or ``RGRAPH_NATIVE=0``.
+NATIVE = load("rgraph.compiler._trace")
 
 
 @dataclass
@@ -70,19 +75,34 @@ def _start(res: ResourceSpec, i: int, usage: str) -> ResourceTrace:
     return _new_trace({usage}, i, i, [], image + 2 * depth + 4 * stencil, group, single)
 
 
-def _scope(key: tuple) -> tuple[Sync, tuple[str, ...], tuple[str, ...]]:
+def _scope(key: tuple) -> tuple[Sync, tuple[str, ...], tuple[str, ...], str | None]:
     usage, kind, stages, code, refit = key
     if len(_SCOPES) > 4096:
         _SCOPES.clear()
     s = sync_of(usage, kind, explicit_stages=stages, is_image=bool(code & 1), depth_format=bool(code & 2),
                 stencil_format=bool(code & 4), refit=refit)
-    found = _SCOPES[key] = (s, names(s.stages), names(s.access))
+    found = _SCOPES[key] = (s, names(s.stages), names(s.access), s.layout)
     return found
 
 
 def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> Trace:
-    """Scopes, usages, lifetimes, timelines and cross-queue waits in one walk; the reads
-    ``read_layouts`` moves to GENERAL are patched in afterwards (a few per graph)."""
+    """Scopes, usages, lifetimes, timelines and cross-queue waits in one walk (compiled where
+    built: :data:`NATIVE`, else :func:`walk_python`); the reads ``read_layouts`` moves to
+    GENERAL are patched in afterwards (a few per graph)."""
+    if NATIVE is None:
+        walked = walk_python(passes, resources)
+    else:
+        walked = NATIVE.walk(passes, resources, _SCOPES, _scope)
+    return _finish(passes, *walked)
+
+
+Walked = tuple[list[list[pm.Access]], dict[str, ResourceTrace], dict[Cell, list[Use]], dict[int, dict[str, int]]]
+
+
+def walk_python(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> Walked:
+    """The walk: per pass its plan accesses; the resources' traces; the timelines of the cells
+    of resources of several cells; the cross-queue waits. ``rgraph/compiler/_trace.pyx``
+    mirrors it (same values)."""
     plan_accesses: list[list[pm.Access]] = []
     info: dict[str, ResourceTrace] = {}
     full: dict[str, tuple] = {}  # read-group candidates: (0, mips), (0, layers)
@@ -120,7 +140,7 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                 sub = get_sub((mips, a.layers))
                 if sub is None:
                     sub = subresource(mips, a.layers)
-            values.append(new_access(name, sub, usage, scope[1], scope[2], s.layout, w))
+            values.append(new_access(name, sub, usage, scope[1], scope[2], scope[3], w))
             group = r.group
             if group is not None:
                 whole = full[name]
@@ -170,6 +190,12 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
                 uses.append((i, s, w, queue, pos))
                 pos += 1
         plan_accesses.append(values)
+    return plan_accesses, info, timeline, waits
+
+
+def _finish(passes: Sequence[PassSpec], plan_accesses: list[list[pm.Access]], info: dict[str, ResourceTrace],
+            timeline: dict[Cell, list[Use]], waits: dict[int, dict[str, int]]) -> Trace:
+    """The walk's results with the reads ``read_layouts`` moves to GENERAL patched in."""
     moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
     general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
     rows: dict[int, list[Sync]] = {}  # the passes with a moved read: the scope of each access

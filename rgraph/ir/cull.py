@@ -16,6 +16,7 @@ from functools import cached_property
 import networkx as nx
 
 from rgraph.ir.graph import READ_WRITE_USAGES, Cell, build_graph, last_writers
+from rgraph.native import load
 from rgraph.plan.builders import builder
 from rgraph.spec.specialize import PassSpec, Spec
 
@@ -27,6 +28,10 @@ class Culled:
 
 
 _new_culled = builder(Culled)
+
+#: The compiled mirror of :func:`_alive_python` and :func:`_has_optional_python`
+#: (``rgraph/ir/_cull.pyx``), None where it is not built or ``RGRAPH_NATIVE=0``.
+NATIVE = load("rgraph.ir._cull")
 
 
 @dataclass(frozen=True)
@@ -54,13 +59,7 @@ def cull(spec: Spec) -> Culling:
     kept, dropped, cascade = _drop_unproduced_reads(spec, removed_reason)
     culled += cascade
     alive = _alive(spec, kept)
-    final = []
-    unreached = []
-    for p in kept:
-        if p.name in alive:
-            final.append(p)
-        else:
-            unreached.append(_new_culled(p.name, "reaches no output"))
+    final, unreached = _split(kept, alive) if NATIVE is None else NATIVE.split(kept, alive, Culled)
     if not culled:  # kept is in declaration order
         return Culling(final, unreached, dropped)
     culled += unreached
@@ -70,6 +69,40 @@ def cull(spec: Spec) -> Culling:
 
 
 def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
+    """The passes of ``kept`` that reach an output: :func:`_alive_python`, compiled where built."""
+    if NATIVE is None:
+        return _alive_python(spec, kept)
+    return NATIVE.alive(spec, kept, READ_WRITE_USAGES)
+
+
+def _split(kept: list[PassSpec], alive: set[str]) -> tuple[list[PassSpec], list[Culled]]:
+    """The passes of ``kept`` in ``alive``, and the others as culled ("reaches no output")."""
+    final = []
+    unreached = []
+    for p in kept:
+        if p.name in alive:
+            final.append(p)
+        else:
+            unreached.append(_new_culled(p.name, "reaches no output"))
+    return final, unreached
+
+
+def _has_optional(passes: list[PassSpec]) -> bool:
+    """Whether any access of ``passes`` is optional (compiled where built)."""
+    if NATIVE is None:
+        return _has_optional_python(passes)
+    return NATIVE.has_optional(passes)
+
+
+def _has_optional_python(passes: list[PassSpec]) -> bool:
+    for p in passes:
+        for a in p.accesses:
+            if a.optional:
+                return True
+    return False
+
+
+def _alive_python(spec: Spec, kept: list[PassSpec]) -> set[str]:
     """``raw_ancestors(dependencies(kept), _roots(spec, kept))`` as one backwards walk:
     ``wanted`` holds the cells that live passes read and whose producer is not met yet,
     ``claimed`` the cells of kept resources that a later pass writes last. (Within a pass,
@@ -197,7 +230,7 @@ def _drop_optional_reads(spec: Spec) -> tuple[list[PassSpec], list[DroppedRead],
     pass is removed and only optional reads of cells nothing wrote are dropped. A pass's
     writes are noted as they come (they overlap none of its reads: ``specialize`` checks it).
     Without optional reads (one scan finds them) nothing is dropped: no walk."""
-    if not any(a.optional for p in spec.passes for a in p.accesses):
+    if not _has_optional(spec.passes):
         return list(spec.passes), [], []
     produced: set[tuple[str, int, int]] = set()
     kept: list[PassSpec] = []

@@ -1,0 +1,118 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
+"""Compiled mirror of ``rgraph.compiler.emit``'s ``_passes_python``, ``_resources_python`` and
+``_culled_python``: the same plan values, each stored slot by slot (``rgraph/plan/_slots.pxi``)
+instead of through its builder. Any change to the Python code must be made here too
+(tests/compiler/test_emit_native.py compares the two)."""
+
+from rgraph.plan import model as pm
+
+include "../plan/_slots.pxi"
+
+cdef Slots PASS = Slots(pm.PlanPass, ("name", "index", "device", "queue", "kind", "impl", "params", "accesses",
+                                     "barriers", "releases", "waits", "signals"))
+cdef Slots RESOURCE = Slots(pm.PlanResource, (
+    "name", "kind", "format", "bytes", "size_bytes", "alignment", "memory_type_bits", "memory_class", "usages",
+    "lifetime", "first", "last", "heap", "offset", "initial", "final", "extent", "mips", "layers", "samples", "accel",
+    "scratch_of"))
+cdef Slots CULLED = Slots(pm.Culled, ("pass_name", "reason", "resources", "bytes"))
+cdef Slots SIGNAL = Slots(pm.Signal, ("queue", "value", "stages"))
+cdef object EMPTY = pm.EMPTY
+
+
+def passes(list passes, list accesses, barriers, releases, waits, signals, signal_values, frozen, tuple signal_stages):
+    """``_passes_python``'s tuple; ``frozen``: ``emit._frozen``."""
+    cdef Py_ssize_t i, n = len(passes)
+    cdef list out = []
+    if len(accesses) != n:
+        raise ValueError("zip() argument 2 is shorter or longer than argument 1")
+    for i in range(n):
+        p = passes[i]
+        params = p.params
+        queue = p.queue
+        value = new_slots(PASS)
+        put(value, PASS, 0, p.name)
+        put(value, PASS, 1, i)
+        put(value, PASS, 2, 0)
+        put(value, PASS, 3, queue)
+        put(value, PASS, 4, p.kind)
+        put(value, PASS, 5, p.impl)
+        put(value, PASS, 6, frozen(params) if params else EMPTY)
+        put(value, PASS, 7, tuple(<list> accesses[i]))
+        put(value, PASS, 8, barriers[i])
+        put(value, PASS, 9, releases[i])
+        put(value, PASS, 10, waits[i])
+        if signals[i]:
+            signal = new_slots(SIGNAL)
+            put(signal, SIGNAL, 0, queue)
+            put(signal, SIGNAL, 1, signal_values[i])
+            put(signal, SIGNAL, 2, signal_stages)
+            put(value, PASS, 11, (signal,))
+        else:
+            put(value, PASS, 11, ())
+        out.append(value)
+    return tuple(out)
+
+
+def resources(resources, memory, set outputs, initial, final, offsets, frozen_json):
+    """``_resources_python``'s tuple; ``frozen_json``: ``emit._frozen_json``."""
+    cdef list out = []
+    for name in sorted(memory):
+        res, mem = resources[name], memory[name]
+        heap, offset = offsets[name]
+        lifetime = res.lifetime
+        if name in outputs and lifetime == "transient":
+            lifetime = "output"
+        fmt = res.format
+        accel = res.accel
+        kind = res.kind
+        value = new_slots(RESOURCE)
+        put(value, RESOURCE, 0, name)
+        put(value, RESOURCE, 1, kind)
+        put(value, RESOURCE, 2, fmt.vk_name if fmt else None)
+        put(value, RESOURCE, 3, mem.bytes)
+        put(value, RESOURCE, 5, mem.alignment)
+        put(value, RESOURCE, 6, mem.memory_type_bits)
+        put(value, RESOURCE, 7, mem.memory_class)
+        put(value, RESOURCE, 8, mem.usages)
+        put(value, RESOURCE, 9, lifetime)
+        put(value, RESOURCE, 10, mem.first)
+        put(value, RESOURCE, 11, mem.last)
+        put(value, RESOURCE, 12, heap)
+        put(value, RESOURCE, 13, offset)
+        put(value, RESOURCE, 14, initial.get(name))
+        put(value, RESOURCE, 15, final.get(name))
+        if kind == "image":
+            put(value, RESOURCE, 4, None)
+            put(value, RESOURCE, 16, tuple(res.extent))
+            put(value, RESOURCE, 17, res.mips)
+            put(value, RESOURCE, 18, res.layers)
+            put(value, RESOURCE, 19, res.samples)
+        else:
+            put(value, RESOURCE, 4, res.bytes)
+            put(value, RESOURCE, 16, None)
+            put(value, RESOURCE, 17, None)
+            put(value, RESOURCE, 18, None)
+            put(value, RESOURCE, 19, None)
+        put(value, RESOURCE, 20, frozen_json(accel.as_plan()) if accel is not None else None)
+        put(value, RESOURCE, 21, res.scratch_of)
+        out.append(value)
+    return tuple(out)
+
+
+def culled(culled, culled_only, culled_bytes):
+    """``_culled_python``'s tuple."""
+    cdef list out = []
+    for x in culled:
+        name = x.pass_name
+        only = culled_only.get(name)
+        value = new_slots(CULLED)
+        put(value, CULLED, 0, name)
+        put(value, CULLED, 1, x.reason)
+        if only is None:
+            put(value, CULLED, 2, ())
+            put(value, CULLED, 3, 0)
+        else:
+            put(value, CULLED, 2, only)
+            put(value, CULLED, 3, sum([culled_bytes.get(r, 0) for r in only]))
+        out.append(value)
+    return tuple(out)

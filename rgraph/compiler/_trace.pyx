@@ -1,0 +1,169 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
+"""Compiled mirror of ``rgraph.compiler.trace.walk_python``: the same walk over the executed
+passes' accesses, with the same results (plan accesses, resource traces, timelines, waits),
+built with typed locals. A resource's trace is kept in a C struct (``_Res``) during the walk
+and becomes a ``ResourceTrace`` at the end; plan values are stored slot by slot
+(``rgraph/plan/_slots.pxi``). Any change to the Python walk must be made here too
+(tests/compiler/test_trace_native.py compares the two)."""
+
+from rgraph.compiler.plan_values import get_subresource, subresource
+from rgraph.compiler.usages import merge
+from rgraph.plan import model as pm
+
+include "../plan/_slots.pxi"
+
+from rgraph.compiler.trace import ResourceTrace
+
+cdef Slots ACCESS = Slots(pm.Access, ("resource", "subresource", "usage", "stages", "access", "layout", "write"))
+cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group", "single"))
+cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared, never replaced)
+
+
+cdef class _Res:
+    """A resource's ``ResourceTrace`` fields during the walk, and its whole-image ranges."""
+
+    cdef set usages
+    cdef Py_ssize_t first, last
+    cdef list cells
+    cdef object code  # int
+    cdef list group  # or None
+    cdef bint single
+    cdef object mips, layers  # read-group candidates: (0, mips), (0, layers)
+
+
+cdef _Res _start(res, Py_ssize_t i, usage):
+    """``trace._start``: a resource's trace at its first use."""
+    cdef _Res r = _Res.__new__(_Res)
+    cdef bint image = res.kind == "image", depth = False, stencil = False
+    fmt = res.format
+    if fmt is not None:
+        depth, stencil = bool(fmt.has_depth), bool(fmt.has_stencil)
+    r.usages = {usage}
+    r.first = r.last = i
+    r.cells = []
+    r.code = image + 2 * depth + 4 * stencil
+    if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil:
+        r.group = []
+        r.mips, r.layers = (0, res.mips), (0, res.layers)
+    else:
+        r.group = None
+    r.single = not image or res.mips * res.layers == 1
+    return r
+
+
+cdef inline void _wait(dict waits, object i, tuple prev, object q):
+    """The dedicated plan's wait of pass ``i`` for ``prev`` (a use on queue ``q``)."""
+    cdef dict found = waits.get(i)
+    if found is None:
+        waits[i] = {q: prev[0]}
+    elif found.get(q, -1) < prev[0]:
+        found[q] = prev[0]
+
+
+def walk(passes, resources, dict scopes, scope_of):
+    """``walk_python(passes, resources)``; ``scopes``: ``trace._SCOPES``, ``scope_of``: its
+    filler (``trace._scope``)."""
+    cdef list plan_accesses = [], values, uses, cells
+    cdef dict info = {}, timeline = {}, waits = {}
+    cdef Py_ssize_t i = -1, j, pos
+    cdef bint raytrace
+    cdef _Res r
+    cdef tuple scope, prev, cs
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value
+    for p in passes:
+        i += 1
+        oi = i
+        queue, kind = p.queue, p.kind
+        raytrace = kind == "raytrace"
+        values = []
+        pos = 0
+        j = -1
+        for a in p.accesses:
+            j += 1
+            name, usage, w = a.resource, a.usage, a.write
+            found = info.get(name)
+            if found is None:
+                r = _start(resources[name], i, usage)
+                info[name] = r
+            else:
+                r = <_Res> found
+                r.usages.add(usage)
+                r.last = i
+            if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
+                r.usages.add("trace_indirect")
+            key = (usage, kind, a.stages, r.code, a.refit)
+            found = scopes.get(key)
+            scope = <tuple> (scope_of(key) if found is None else found)
+            s = scope[0]
+            layout = scope[3]
+            mips, layers = a.mips, a.layers
+            if mips is None:  # buffers and accels
+                sub = None
+            else:
+                sub = SUBRESOURCES.get((mips, layers))
+                if sub is None:
+                    sub = subresource(mips, layers)
+            value = new_slots(ACCESS)
+            put(value, ACCESS, 0, name)
+            put(value, ACCESS, 1, sub)
+            put(value, ACCESS, 2, usage)
+            put(value, ACCESS, 3, scope[1])
+            put(value, ACCESS, 4, scope[2])
+            put(value, ACCESS, 5, layout)
+            put(value, ACCESS, 6, w)
+            values.append(value)
+            if r.group is not None:
+                if mips != r.mips or layers != r.layers:  # not the whole image: never unified
+                    r.group = None
+                else:
+                    r.group.append((oi, j, w, usage, layout))
+            if r.single:  # most resources: the one cell's uses without a lookup by cell
+                cells = r.cells
+                if not cells:
+                    cells.append(((<tuple> a.cells)[0], [(oi, s, w, queue, pos)]))
+                    pos += 1
+                    continue
+                uses = <list> (<tuple> cells[0])[1]
+                prev = <tuple> uses[len(uses) - 1]
+                if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
+                    uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
+                    continue
+                q = prev[3]
+                if q is not queue and q != queue:  # the dedicated plan waits for that use
+                    _wait(waits, oi, prev, q)
+                uses.append((oi, s, w, queue, pos))
+                pos += 1
+                continue
+            cs = a.cells
+            for c in cs:
+                found = timeline.get(c)
+                if found is None:
+                    uses = [(oi, s, w, queue, pos)]
+                    timeline[c] = uses
+                    r.cells.append((c, uses))
+                    pos += 1
+                    continue
+                uses = <list> found
+                prev = <tuple> uses[len(uses) - 1]
+                if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
+                    uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
+                    continue
+                q = prev[3]
+                if q is not queue and q != queue:  # the dedicated plan waits for that use
+                    _wait(waits, oi, prev, q)
+                uses.append((oi, s, w, queue, pos))
+                pos += 1
+        plan_accesses.append(values)
+    traced = {}
+    for name, found in info.items():
+        r = <_Res> found
+        value = new_slots(TRACE)
+        put(value, TRACE, 0, r.usages)
+        put(value, TRACE, 1, r.first)
+        put(value, TRACE, 2, r.last)
+        put(value, TRACE, 3, r.cells)
+        put(value, TRACE, 4, r.code)
+        put(value, TRACE, 5, r.group)
+        put(value, TRACE, 6, r.single)
+        traced[name] = value
+    return plan_accesses, traced, timeline, waits

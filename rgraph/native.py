@@ -2,12 +2,17 @@
 
 An accelerator mirrors a pure-Python function exactly: same inputs, same results, same
 operation counts; only the time differs. ``RGRAPH_NATIVE=0`` in the environment makes every
-caller use the pure-Python code (the tests compare the two)."""
+caller use the pure-Python code (the tests compare the two). A build older than its ``.pyx``
+(a checkout that changed the source since the last ``make setup``) is not used: the Python
+code runs instead, with a warning to rebuild."""
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import os
+import warnings
+from pathlib import Path
 from types import ModuleType
 
 
@@ -22,6 +27,25 @@ def load(name: str) -> ModuleType | None:
     if not enabled():
         return None
     try:
+        found = importlib.util.find_spec(name)
+    except ImportError:
+        return None
+    if found is None or found.origin is None:
+        return None
+    if stale(Path(found.origin)):
+        warnings.warn(f"{name}: the build is older than its .pyx; running the Python code "
+                      "(rebuild: make setup)", RuntimeWarning, stacklevel=2)
+        return None
+    try:
         return importlib.import_module(name)
     except ImportError:
         return None
+
+
+def stale(built: Path) -> bool:
+    """Whether the extension ``built`` is older than the ``.pyx`` beside it."""
+    source = built.with_name(built.name.split(".", 1)[0] + ".pyx")
+    try:
+        return source.stat().st_mtime > built.stat().st_mtime
+    except OSError:
+        return False

@@ -28,7 +28,9 @@ fi
 PY=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then "$PY" -m venv .venv; fi
 stamp=.venv/.rgraph-installed
-if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
+# again when pyproject.toml or a compiled accelerator's source (rgraph/**/*.pyx, *.pxi) changed
+if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ setup.py -nt "$stamp" ] \
+   || [ -n "$(find rgraph \( -name '*.pyx' -o -name '*.pxi' \) -newer "$stamp" -print -quit)" ]; then
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e ".[dev,ray]"  # ray: the tests of rgraph sweep --ray
   touch "$stamp"

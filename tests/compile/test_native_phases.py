@@ -1,0 +1,63 @@
+"""The compiled compiler phases (``rgraph/**/_*.pyx``: cull, trace, measure, place, emit, the
+best fit and the elastic dive) against the pure-Python code they mirror: byte-identical plans
+on random graphs under every policy, on graphs with optional reads, culled passes and
+several queues, and on every bundled graph. A plan differing anywhere fails."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from rgraph.compiler import emit, memory, queue_order, trace
+from rgraph.compiler.pipeline import compile_plan, frontend
+from rgraph.ir import cull
+from rgraph.memory import elastic, greedy
+from rgraph.memory import instance as instance_module
+from rgraph.plan import dump
+from rgraph.random_graph import random_graph, to_yaml
+
+#: (module, attribute) of every compiled accelerator a compile can use.
+SWITCHES = [(cull, "NATIVE"), (trace, "NATIVE"), (memory, "NATIVE"), (queue_order, "NATIVE"), (emit, "NATIVE"),
+            (greedy, "NATIVE"), (instance_module, "_NATIVE"), (elastic, "NATIVE")]
+BUILT = [getattr(module, name) is not None for module, name in SWITCHES]
+GRAPHS = sorted((Path(__file__).resolve().parents[2] / "graphs").glob("*.yaml"))
+
+pytestmark = pytest.mark.skipif(not all(BUILT), reason="compiled accelerators not built (setup.py build_ext)")
+
+
+def both(spec, monkeypatch: pytest.MonkeyPatch, **options) -> tuple[str, str]:
+    """The plan's JSON compiled with the accelerators, then with the Python code only."""
+    native = dump(compile_plan(spec, **options))
+    with monkeypatch.context() as m:
+        for module, name in SWITCHES:
+            m.setattr(module, name, None)
+        python = dump(compile_plan(spec, **options))
+    return native, python
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(seed=st.integers(0, 10**6), passes=st.integers(1, 120),
+       policy=st.sampled_from(("aliased", "dedicated", "tlsf")))
+def test_random_graphs_compile_alike(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, seed: int, passes: int,
+                                     policy: str) -> None:
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed, passes)))
+    native, python = both(frontend(path, size=(16, 16)).spec, monkeypatch, policy=policy)
+    assert native == python
+
+
+@pytest.mark.parametrize("graph", GRAPHS, ids=[g.stem for g in GRAPHS])
+def test_bundled_graphs_compile_alike(graph: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    native, python = both(frontend(graph, size=(64, 64)).spec, monkeypatch, policy="aliased")
+    assert native == python
+
+
+def test_a_large_graph_compiles_alike(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """1,000 passes: past the best fit's sweep threshold and the elastic dives' start."""
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=1000, passes=1000)))
+    native, python = both(frontend(path, size=(16, 16)).spec, monkeypatch, policy="aliased")
+    assert native == python

@@ -43,8 +43,12 @@ def load(name: str) -> ModuleType | None:
 
 
 def stale(built: Path) -> bool:
-    """Whether the extension ``built`` is older than the ``.pyx`` beside it."""
-    source = built.with_name(built.name.split(".", 1)[0] + ".pyx")
+    """Whether the extension ``built`` is older than its source beside it: ``_x.pyx``, or for a
+    twin (``_x.pxd`` without a ``.pyx``: setup.py ``TWINS``) the module ``x.py`` it compiles."""
+    stem = built.name.split(".", 1)[0]
+    source = built.with_name(stem + ".pyx")
+    if not source.exists() and built.with_name(stem + ".pxd").exists():
+        source = built.with_name(stem.removeprefix("_") + ".py")
     try:
         return source.stat().st_mtime > built.stat().st_mtime
     except OSError:

@@ -25,10 +25,10 @@ from functools import cached_property
 from typing import TYPE_CHECKING
 
 from rgraph.compiler import memory
+from rgraph.compiler import sync as sync_python
 from rgraph.compiler.emit import emit as emit_plan
 from rgraph.compiler.queue_order import cross_queue_conflicts
 from rgraph.compiler.sync import SyncResult
-from rgraph.compiler.sync import synchronize as synchronize_passes
 from rgraph.compiler.trace import Trace
 from rgraph.compiler.trace import trace as trace_passes
 from rgraph.defaults import DEFAULT_SCHEDULE
@@ -37,7 +37,12 @@ from rgraph.ir.cull import Culled, Culling
 from rgraph.ir.cull import cull as cull_spec
 from rgraph.ir.schedule import schedule_passes
 from rgraph.memory.model import Placement
+from rgraph.native import load
 from rgraph.spec.specialize import PassSpec, Spec
+
+#: ``rgraph/compiler/sync.py`` compiled as it is (setup.py ``TWINS``, typed by ``_sync.pxd``),
+#: None where not built or ``RGRAPH_NATIVE=0``: then sync.py itself runs.
+SYNC_NATIVE = load("rgraph.compiler._sync")
 
 if TYPE_CHECKING:
     import networkx as nx
@@ -170,6 +175,7 @@ def synchronize(c: Compilation) -> Compilation:
     # (heap, first byte, end byte) of the resources that alias or are aliased (``with_partial_handoffs``)
     named = {n for preds in aliases.values() for n in preds}.union(aliases)
     ranges = {n: (heap, off, off + c.memory[n].bytes) for n in named for heap, off in (offsets[n],)}
+    synchronize_passes = (SYNC_NATIVE or sync_python).synchronize
     return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, aliases, ranges,
                                               set(c.spec.outputs)))
 

@@ -25,6 +25,17 @@ def test_a_build_older_than_its_source_is_stale(tmp_path: Path) -> None:
     assert not native.stale(built)  # no source beside it (an installed wheel)
 
 
+def test_a_twin_is_stale_when_its_module_changed(tmp_path: Path) -> None:
+    module, types = tmp_path / "walk.py", tmp_path / "_walk.pxd"
+    built = tmp_path / "_walk.cpython-311-x86_64-linux-gnu.so"
+    for f, t in ((module, 300), (types, 100), (built, 200)):
+        f.write_text("")
+        os.utime(f, (t, t))
+    assert native.stale(built)
+    os.utime(module, (150, 150))
+    assert not native.stale(built)
+
+
 def test_a_stale_build_is_not_loaded(monkeypatch: pytest.MonkeyPatch) -> None:
     if native.load("rgraph.memory._dive") is None:
         pytest.skip("rgraph.memory._dive not built")

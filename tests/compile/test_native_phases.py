@@ -1,5 +1,5 @@
 """The compiled compiler phases (``rgraph/**/_*.pyx``: cull, trace, measure, place, emit, the
-best fit and the elastic dive) against the pure-Python code they mirror: byte-identical plans
+best fit and the elastic dive; sync.py compiled as it is) against the pure-Python code they mirror: byte-identical plans
 on random graphs under every policy, on graphs with optional reads, culled passes and
 several queues, and on every bundled graph. A plan differing anywhere fails."""
 
@@ -11,7 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rgraph.compiler import emit, memory, queue_order, trace
+from rgraph.compiler import emit, memory, phases, queue_order, trace
 from rgraph.compiler.pipeline import compile_plan, frontend
 from rgraph.ir import cull
 from rgraph.memory import elastic, greedy
@@ -21,7 +21,7 @@ from rgraph.random_graph import random_graph, to_yaml
 
 #: (module, attribute) of every compiled accelerator a compile can use.
 SWITCHES = [(cull, "NATIVE"), (trace, "NATIVE"), (memory, "NATIVE"), (queue_order, "NATIVE"), (emit, "NATIVE"),
-            (greedy, "NATIVE"), (instance_module, "_NATIVE"), (elastic, "NATIVE")]
+            (phases, "SYNC_NATIVE"), (greedy, "NATIVE"), (instance_module, "_NATIVE"), (elastic, "NATIVE")]
 BUILT = [getattr(module, name) is not None for module, name in SWITCHES]
 GRAPHS = sorted((Path(__file__).resolve().parents[2] / "graphs").glob("*.yaml"))
 

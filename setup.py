@@ -9,7 +9,6 @@ from pathlib import Path
 
 from setuptools import Extension, setup
 
-
 #: Pure-Python modules -> the extension module compiled from the same source (typed by the
 #: ``.pxd`` of the extension's name beside it).
 TWINS = {"rgraph/compiler/sync.py": "rgraph.compiler._sync"}

@@ -2,7 +2,7 @@
 """Compiled mirror of ``rgraph.compiler.emit``'s ``_passes_python``, ``_resources_python`` and
 ``_culled_python``: the same plan values, each stored slot by slot (``rgraph/plan/_slots.pxi``)
 instead of through its builder. Any change to the Python code must be made here too
-(tests/compiler/test_emit_native.py compares the two)."""
+(tests/compile/test_native_phases.py compares the plans of both)."""
 
 from rgraph.plan import model as pm
 

@@ -4,7 +4,7 @@
 ``rgraph.compiler.phases._culled_only_python``: the same values, with typed locals, C arrays
 for the spans of one heap's resources, and the results stored slot by slot
 (``rgraph/plan/_slots.pxi``). Any change to the Python code must be made here too
-(tests/compiler/test_measure_native.py compares the two)."""
+(tests/compile/test_native_phases.py compares the plans of both)."""
 
 from libc.stdlib cimport free, malloc
 
@@ -13,7 +13,7 @@ from rgraph.errors import RGraphError
 
 include "../plan/_slots.pxi"
 
-ctypedef long long i64
+include "_bisect.pxi"
 
 cdef Slots REQUIREMENT = Slots(Requirement, ("bytes", "alignment", "memory_type_bits", "tiling"))
 cdef Slots MEMORY = Slots(ResourceMemory, ("bytes", "alignment", "memory_type_bits", "memory_class", "usages",
@@ -104,17 +104,6 @@ def culled_only(passes, culled, traced):
             only_by_pass[p.name] = tuple(sorted(only))
             used_by.append(p)
     return only_by_pass, used_by
-
-
-cdef Py_ssize_t _bisect_left(i64 *a, Py_ssize_t n, i64 x):
-    cdef Py_ssize_t lo = 0, hi = n, mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if a[mid] < x:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
 
 
 cdef int _heap_sources(list names, offsets, memory, dict out) except -1:

@@ -2,22 +2,11 @@
 """Compiled mirror of ``rgraph.compiler.queue_order.cross_queue_conflicts_python``: the same
 pairs, found with typed locals and, per queue, C arrays of the sorted (last use, resource's
 last pass) rows. Any change to the Python code must be made here too
-(tests/compiler/test_measure_native.py compares the two)."""
+(tests/compile/test_native_phases.py compares the plans of both)."""
 
 from libc.stdlib cimport free, malloc
 
-ctypedef long long i64
-
-
-cdef Py_ssize_t _bisect_left(i64 *a, Py_ssize_t n, i64 x):
-    cdef Py_ssize_t lo = 0, hi = n, mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if a[mid] < x:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+include "_bisect.pxi"
 
 
 cdef Py_ssize_t _bisect_right(i64 *a, Py_ssize_t n, i64 x):

@@ -4,7 +4,7 @@ passes' accesses, with the same results (plan accesses, resource traces, timelin
 built with typed locals. A resource's trace is kept in a C struct (``_Res``) during the walk
 and becomes a ``ResourceTrace`` at the end; plan values are stored slot by slot
 (``rgraph/plan/_slots.pxi``). Any change to the Python walk must be made here too
-(tests/compiler/test_trace_native.py compares the two)."""
+(tests/compile/test_native_phases.py compares the plans of both)."""
 
 from rgraph.compiler.plan_values import get_subresource, subresource
 from rgraph.compiler.usages import merge

@@ -2,7 +2,7 @@
 """Compiled mirror of ``rgraph.ir.cull._alive_python`` (the backwards walk), of
 ``rgraph.ir.cull._split`` and of ``rgraph.ir.cull._has_optional_python``: the same sets, with typed locals and the set tests of a
 write's few cells done cell by cell. Any change to the Python code must be made here too
-(tests/ir/test_cull_native.py compares the two)."""
+(tests/compile/test_native_phases.py compares the plans of both)."""
 
 
 include "../plan/_slots.pxi"

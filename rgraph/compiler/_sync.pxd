@@ -13,7 +13,7 @@ cdef _end_state(bint per_cell, dict states)
 
 cdef tuple _state(tuple end)
 
-@cython.locals(k=Py_ssize_t, end=Py_ssize_t, covered_until=Py_ssize_t, w=bint, transfer=bint, reads=list,
+@cython.locals(k=Py_ssize_t, end=Py_ssize_t, covered_until=Py_ssize_t, w=bint, transfer=bint,
                visible=tuple, u=tuple, src=tuple, key=tuple, write=tuple, bars=list, rels=list, waits=list,
                multi=dict, groups=list, group=list)
 cdef tuple _walk(list uses, bint image, tuple start, tuple aliases, tuple alias_waits, bint last_prev, tuple sink,

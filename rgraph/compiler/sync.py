@@ -47,7 +47,9 @@ _START_IMAGE = ("UNDEFINED", plan_state((EMPTY, EMPTY, "UNDEFINED", None)))
 _START_BUFFER = (None, plan_state((EMPTY, EMPTY, None, None)))
 
 #: A cell's state between walks: (layout, queue, write, reads, last pass, visible) where write
-#: is (stages, write access) of the last write or None, reads the stages of each read since it,
+#: is (stages, write access) of the last write or None, reads the union of the stages of the
+#: reads since it (None: no read since; kept as one running union, so that a resource read by
+#: many passes costs no union over all of them at each barrier),
 #: visible the dst scope (stages, access) of the barriers since it.
 CellEnd = tuple
 #: A barrier's key: (src state, dst state, aliases); cells of one resource and pass with equal
@@ -110,13 +112,13 @@ def synchronize(
                 stages, access, queue, last, aliases, alias_waits = alias_state(
                     preds, [end for pred in preds for end in ends.get(pred, ())], r.first)
                 write = (stages, access) if stages or access else None
-                first = _state((layout, queue, write, (), last, EMPTY2))
+                first = _state((layout, queue, write, None, last, EMPTY2))
                 initial[name] = get_state(first) or plan_state(first)
-                end = _walk(uses, image, (layout, queue, write, [], last, EMPTY2), aliases, alias_waits, False,
+                end = _walk(uses, image, (layout, queue, write, None, last, EMPTY2), aliases, alias_waits, False,
                             one_sink, c, sub)
             else:
                 layout, initial[name] = fresh[image]
-                end = _walk(uses, image, (layout, None, None, [], None, EMPTY2), (), (), False, one_sink, c, sub)
+                end = _walk(uses, image, (layout, None, None, None, None, EMPTY2), (), (), False, one_sink, c, sub)
             st = _state(end)
             final[name] = get_state(st) or plan_state(st)
             if name in wanted:
@@ -138,9 +140,9 @@ def synchronize(
         sink = (bars, rels, waits, multi)
         if lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
             for c, uses in cells:
-                lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, [], None, EMPTY2),
+                lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, None, None, EMPTY2),
                                                                 (), (), False, None, c, None)
-                start = (lay, queue, write, list(reads), last, visible)
+                start = (lay, queue, write, reads, last, visible)
                 starts[c] = _state(start)
                 end = _walk(uses, image, start, (), (), True, sink, c, sub)
                 finals[c] = st = _state(end)
@@ -154,9 +156,9 @@ def synchronize(
                 stages, access, queue, last, aliases, alias_waits = alias_state(
                     preds, [end for pred in preds for end in ends.get(pred, ())], r.first)
                 write = (stages, access) if stages or access else None
-            first_state = _state((layout, queue, write, (), last, EMPTY2))  # every cell starts alike
+            first_state = _state((layout, queue, write, None, last, EMPTY2))  # every cell starts alike
             for c, uses in cells:
-                start = (layout, queue, write, [], last, EMPTY2)
+                start = (layout, queue, write, None, last, EMPTY2)
                 starts[c] = first_state
                 end = _walk(uses, image, start, aliases, alias_waits, False, sink, c, sub)
                 finals[c] = st = _state(end)
@@ -191,8 +193,8 @@ def _end_state(per_cell: bool, states: Mapping[Cell, StateKey]) -> pm.EndState:
 def _state(end: CellEnd) -> StateKey:
     """What later accesses must wait for: the reads since the write, else the write."""
     layout, queue, write, reads, _, _ = end
-    if reads:
-        return (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, queue)
+    if reads is not None:
+        return (reads, EMPTY, layout, queue)
     if write:
         return (write[0], write[1], layout, queue)
     return (EMPTY, EMPTY, layout, queue)
@@ -225,7 +227,7 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                 if image:
                     transfer = layout not in (None, "UNDEFINED")
                 else:
-                    transfer = not aliases and (write is not None or bool(reads))
+                    transfer = not aliases and (write is not None or reads is not None)
                 if transfer:
                     release_at = last_pass
             src_queue = cq if transfer else queue
@@ -237,8 +239,8 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
         new_layout = s.layout
         key = None
         if w or new_layout != layout:
-            if reads:
-                src = (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, src_queue)
+            if reads is not None:
+                src = (reads, EMPTY, layout, src_queue)
             elif write:
                 src = (write[0], write[1], layout, src_queue)
             else:
@@ -255,17 +257,17 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                     key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
             if w:
                 write = s.write_scope
-                reads = []
+                reads = None
                 covered_until = k
                 visible = EMPTY2
             else:  # a layout change: a transition is a write; from UNDEFINED it happens once, at creation
                 write = (s.stages, EMPTY) if layout != "UNDEFINED" else None
-                reads = [s.stages]
+                reads = s.stages
         else:  # a read in the current layout
             if transfer or (write and k > covered_until
                             and not (s.stages <= visible[0] and s.access <= visible[1])):  # e.g. last frame's barrier
-                if reads:  # the write is already available: chain through the reads
-                    src = (reads[0] if len(reads) == 1 else EMPTY.union(*reads), EMPTY, layout, src_queue)
+                if reads is not None:  # the write is already available: chain through the reads
+                    src = (reads, EMPTY, layout, src_queue)
                 elif write:
                     src = (write[0], write[1], layout, src_queue)
                 else:
@@ -277,7 +279,10 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                 visible = (dst_stages, dst_access)
                 if transfer or src[0] or src[1]:
                     key = (src, (dst_stages, dst_access, new_layout, queue), aliases)
-            reads.append(s.stages)
+            if reads is None:
+                reads = s.stages
+            elif not s.stages <= reads:
+                reads = reads | s.stages
         layout = new_layout
         cq = queue
         last_pass = i

@@ -51,6 +51,21 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     return r
 
 
+cdef inline int _add_use(list uses, Py_ssize_t i, object oi, object s, object w, object queue, Py_ssize_t pos,
+                         dict waits) except -1:
+    """Pass ``i``'s use of a cell that has ``uses`` already: 1 where appended (at ``pos``), 0 where a
+    second access of the pass to the cell merged into its last use."""
+    cdef tuple prev = <tuple> uses[len(uses) - 1]
+    if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
+        uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
+        return 0
+    q = prev[3]
+    if q is not queue and q != queue:  # the dedicated plan waits for that use
+        _wait(waits, oi, prev, q)
+    uses.append((oi, s, w, queue, pos))
+    return 1
+
+
 cdef inline void _wait(dict waits, object i, tuple prev, object q):
     """The dedicated plan's wait of pass ``i`` for ``prev`` (a use on queue ``q``)."""
     cdef dict found = waits.get(i)
@@ -123,16 +138,7 @@ def walk(passes, resources, dict scopes, scope_of):
                     cells.append(((<tuple> a.cells)[0], [(oi, s, w, queue, pos)]))
                     pos += 1
                     continue
-                uses = <list> (<tuple> cells[0])[1]
-                prev = <tuple> uses[len(uses) - 1]
-                if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
-                    uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
-                    continue
-                q = prev[3]
-                if q is not queue and q != queue:  # the dedicated plan waits for that use
-                    _wait(waits, oi, prev, q)
-                uses.append((oi, s, w, queue, pos))
-                pos += 1
+                pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
                 continue
             cs = a.cells
             for c in cs:
@@ -143,16 +149,7 @@ def walk(passes, resources, dict scopes, scope_of):
                     r.cells.append((c, uses))
                     pos += 1
                     continue
-                uses = <list> found
-                prev = <tuple> uses[len(uses) - 1]
-                if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
-                    uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
-                    continue
-                q = prev[3]
-                if q is not queue and q != queue:  # the dedicated plan waits for that use
-                    _wait(waits, oi, prev, q)
-                uses.append((oi, s, w, queue, pos))
-                pos += 1
+                pos += _add_use(<list> found, i, oi, s, w, queue, pos, waits)
         plan_accesses.append(values)
     traced = {}
     for name, found in info.items():

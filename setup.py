@@ -11,6 +11,7 @@ from setuptools import Extension, setup
 
 #: Pure-Python modules -> the extension module compiled from the same source (typed by the
 #: ``.pxd`` of the extension's name beside it).
+#: scripts/setup.sh rebuilds when one of these changes: add a new twin there too.
 TWINS = {"rgraph/compiler/sync.py": "rgraph.compiler._sync"}
 
 

@@ -28,9 +28,10 @@ fi
 PY=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then "$PY" -m venv .venv; fi
 stamp=.venv/.rgraph-installed
-# again when pyproject.toml or a compiled accelerator's source (rgraph/**/*.pyx, *.pxi) changed
+# again when pyproject.toml, setup.py or a compiled accelerator's source changed (rgraph/**/*.pyx,
+# *.pxi, *.pxd, and the modules setup.py's TWINS compiles as they are)
 if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ setup.py -nt "$stamp" ] \
-   || [ -n "$(find rgraph \( -name '*.pyx' -o -name '*.pxi' \) -newer "$stamp" -print -quit)" ]; then
+   || [ -n "$(find rgraph \( -name '*.pyx' -o -name '*.pxi' -o -name '*.pxd' -o -path rgraph/compiler/sync.py \) -newer "$stamp" -print -quit)" ]; then
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e ".[dev,ray]"  # ray: the tests of rgraph sweep --ray
   touch "$stamp"

@@ -1,7 +1,7 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
-"""Compiled mirror of ``rgraph.ir.cull._alive_python`` (the backwards walk), of
-``rgraph.ir.cull._split`` and of ``rgraph.ir.cull._has_optional_python``: the same sets, with typed locals and the set tests of a
-write's few cells done cell by cell. Any change to the Python code must be made here too
+"""Compiled mirror of ``rgraph.ir.cull._alive_python`` (the backwards walk)
+and of ``rgraph.ir.cull._split``: the same sets, with typed locals and the set tests of a write's
+few cells done cell by cell. Any change to the Python code must be made here too
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
 
@@ -75,15 +75,6 @@ def alive(spec, list kept, frozenset rw):
                 for c in <tuple> access.cells:
                     wanted.add(c)
     return alive
-
-
-def has_optional(passes):
-    """``_has_optional_python(passes)``: whether any access is optional."""
-    for p in passes:
-        for a in <tuple> p.accesses:
-            if a.optional:
-                return True
-    return False
 
 
 def split(list kept, set alive, culled_class):

@@ -29,8 +29,8 @@ class Culled:
 
 _new_culled = builder(Culled)
 
-#: The compiled mirror of :func:`_alive_python` and :func:`_has_optional_python`
-#: (``rgraph/ir/_cull.pyx``), None where it is not built or ``RGRAPH_NATIVE=0``.
+#: The compiled mirror of :func:`_alive_python` and :func:`_split` (``rgraph/ir/_cull.pyx``),
+#: None where it is not built or ``RGRAPH_NATIVE=0``.
 NATIVE = load("rgraph.ir._cull")
 
 
@@ -88,13 +88,7 @@ def _split(kept: list[PassSpec], alive: set[str]) -> tuple[list[PassSpec], list[
 
 
 def _has_optional(passes: list[PassSpec]) -> bool:
-    """Whether any access of ``passes`` is optional (compiled where built)."""
-    if NATIVE is None:
-        return _has_optional_python(passes)
-    return NATIVE.has_optional(passes)
-
-
-def _has_optional_python(passes: list[PassSpec]) -> bool:
+    """Whether any access of ``passes`` is optional."""
     for p in passes:
         for a in p.accesses:
             if a.optional:

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_best_fit_paths import instance, plain_best_fit
-from test_elastic_native import TRACES
+from test_elastic_native import TRACES, symmetric_conflicts
 from test_minimalloc_exact import block_lists
 
 from rgraph.memory import bounds, greedy, place
@@ -105,14 +105,7 @@ def test_neighbour_lists_of_large_dense_instances_give_identical_offsets(sizes):
     """From :data:`SWEEP_FROM` blocks there is no matrix: the dense scan tests neighbours
     by stamps, blocks with few neighbours sort theirs."""
     blocks = long_lived(SWEEP_FROM + 60, 1, sizes)
-    names = [b.name for b in blocks]
-    rng = random.Random(2)
-    conflicts: dict[str, set[str]] = {}
-    for _ in range(200):
-        a, b = rng.sample(names, 2)
-        conflicts.setdefault(a, set()).add(b)
-        conflicts.setdefault(b, set()).add(a)
-    inst = Instance.build(blocks, conflicts)
+    inst = Instance.build(blocks, symmetric_conflicts([b.name for b in blocks], 200, 2))
     assert inst.adjacency is None and 4 * inst.pair_count >= inst.n**2
     order = next(orderings(inst))[1]
     python = best_fit_python(inst, order)

@@ -99,16 +99,20 @@ def test_small_instances_with_empty_blocks_give_identical_dives(blocks, rank):
     assert_same_dives(inst, order, inst.lower_bound())
 
 
-def test_conflicts_apart_in_time_give_identical_dives():
-    blocks = hard_trace(80, 7)
-    names = [b.name for b in blocks]
-    rng = random.Random(3)
+def symmetric_conflicts(names: list[str], pairs: int, seed: int) -> dict[str, set[str]]:
+    """``pairs`` random pairs of ``names`` that may not share memory, both ways."""
+    rng = random.Random(seed)
     conflicts: dict[str, set[str]] = {}
-    for _ in range(60):
+    for _ in range(pairs):
         a, b = rng.sample(names, 2)
         conflicts.setdefault(a, set()).add(b)
         conflicts.setdefault(b, set()).add(a)
-    inst = Instance.build(blocks, conflicts)
+    return conflicts
+
+
+def test_conflicts_apart_in_time_give_identical_dives():
+    blocks = hard_trace(80, 7)
+    inst = Instance.build(blocks, symmetric_conflicts([b.name for b in blocks], 60, 3))
     assert not inst.separable
     for h in ELASTIC_ORDERS:
         assert_same_dives(inst, preorder(inst, h), inst.lower_bound())

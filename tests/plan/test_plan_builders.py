@@ -8,10 +8,14 @@ import dataclasses
 import pytest
 
 from rgraph.plan import model as pm
-from rgraph.plan.builders import builder
+from rgraph.plan.builders import _NATIVE, builder, builder_python
+
+#: Every builder there is here: the Python one, and the compiled one where it is built.
+BUILDERS = [builder_python] + ([_NATIVE.FastBuilder] if _NATIVE is not None else [])
 
 
-def test_builders_equal_the_dataclass_constructors() -> None:
+@pytest.mark.parametrize("make", BUILDERS)
+def test_builders_equal_the_dataclass_constructors(make) -> None:
     sub = pm.Subresource((0, 1), (0, 2))
     st = pm.State(("COMPUTE_SHADER",), ("SHADER_STORAGE_WRITE",), "GENERAL", "compute")
     cases = [
@@ -21,9 +25,11 @@ def test_builders_equal_the_dataclass_constructors() -> None:
         (pm.Wait, ("compute", 3, ("ALL_COMMANDS",)), {}),
         (pm.Signal, ("graphics", 1, ("ALL_COMMANDS",)), {"device": 1}),
         (pm.Culled, ("p", "reaches no output", ("r",), 256), {}),
+        (pm.Wait, ("compute",), {"stages": ("ALL_COMMANDS",), "value": 2}),
+        (pm.Signal, (), {"queue": "graphics", "value": 1, "stages": (), "device": None}),
     ]
     for cls, args, kwargs in cases:
-        made = builder(cls)(*args, **kwargs)
+        made = make(cls)(*args, **kwargs)
         assert type(made) is cls
         assert made == cls(*args, **kwargs)
         assert hash(made) == hash(cls(*args, **kwargs))
@@ -62,3 +68,22 @@ def test_builder_without_a_twin_still_builds_equal_objects() -> None:
     assert _twin(Child) is None
     made = builder(Child)(1)
     assert type(made) is Child and made == Child(1, 2)
+
+
+@pytest.mark.parametrize("make", BUILDERS)
+def test_builders_refuse_wrong_arguments_as_the_constructor_does(make) -> None:
+    build = make(pm.Wait)
+    for args, kwargs in [((), {}), (("q", 1), {}), (("q", 1, (), None, 5), {}), (("q", 1, ()), {"colour": 1}),
+                         (("q", 1, ()), {"queue": "r"})]:
+        with pytest.raises(TypeError):
+            pm.Wait(*args, **kwargs)
+        with pytest.raises(TypeError):
+            build(*args, **kwargs)
+
+
+def test_the_compiled_builder_is_used_where_built() -> None:
+    if _NATIVE is None:
+        pytest.skip("rgraph.plan._builders not built (or RGRAPH_NATIVE=0)")
+    assert isinstance(builder(pm.Barrier), _NATIVE.FastBuilder)
+    with pytest.raises(TypeError):
+        _NATIVE.FastBuilder(pm.Plan)  # no slots

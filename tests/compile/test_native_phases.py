@@ -1,5 +1,5 @@
 """The compiled compiler phases (``rgraph/**/_*.pyx``: cull, trace, measure, place, emit, the
-best fit and the elastic dive; sync.py compiled as it is) against the pure-Python code they mirror: byte-identical plans
+best fit and the elastic dive; sync.py compiled as it is, and its cell walk `_sync_walk.pyx`) against the pure-Python code they mirror: byte-identical plans
 on random graphs under every policy, on graphs with optional reads, culled passes and
 several queues, and on every bundled graph. A plan differing anywhere fails."""
 
@@ -11,7 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rgraph.compiler import emit, memory, phases, queue_order, trace
+from rgraph.compiler import emit, memory, phases, queue_order, sync, trace
 from rgraph.compiler.pipeline import compile_plan, frontend
 from rgraph.ir import cull
 from rgraph.memory import elastic, greedy
@@ -21,7 +21,7 @@ from rgraph.random_graph import random_graph, to_yaml
 
 #: (module, attribute) of every compiled accelerator a compile can use.
 SWITCHES = [(cull, "NATIVE"), (trace, "NATIVE"), (memory, "NATIVE"), (queue_order, "NATIVE"), (emit, "NATIVE"),
-            (phases, "SYNC_NATIVE"), (greedy, "NATIVE"), (instance_module, "_NATIVE"), (elastic, "NATIVE")]
+            (phases, "SYNC_NATIVE"), (sync, "_WALK"), (greedy, "NATIVE"), (instance_module, "_NATIVE"), (elastic, "NATIVE")]
 BUILT = [getattr(module, name) is not None for module, name in SWITCHES]
 GRAPHS = sorted((Path(__file__).resolve().parents[2] / "graphs").glob("*.yaml"))
 
@@ -60,4 +60,32 @@ def test_a_large_graph_compiles_alike(tmp_path: Path, monkeypatch: pytest.Monkey
     path = tmp_path / "g.yaml"
     path.write_text(to_yaml(random_graph(seed=1000, passes=1000)))
     native, python = both(frontend(path, size=(16, 16)).spec, monkeypatch, policy="aliased")
+    assert native == python
+
+
+#: A persistent buffer read at the frame's start, written, then read in the same layout: the
+#: second frame's first read is covered by the first frame's last barrier (the walk's end state
+#: carries what that barrier made visible), so it gets none.
+PERSISTENT_READS = """\
+rgraph: 1
+name: persistent_reads
+resources:
+  b: {kind: buffer, bytes: 256, lifetime: persistent}
+  o0: {kind: buffer, bytes: 256}
+  o2: {kind: buffer, bytes: 256}
+passes:
+  p0: {kind: compute, reads: {b: storage_read}, writes: {o0: storage_write}}
+  p1: {kind: compute, writes: {b: storage_write}}
+  p2: {kind: compute, reads: {b: storage_read}, writes: {o2: storage_write}}
+outputs: [o0, o2]
+"""
+
+
+def test_a_persistent_resource_s_frame_boundary_compiles_alike(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = tmp_path / "g.yaml"
+    path.write_text(PERSISTENT_READS)
+    plan = compile_plan(frontend(path, size=(16, 16)).spec)
+    first = next(p for p in plan.passes if p.name == "p0")
+    assert not [b for b in first.barriers if b.resource == "b"]  # covered by the previous frame's barrier
+    native, python = both(frontend(path, size=(16, 16)).spec, monkeypatch)
     assert native == python

@@ -13,9 +13,13 @@ from rgraph.plan import model as pm
 include "../plan/_slots.pxi"
 
 from rgraph.compiler.trace import ResourceTrace
+from rgraph.spec.specialize import AccessSpec
 
 cdef Slots ACCESS = Slots(pm.Access, ("resource", "subresource", "usage", "stages", "access", "layout", "write"))
 cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group", "single"))
+#: An access's fields, read from its slots (``get``) when it is exactly an ``AccessSpec``.
+cdef Slots SPEC = Slots(AccessSpec, ("resource", "usage", "write", "mips", "layers", "stages", "optional", "loc",
+                                     "refit", "cells"))
 cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared, never replaced)
 
 
@@ -84,7 +88,7 @@ def walk(passes, resources, dict scopes, scope_of):
     cdef bint raytrace
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, stages, refit, a_cells
     for p in passes:
         i += 1
         oi = i
@@ -95,7 +99,13 @@ def walk(passes, resources, dict scopes, scope_of):
         j = -1
         for a in p.accesses:
             j += 1
-            name, usage, w = a.resource, a.usage, a.write
+            if type(a) is AccessSpec:
+                name, usage, w, mips, layers = get(a, SPEC, 0), get(a, SPEC, 1), get(a, SPEC, 2), get(a, SPEC, 3), \
+                    get(a, SPEC, 4)
+                stages, refit, a_cells = get(a, SPEC, 5), get(a, SPEC, 8), get(a, SPEC, 9)
+            else:
+                name, usage, w, mips, layers = a.resource, a.usage, a.write, a.mips, a.layers
+                stages, refit, a_cells = a.stages, a.refit, a.cells
             found = info.get(name)
             if found is None:
                 r = _start(resources[name], i, usage)
@@ -106,12 +116,11 @@ def walk(passes, resources, dict scopes, scope_of):
                 r.last = i
             if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 r.usages.add("trace_indirect")
-            key = (usage, kind, a.stages, r.code, a.refit)
+            key = (usage, kind, stages, r.code, refit)
             found = scopes.get(key)
             scope = <tuple> (scope_of(key) if found is None else found)
             s = scope[0]
             layout = scope[3]
-            mips, layers = a.mips, a.layers
             if mips is None:  # buffers and accels
                 sub = None
             else:
@@ -135,12 +144,12 @@ def walk(passes, resources, dict scopes, scope_of):
             if r.single:  # most resources: the one cell's uses without a lookup by cell
                 cells = r.cells
                 if not cells:
-                    cells.append(((<tuple> a.cells)[0], [(oi, s, w, queue, pos)]))
+                    cells.append(((<tuple> a_cells)[0], [(oi, s, w, queue, pos)]))
                     pos += 1
                     continue
                 pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
                 continue
-            cs = a.cells
+            cs = a_cells
             for c in cs:
                 found = timeline.get(c)
                 if found is None:

@@ -71,3 +71,12 @@ cdef inline object new_slots(Slots layout):
     for k in range(layout.given, layout.n):
         put(o, layout, k, layout.defaults[k - layout.given])
     return o
+
+
+cdef inline object get(object o, Slots layout, Py_ssize_t k):
+    """Field ``k`` of ``o``, an instance of exactly ``layout.cls`` (the caller checks its type):
+    read from its slot, as the member descriptor's ``__get__`` does."""
+    cdef PyObject *v = (<PyObject **> ((<char *> <PyObject *> o) + layout.off[k]))[0]
+    if v == NULL:
+        raise AttributeError(f"{type(o).__name__}: field {k} is not set")
+    return <object> v

@@ -89,3 +89,27 @@ def test_a_persistent_resource_s_frame_boundary_compiles_alike(tmp_path: Path, m
     assert not [b for b in first.barriers if b.resource == "b"]  # covered by the previous frame's barrier
     native, python = both(frontend(path, size=(16, 16)).spec, monkeypatch)
     assert native == python
+
+
+def test_the_compiled_trace_reads_any_access_type(tmp_path: Path) -> None:
+    """The compiled walk reads an ``AccessSpec``'s fields from its slots, and any other access
+    object (here a subclass) through its attributes: both give the Python walk's values."""
+    from dataclasses import replace as dc_replace
+
+    from rgraph.spec.specialize import AccessSpec
+
+    class Access(AccessSpec):
+        __slots__ = ()
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=7, passes=60)))
+    spec = frontend(path, size=(16, 16)).spec
+    passes = [dc_replace(p, accesses=tuple(Access(*(getattr(a, f) for f in (
+        "resource", "usage", "write", "mips", "layers", "stages", "optional", "loc", "refit"))) for a in p.accesses))
+        for p in spec.passes]
+    assert type(passes[0].accesses[0]) is Access
+    native = trace.NATIVE.walk(passes, spec.resources, trace._SCOPES, trace._scope)
+    python = trace.walk_python(spec.passes, spec.resources)
+    assert native[0] == python[0] and native[2] == python[2] and native[3] == python[3]
+    assert {n: (r.usages, r.first, r.last, r.cells) for n, r in native[1].items()} == \
+        {n: (r.usages, r.first, r.last, r.cells) for n, r in python[1].items()}

@@ -11,15 +11,12 @@ from rgraph.compiler.usages import merge
 from rgraph.plan import model as pm
 
 include "../plan/_slots.pxi"
+include "../plan/_spec_slots.pxi"
 
 from rgraph.compiler.trace import ResourceTrace
-from rgraph.spec.specialize import AccessSpec
 
 cdef Slots ACCESS = Slots(pm.Access, ("resource", "subresource", "usage", "stages", "access", "layout", "write"))
 cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group", "single"))
-#: An access's fields, read from its slots (``get``) when it is exactly an ``AccessSpec``.
-cdef Slots SPEC = Slots(AccessSpec, ("resource", "usage", "write", "mips", "layers", "stages", "optional", "loc",
-                                     "refit", "cells"))
 cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared, never replaced)
 
 
@@ -92,20 +89,16 @@ def walk(passes, resources, dict scopes, scope_of):
     for p in passes:
         i += 1
         oi = i
-        queue, kind = p.queue, p.kind
+        queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
         raytrace = kind == "raytrace"
         values = []
         pos = 0
         j = -1
-        for a in p.accesses:
+        for a in <tuple> pass_field(p, 7, "accesses"):
             j += 1
-            if type(a) is AccessSpec:
-                name, usage, w, mips, layers = get(a, SPEC, 0), get(a, SPEC, 1), get(a, SPEC, 2), get(a, SPEC, 3), \
-                    get(a, SPEC, 4)
-                stages, refit, a_cells = get(a, SPEC, 5), get(a, SPEC, 8), get(a, SPEC, 9)
-            else:
-                name, usage, w, mips, layers = a.resource, a.usage, a.write, a.mips, a.layers
-                stages, refit, a_cells = a.stages, a.refit, a.cells
+            name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
+            mips, layers, stages = access_field(a, 3, "mips"), access_field(a, 4, "layers"), access_field(a, 5, "stages")
+            refit, a_cells = access_field(a, 8, "refit"), access_field(a, 9, "cells")
             found = info.get(name)
             if found is None:
                 r = _start(resources[name], i, usage)

@@ -6,6 +6,7 @@ few cells done cell by cell. Any change to the Python code must be made here too
 
 
 include "../plan/_slots.pxi"
+include "../plan/_spec_slots.pxi"
 
 cdef Slots CULLED = None
 
@@ -37,11 +38,11 @@ def alive(spec, list kept, frozenset rw):
     keep.update(spec.outputs)
     for k in range(len(kept) - 1, -1, -1):
         p = kept[k]
-        live = p.side_effects
-        accesses = p.accesses
+        live = pass_field(p, 6, "side_effects")
+        accesses = <tuple> pass_field(p, 7, "accesses")
         for access in accesses:
-            if access.write:
-                name = access.resource
+            if access_field(access, 2, "write"):
+                name = access_field(access, 0, "resource")
                 if name in single:
                     if name in keep:
                         if not live and (name not in claimed or name in wanted):
@@ -50,7 +51,7 @@ def alive(spec, list kept, frozenset rw):
                     elif not live and name in wanted:
                         live = True
                     continue
-                cs = access.cells
+                cs = access_field(access, 9, "cells")
                 if name in keep:
                     if not live and (not _all_in(claimed, cs) or _any_in(wanted, cs)):
                         live = True
@@ -60,19 +61,19 @@ def alive(spec, list kept, frozenset rw):
                     live = True
         if not live:
             continue
-        alive.add(p.name)
+        alive.add(pass_field(p, 0, "name"))
         for access in accesses:
-            name = access.resource
+            name = access_field(access, 0, "resource")
             if name in single:
-                if access.write and access.usage not in rw:
+                if access_field(access, 2, "write") and access_field(access, 1, "usage") not in rw:
                     wanted.discard(name)
                 else:
                     wanted.add(name)
-            elif access.write and access.usage not in rw:
-                for c in <tuple> access.cells:
+            elif access_field(access, 2, "write") and access_field(access, 1, "usage") not in rw:
+                for c in <tuple> access_field(access, 9, "cells"):
                     wanted.discard(c)
             else:  # ``reads(access)``
-                for c in <tuple> access.cells:
+                for c in <tuple> access_field(access, 9, "cells"):
                     wanted.add(c)
     return alive
 

@@ -69,6 +69,7 @@ def warnings(front, culling) -> list[tuple[Location, str]]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rgraph.compiler.accel import check_geometry
     from rgraph.compiler.pipeline import frontend
     from rgraph.ir.cull import cull
 
@@ -76,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
     check_impls(front.source)
     check_probe_buffers(front.source, front.spec)
     culling = cull(front.spec)
+    check_geometry(front.spec, list(culling.passes))
     found = warnings(front, culling)
     if args.json:
         emit(document(

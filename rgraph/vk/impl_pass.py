@@ -58,7 +58,7 @@ class ImplPass:
         self.device = device
         self.p = plan_pass
         try:
-            impl_class = lookup(plan_pass["impl"]) if plan_pass.get("impl") else probe_class(plan_pass)
+            impl_class = lookup(plan_pass["impl"]) if plan_pass.get("impl") else probe_class(plan_pass, device)
         except KeyError as exc:
             raise ExecutionError(f"pass {plan_pass['name']!r}: {exc.args[0]}") from None
         self.render_pass = None

@@ -171,6 +171,15 @@ def names() -> list[str]:
     return sorted(_REGISTRY)
 
 
+def scene_param_schema() -> dict[str, Param]:
+    """Graph params every implemented pass of a plan with a scene reads through its shader
+    defines (``rgraph.vk.scene_modes``): refused before the device opens, located in the graph."""
+    from rgraph.vk.scene_modes import MAX_VIEWS, MODES, NAIVE_WAYS
+
+    return {"views": Param(int, 1, MAX_VIEWS), "draw.mode": Param(str, choices=MODES),
+            "draw.naive": Param(str, choices=NAIVE_WAYS)}
+
+
 def param_problems(plan: Mapping[str, Any], user_params: Mapping[str, Any] | None = None) -> list[tuple[str, str]]:
     """(param name, message) for every param value of ``plan`` that an implementation's
     ``param_schema`` refuses; the values a pass sees are the plan's merged with its own.
@@ -188,7 +197,8 @@ def param_problems(plan: Mapping[str, Any], user_params: Mapping[str, Any] | Non
         except KeyError:
             continue  # the executor reports unknown implementations itself
         values = {**shared, **(p.get("params") or {})}
-        for name, spec in cls.param_schema.items():
+        schema = {**cls.param_schema, **(scene_param_schema() if plan.get("scene_source") else {})}
+        for name, spec in schema.items():
             if name not in values:
                 continue
             problem = spec.problem(values[name])

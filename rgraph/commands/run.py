@@ -191,11 +191,11 @@ def _plan_from_file(args: argparse.Namespace) -> dict:
 
 def _params_view(args: argparse.Namespace) -> dict:
     """The passes' impls and params as a plan would carry them, without touching a device."""
+    from rgraph.commands.outputs import params_view
     from rgraph.compiler.pipeline import frontend
 
-    spec = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size)).spec
-    return {"source": str(spec.source) if getattr(spec, "source", None) else args.graph, "params": dict(spec.params),
-            "passes": [{"name": p.name, "impl": p.impl, "params": dict(p.params)} for p in spec.passes]}
+    return params_view(frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size)).spec,
+                       args.graph)
 
 
 def _is_multi_plan(target: str) -> bool:

@@ -100,13 +100,15 @@ class PassImpl:
       otherwise the runtime makes one from the pass's attachments and wraps ``record`` in it;
     - ``multiview``: True when the shaders handle ``gl_ViewIndex`` (``RGRAPH_VIEWS``): with the
       graph param ``views`` > 1 and attachments of that many layers, the runtime's render pass
-      renders every view in one pass (VK_KHR_multiview view mask, one framebuffer layer).
+      renders every view in one pass (VK_KHR_multiview view mask, one framebuffer layer);
+      ``"layers"``: every layer of layered attachments is a view, whatever ``views`` says
+      (``gl_ViewIndex`` is the layer: the sort-last composite);
     """
 
     attachment_load: ClassVar[dict[str, str]] = {}
     clear_values: ClassVar[dict[str, Any]] = {}
     owns_render_pass: ClassVar[bool] = False
-    multiview: ClassVar[bool] = False
+    multiview: ClassVar[bool | str] = False
     param_schema: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, setup: Any) -> None:

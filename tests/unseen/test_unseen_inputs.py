@@ -10,7 +10,10 @@ tracing pipelines) and each bug these inputs found stays fixed:
 - ``validate`` passed a persistent scene accel with no meshes to build it from, ``compile``
   refused it;
 - unknown keys in a scene's camera/cameras/materials/instances/decals listed the top-level keys;
-- ``views`` outside 1..2 on a scene graph was an unlocated run-time error after compiling.
+- ``views`` outside 1..2 on a scene graph was an unlocated run-time error after compiling;
+- FORMAT.md section 1's own ``layers: "${scene.shadow_lights}"`` / ``bytes: "${scene.lights} * 64"``
+  failed on any scene without them, although only removed passes and optional reads use them;
+- the sort-last composite of layered images (``views=2``) broke validation and both eyes.
 """
 
 from __future__ import annotations
@@ -104,6 +107,25 @@ def test_views_out_of_range_is_refused_before_compiling_and_located(tmp_path: Pa
     assert main(["validate", "clustered", "-p", "views=2"]) == 0
 
 
+def test_counts_of_absent_scene_features_are_errors_only_where_used(tmp_path: Path, capsys) -> None:
+    graph = _g("spec_section1_probe")
+    plan = tmp_path / "plan.json"
+    assert main(["compile", graph, "--scene", _s("one_instance_no_lights"), "--size", "16x8", "-o", str(plan)]) == 0
+    doc = json.loads(plan.read_text())
+    assert [(c["pass"], c["resources"], c["bytes"]) for c in doc["culled"]] == [
+        ("shadow", ["shadow_maps"], 0), ("light_fill", ["lights"], 0)]
+    assert {d["resource"] for d in doc["dropped_reads"]} == {"shadow_maps", "lights"}
+    assert "shadow_maps" not in {r["name"] for r in doc["resources"]}
+    text = Path(graph).read_text()
+    kept = tmp_path / "kept.yaml"  # the shadow pass runs anyway: its 0 layers are an error again
+    kept.write_text(text.replace("    requires: [shadow_lights]\n", ""))
+    rc, diags = _diagnostics(capsys, ["validate", str(kept), "--scene", _s("opaque_only")])
+    assert rc == 2 and [(d["line"], d["col"]) for d in diags] == [(11, 25)] and "got 0" in diags[0]["message"]
+    literal = tmp_path / "literal.yaml"  # a literal 0 is an error even where nothing uses it
+    literal.write_text(text.replace('layers: "${scene.shadow_lights}"', "layers: 0"))
+    assert main(["validate", str(literal), "--scene", _s("deformable_rt")]) == 2
+
+
 def test_the_simulation_leaves_scene_geometry_traces_unchecked(memory) -> None:
     from rgraph.compiler.pipeline import compile_graph
     from rgraph.probe.simulate import simulate
@@ -143,6 +165,7 @@ RUNS = {  # id: (graph, scene, extra arguments)
     "ray_query_raster_async": ("rt_ray_query_raster", "one_instance_no_lights", []),
     "ray_query_sort_first": ("rt_ray_query_raster", "presets", ["--devices", "0,0", "--split", "sort-first",
                                                                  "--camera", "1"]),
+    "spec_section1_no_shadow_lights": ("spec_section1_probe", "opaque_only", []),
     "cluster_views2_sort_last": ("cluster_like", "many_lights_odd", ["-p", "views=2", "--devices", "0,0",
                                                                      "--split", "sort-last"]),
 }

@@ -431,11 +431,16 @@ def _pass(name: str, order: int, located: Located, resources: dict[str, Resource
     )
 
 
+def _a(kind: str) -> str:
+    """``an image``, ``a buffer``, ``an accel``."""
+    return ("an " if kind[0] in "aeiou" else "a ") + kind
+
+
 def _access(pass_name, pass_kind, section, res, ranges, entry, where, located, key) -> AccessSpec:
     usage = entry.usage
     if res.kind not in USAGE_RESOURCE_KINDS[usage]:
-        kinds = " or ".join(sorted(USAGE_RESOURCE_KINDS[usage]))
-        raise RGraphError.at(where, f"usage '{usage}' needs an {kinds}, but '{res.name}' is a {res.kind}")
+        kinds = " or ".join(_a(k) for k in sorted(USAGE_RESOURCE_KINDS[usage]))
+        raise RGraphError.at(where, f"usage '{usage}' needs {kinds}, but '{res.name}' is {_a(res.kind)}")
     if pass_kind not in USAGE_PASS_KINDS[usage]:
         kinds = ", ".join(sorted(USAGE_PASS_KINDS[usage]))
         raise RGraphError.at(where, f"usage '{usage}' is not possible in a {pass_kind} pass (only in: {kinds})")
@@ -461,7 +466,7 @@ def _access(pass_name, pass_kind, section, res, ranges, entry, where, located, k
                     f"{axis} range {a}:{b} is outside '{res.name}', which has {count} {axis}{'s' if count != 1 else ''}",
                 )
     elif ranges:
-        raise RGraphError.at(located.key_loc(section, key), f"'{res.name}' is a {res.kind}: it has no mips or layers")
+        raise RGraphError.at(located.key_loc(section, key), f"'{res.name}' is {_a(res.kind)}: it has no mips or layers")
     return AccessSpec(
         res.name, usage, writes, mips, layers, tuple(entry.stages) if entry.stages else None, entry.optional, where
     )

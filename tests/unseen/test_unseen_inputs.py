@@ -151,6 +151,45 @@ def test_ray_queries_need_the_device_feature() -> None:
     assert probe_class(plan_pass, SimpleNamespace(name="gpu", enabled_features={"rayQuery"})).__name__ == "Probe"
 
 
+BAD = {  # malformed ray tracing graphs (tests/fixtures/unseen/bad): (line, col, message start) each
+    "accel_geom_bad": [(4, 33, "unknown geometry 'everything' (valid: scene, probe)")],
+    "accel_kind_typo": [(4, 16, "unknown resource kind 'acceleration'"), (8, 11, "unknown pass kind 'raytracing'")],
+    "accel_no_build": [(9, 19, "pass 'trace' reads 'tlas' before any pass writes it")],
+    "accel_read_on_image": [(13, 36, "usage 'accel_read' needs an accel, but 'src' is an image")],
+    "accel_rw": [(11, 20, "pass 'both' uses overlapping parts of 'tlas'")],
+    "accel_selector": [(12, 13, "'tlas' is an accel: it has no mips or layers")],
+    "accel_stages": [(12, 19, "stages ['fragment'] are not stages of a raytrace pass")],
+    "accel_twice": [(7, 55, "pass 'build' uses 'tlas' as accel_build twice")],
+    "accel_with_size": [(4, 23, "unknown key 'size' in resource 'tlas'"), (4, 37, "unknown key 'format'")],
+    "accel_wrong_usage": [(9, 20, "usage 'storage_write' needs a buffer or an image, but 'tlas' is an accel")],
+    "build_in_raster": [(9, 20, "usage 'accel_build' is not possible in a raster pass")],
+    "build_in_raytrace": [(9, 20, "usage 'accel_build' is not possible in a raytrace pass")],
+    "build_transfer_queue": [(9, 12, "a compute pass cannot run on the transfer queue")],
+    "rt_impl_unknown": [(13, 11, "no pass implementation named 'no_such_tracer'")],
+    "rt_requires_bad": [(12, 16, "unknown scene feature 'reflective_material'; did you mean 'reflective_materials'?")],
+    "trace_color_attach": [(13, 19, "usage 'color_attachment' is not possible in a raytrace pass")],
+    "trace_transfer_queue": [(12, 12, "a raytrace pass cannot run on the transfer queue")],
+    "transfer_accel": [(13, 19, "usage 'transfer_src' needs a buffer or an image, but 'tlas' is an accel")],
+}
+
+
+def test_every_bad_fixture_is_listed() -> None:
+    assert sorted(p.stem for p in (FIXTURES / "bad").glob("*.yaml")) == sorted(BAD)
+
+
+@pytest.mark.parametrize("name", sorted(BAD))
+def test_malformed_ray_tracing_graphs_are_located(name: str, capsys) -> None:
+    path = str(FIXTURES / "bad" / f"{name}.yaml")
+    # impls: compile leaves them to the runtime; validate and run (before the device opens) look them up
+    commands = ["validate", "run"] if name == "rt_impl_unknown" else ["validate", "compile"]
+    for command in commands:
+        rc, diags = _diagnostics(capsys, [command, path])
+        assert rc == 2, command
+        assert [(d["file"], d["line"], d["col"]) for d in diags] == [(path, ln, col) for ln, col, _ in BAD[name]]
+        for d, (_, _, start) in zip(diags, BAD[name], strict=True):
+            assert d["message"].startswith(start), d["message"]
+
+
 # ------------------------------------------------------------------ on the device
 def _run(capsys, argv: list[str]) -> tuple[int, str]:
     capsys.readouterr()

@@ -205,6 +205,8 @@ RUNS = {  # id: (graph, scene, extra arguments)
     "ray_query_sort_first": ("rt_ray_query_raster", "presets", ["--devices", "0,0", "--split", "sort-first",
                                                                  "--camera", "1"]),
     "spec_section1_no_shadow_lights": ("spec_section1_probe", "opaque_only", []),
+    "ray_query_layers_sort_last": ("rt_ray_query_layers", "deformable_rt", ["--devices", "0,0", "--split",
+                                                                             "sort-last"]),
     "cluster_views2_sort_last": ("cluster_like", "many_lights_odd", ["-p", "views=2", "--devices", "0,0",
                                                                      "--split", "sort-last"]),
 }

@@ -100,13 +100,15 @@ class PassImpl:
       otherwise the runtime makes one from the pass's attachments and wraps ``record`` in it;
     - ``multiview``: True when the shaders handle ``gl_ViewIndex`` (``RGRAPH_VIEWS``): with the
       graph param ``views`` > 1 and attachments of that many layers, the runtime's render pass
-      renders every view in one pass (VK_KHR_multiview view mask, one framebuffer layer).
+      renders every view in one pass (VK_KHR_multiview view mask, one framebuffer layer);
+      ``"layers"``: every layer of layered attachments is a view, whatever ``views`` says
+      (``gl_ViewIndex`` is the layer: the sort-last composite);
     """
 
     attachment_load: ClassVar[dict[str, str]] = {}
     clear_values: ClassVar[dict[str, Any]] = {}
     owns_render_pass: ClassVar[bool] = False
-    multiview: ClassVar[bool] = False
+    multiview: ClassVar[bool | str] = False
     param_schema: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, setup: Any) -> None:
@@ -171,6 +173,15 @@ def names() -> list[str]:
     return sorted(_REGISTRY)
 
 
+def scene_param_schema() -> dict[str, Param]:
+    """Graph params every implemented pass of a plan with a scene reads through its shader
+    defines (``rgraph.vk.scene_modes``): refused before the device opens, located in the graph."""
+    from rgraph.vk.scene_modes import MAX_VIEWS, MODES, NAIVE_WAYS
+
+    return {"views": Param(int, 1, MAX_VIEWS), "draw.mode": Param(str, choices=MODES),
+            "draw.naive": Param(str, choices=NAIVE_WAYS)}
+
+
 def param_problems(plan: Mapping[str, Any], user_params: Mapping[str, Any] | None = None) -> list[tuple[str, str]]:
     """(param name, message) for every param value of ``plan`` that an implementation's
     ``param_schema`` refuses; the values a pass sees are the plan's merged with its own.
@@ -188,7 +199,8 @@ def param_problems(plan: Mapping[str, Any], user_params: Mapping[str, Any] | Non
         except KeyError:
             continue  # the executor reports unknown implementations itself
         values = {**shared, **(p.get("params") or {})}
-        for name, spec in cls.param_schema.items():
+        schema = {**cls.param_schema, **(scene_param_schema() if plan.get("scene_source") else {})}
+        for name, spec in schema.items():
             if name not in values:
                 continue
             problem = spec.problem(values[name])

@@ -120,6 +120,14 @@ def _param_location(plan: Mapping[str, Any], name: str) -> Location:
     return located.loc() if located is not None else Location(source)
 
 
+def params_view(spec: Any, graph: str) -> dict:
+    """The passes' impls and params of a specialized graph as a plan would carry them (what
+    ``check_pass_params`` reads), without touching a device."""
+    return {"source": str(spec.source) if getattr(spec, "source", None) else graph, "params": dict(spec.params),
+            "scene_source": spec.scene_source,
+            "passes": [{"name": p.name, "impl": p.impl, "params": dict(p.params)} for p in spec.passes]}
+
+
 def check_pass_params(plan: Mapping[str, Any], user_params: Mapping[str, Any]) -> None:
     """Every pass's params against its implementation's declared schema (before the device opens);
     an output param must come from the command line and be writable."""

@@ -190,12 +190,15 @@ def _plan_from_file(args: argparse.Namespace) -> dict:
 
 
 def _params_view(args: argparse.Namespace) -> dict:
-    """The passes' impls and params as a plan would carry them, without touching a device."""
+    """The passes' impls and params as a plan would carry them, without touching a device;
+    every ``impl`` must name a registered implementation (located in the graph, as validate)."""
+    from rgraph.commands.outputs import params_view
+    from rgraph.commands.validate import check_impls
     from rgraph.compiler.pipeline import frontend
 
-    spec = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size)).spec
-    return {"source": str(spec.source) if getattr(spec, "source", None) else args.graph, "params": dict(spec.params),
-            "passes": [{"name": p.name, "impl": p.impl, "params": dict(p.params)} for p in spec.passes]}
+    front = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size))
+    check_impls(front.source)
+    return params_view(front.spec, args.graph)
 
 
 def _is_multi_plan(target: str) -> bool:

@@ -1,6 +1,7 @@
 """``rgraph validate G [--scene S]``: schema and semantic checks, nothing else.
 
-Beyond what compiling checks, ``impl`` names are looked up in the pass registry and buffers
+Beyond what compiling checks, ``impl`` names are looked up in the pass registry, pass params
+are checked against their implementations' schemas (as ``rgraph run`` does), and buffers
 that probe passes use as ``indirect`` must hold the probe's argument header. Warnings
 (e.g. every pass culled) go to stderr as ``FILE:LINE:COL: warning: ...`` and keep exit 0.
 """
@@ -69,13 +70,17 @@ def warnings(front, culling) -> list[tuple[Location, str]]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from rgraph.commands.outputs import check_pass_params, params_view
+    from rgraph.compiler.accel import check_geometry
     from rgraph.compiler.pipeline import frontend
     from rgraph.ir.cull import cull
 
     front = frontend(args.graph, args.scene, parse_params(args.param), parse_size(args.size))
     check_impls(front.source)
+    check_pass_params(params_view(front.spec, args.graph), parse_params(args.param))
     check_probe_buffers(front.source, front.spec)
     culling = cull(front.spec)
+    check_geometry(front.spec, list(culling.passes))
     found = warnings(front, culling)
     if args.json:
         emit(document(

@@ -102,11 +102,23 @@ def _geometry(res: ResourceSpec, spec: Spec, passes: list[PassSpec]) -> tuple[st
     return "scene", blas, instances
 
 
+def used_accels(spec: Spec, passes: list[PassSpec]) -> list[ResourceSpec]:
+    """The accels that ``passes`` (the kept ones) touch, by name."""
+    used = {a.resource for p in passes for a in p.accesses}
+    return [r for n, r in sorted(spec.resources.items()) if r.kind == "accel" and n in used]
+
+
+def check_geometry(spec: Spec, passes: list[PassSpec]) -> None:
+    """What ``rgraph validate`` can tell without a device: every used accel has geometry to be
+    built from (the errors of sizing that are not the device's)."""
+    for res in used_accels(spec, passes):
+        _geometry(res, spec, passes)
+
+
 def size_accels(spec: Spec, passes: list[PassSpec], provider) -> list[PassSpec]:
     """Size every used accel of ``spec`` (in place) and add its scratch buffer; returns
     ``passes`` with each build pass also writing its accel's scratch, and refits reading."""
-    used = {a.resource for p in passes for a in p.accesses}
-    accels = [r for n, r in sorted(spec.resources.items()) if r.kind == "accel" and n in used]
+    accels = used_accels(spec, passes)
     if not accels:
         return passes
     if not hasattr(provider, "accel_sizes"):

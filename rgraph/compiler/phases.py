@@ -121,7 +121,8 @@ def measure(c: Compilation) -> Compilation:
     culled_used = {r: u for r, u in culled_used.items() if r not in traced}
     culled_reqs = memory.requirements(spec.resources, culled_used, spec.outputs, c.provider) if culled_used else {}
     return replace(c, memory=memory.resource_memory(reqs, used, spans),
-                   culled_bytes={r: q.bytes for r, q in culled_reqs.items()}, culled_only=culled_only)
+                   culled_bytes={r: 0 if r in spec.empty else q.bytes for r, q in culled_reqs.items()},
+                   culled_only=culled_only)
 
 
 def _culled_only(spec: Spec, culled: Sequence[Culled], traced: Mapping[str, object]

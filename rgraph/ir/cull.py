@@ -18,7 +18,7 @@ import networkx as nx
 from rgraph.ir.graph import READ_WRITE_USAGES, Cell, build_graph, last_writers
 from rgraph.native import load
 from rgraph.plan.builders import builder
-from rgraph.spec.specialize import PassSpec, Spec
+from rgraph.spec.specialize import PassSpec, Spec, check_empty
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,6 +60,7 @@ def cull(spec: Spec) -> Culling:
     culled += cascade
     alive = _alive(spec, kept)
     final, unreached = _split(kept, alive) if NATIVE is None else NATIVE.split(kept, alive, Culled)
+    check_empty(spec, final)
     if not culled:  # kept is in declaration order
         return Culling(final, unreached, dropped)
     culled += unreached

@@ -1,7 +1,8 @@
 """CPU simulation of the probe over a plan: the value every subresource holds after N frames.
 
 Values are integers (see ``rgraph.probe.values``) or None where the probe cannot know them
-(a format without an exact encoding, undefined contents, a partial copy).
+(a format without an exact encoding, undefined contents, a partial copy, an accel over the
+scene's geometry: what the probe's rays hit there depends on the scene).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ class Simulation:
         self.resources = {r["name"]: r for r in self.plan["resources"]}
         for r in self.resources.values():
             if r["lifetime"] in ("persistent", "imported"):
-                m = modulus(r)
+                m = modulus(r) if probe_known(r) else None
                 for key in all_keys(r):
                     self.values[key] = initial_value(r["name"], m) if m else None
 
@@ -71,14 +72,15 @@ class Simulation:
                 total = None
             else:
                 total = (total + value * len(read.stages)) & UINT32
-        if p["kind"] == "raytrace":  # the probe's rays against each accel read
+        if p["kind"] != "transfer":  # the probe's rays (ray queries outside raytrace passes) per accel read
             for a in accesses:
                 if a["usage"] == "accel_read":
                     value = self._get(a["resource"], None)
                     total = None if value is None or total is None else (total + trace_value(value)) & UINT32
         for a in accesses:
             if a["usage"] == "accel_build":
-                self._set(a["resource"], None, accel_value(self.plan, a["resource"]))
+                known = probe_known(self.resources[a["resource"]])
+                self._set(a["resource"], None, accel_value(self.plan, a["resource"]) if known else None)
         for write in probe.writes:
             m = modulus(self.resources[write.resource])
             for sub in write.subs:
@@ -93,6 +95,12 @@ class Simulation:
                         continue
                     out = (out + own) & UINT32
                 self._set(write.resource, sub, out % m)
+
+
+def probe_known(resource: dict) -> bool:
+    """Whether the probe can predict what a resource holds: not for an accel over the scene's
+    geometry (the probe's rays hit whatever the scene puts in their way)."""
+    return resource["kind"] != "accel" or (resource.get("accel") or {}).get("geometry", "probe") == "probe"
 
 
 def all_keys(resource: dict) -> list[Key]:

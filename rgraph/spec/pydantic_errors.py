@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import Any, get_args
 
 from pydantic import BaseModel, ValidationError
 
@@ -60,12 +60,37 @@ def _where(path: Sequence[str | int]) -> str:
     return "the file"
 
 
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """The pydantic models an annotation holds (through Optional, unions, lists, mappings)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    found: list[type[BaseModel]] = []
+    for arg in get_args(annotation):
+        found += [m for m in _models_in(arg) if m not in found]
+    return found
+
+
+def _nested_fields(model: type[BaseModel], path: Sequence[str | int]) -> list[str]:
+    """The field names of the model(s) at ``path``, walking field annotations; list indices and
+    mapping keys (a material's name) stay on the element model."""
+    current = [model]
+    for part in path:
+        inner = [m for c in current if isinstance(part, str) and part in c.model_fields
+                 for m in _models_in(c.model_fields[part].annotation)]
+        if inner:
+            current = inner
+    names: list[str] = []
+    for m in current:
+        names += [n for n in m.model_fields if n not in names]
+    return names
+
+
 def _model_fields(model: type[BaseModel], path: Sequence[str | int], data: Any = None) -> list[str]:
     """Best effort: the field names valid in the mapping at ``path`` for the did-you-mean."""
     from rgraph.spec import models
 
     if model is not models.GraphFile or not path:
-        return list(model.model_fields)
+        return _nested_fields(model, path)
     if path[0] == "passes" and len(path) >= 2:
         if len(path) >= 4 and path[2] in ("reads", "writes"):
             return list(models.UsageEntry.model_fields)

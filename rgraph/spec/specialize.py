@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -122,6 +122,10 @@ class Spec:
     removed: list[tuple[str, str]]  # (pass, reason) for `requires` the scene lacks
     scene_source: str | None = None  # the scene file's path (the runtime builds its geometry)
     memory_policy: str | None = None  # the graph's default placement policy (``memory_policy:``)
+    # resources whose count expression evaluated to 0 (``layers: "${scene.shadow_lights}"`` on a scene with
+    # none): a placeholder of count 1 in ``resources``; the error is raised only when an
+    # executed pass (after ``requires`` and culling) or an output uses it (``check_empty``)
+    empty: dict[str, RGraphError] = field(default_factory=dict)
 
 
 _SELECTOR = re.compile(r"^(?P<name>[^\[\]]+?)\s*(\[(?P<sel>[^\]]*)\])?$")
@@ -220,7 +224,13 @@ def specialize(
     """``quantities``: more ``scene.*`` names for expressions only (e.g. ``scene.draws``), not
     scene features (``requires`` and the plan's ``features`` do not see them)."""
     env = _Env(params, {**(quantities or {}), **features})
-    resources = {name: _resource(loc, env, size, limits) for name, loc in source.resources.items()}
+    resources: dict[str, ResourceSpec] = {}
+    empty: dict[str, RGraphError] = {}
+    for name, loc in source.resources.items():
+        try:
+            resources[name] = _resource(loc, env, size, limits)
+        except _Empty as exc:
+            resources[name], empty[name] = _resource(loc, env, size, limits, placeholder=True), exc
     outputs = _outputs(source, resources)
     passes: list[PassSpec] = []
     removed: list[tuple[str, str]] = []
@@ -251,7 +261,33 @@ def specialize(
         outputs=outputs,
         removed=removed,
         memory_policy=source.memory_policy,
+        empty=empty,
     )
+
+
+class _Empty(RGraphError):
+    """A resource count (layers, bytes, width, height, scale) whose expression evaluated to 0."""
+
+
+def _count_error(where: Location, message: str, value: float, placeholder: bool, raw: Any) -> None:
+    """Raise the out-of-range error of a count: ``_Empty`` for an expression (``raw`` a string)
+    that evaluated to 0, nothing for it when making a placeholder; a literal 0 is an error."""
+    empty = value == 0 and isinstance(raw, str)
+    if empty and placeholder:
+        return
+    raise (_Empty if empty else RGraphError).at(where, message)
+
+
+def check_empty(spec: Spec, passes: Sequence[PassSpec]) -> None:
+    """An empty resource (``Spec.empty``) that an executed pass or an output uses is an error;
+    otherwise only removed or culled passes (a shadow pass that ``requires: [shadow_lights]``)
+    and dropped optional reads ever named it."""
+    if not spec.empty:
+        return
+    used = {a.resource for p in passes for a in p.accesses} | set(spec.outputs)
+    found = [d for name, err in spec.empty.items() if name in used for d in err.diagnostics]
+    if found:
+        raise RGraphError(found)
 
 
 def _outputs(source: GraphSource, resources: dict[str, ResourceSpec]) -> list[str]:
@@ -267,16 +303,18 @@ def _outputs(source: GraphSource, resources: dict[str, ResourceSpec]) -> list[st
     return names
 
 
-def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits) -> ResourceSpec:
+def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits,
+              placeholder: bool = False) -> ResourceSpec:
+    """``placeholder``: counts of 0 become 1 (see ``Spec.empty``)."""
     model = loc.model
     if isinstance(model, AccelResource):
         return ResourceSpec(loc.name, "accel", model.lifetime, loc=loc.key_loc(), geometry=model.geometry)
     if not isinstance(model, ImageResource):
         nbytes = env.integer(model.bytes, loc, "bytes")
         if nbytes <= 0 or nbytes > limits.max_buffer_bytes:
-            raise RGraphError.at(
-                loc.loc("bytes"), f"buffer size {nbytes} bytes is out of range (1 .. {limits.max_buffer_bytes})"
-            )
+            _count_error(loc.loc("bytes"), f"buffer size {nbytes} bytes is out of range (1 .. {limits.max_buffer_bytes})",
+                         nbytes, placeholder, model.bytes)
+            nbytes = 4
         return ResourceSpec(loc.name, model.kind, model.lifetime, bytes=nbytes, loc=loc.key_loc())
     try:
         fmt = formats.lookup(model.format)
@@ -285,12 +323,13 @@ def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits) ->
             loc.loc("format"),
             f"unknown format {quote(model.format)}{did_you_mean(model.format.lower(), formats.names())}",
         ) from None
-    width, height = _extent(model.size, loc, env, size, limits)
+    width, height = _extent(model.size, loc, env, size, limits, placeholder)
     layers = env.integer(model.layers, loc, "layers")
     if not 1 <= layers <= limits.max_image_array_layers:
-        raise RGraphError.at(
-            loc.loc("layers"), f"layers must be 1 .. {limits.max_image_array_layers} (maxImageArrayLayers), got {layers}"
-        )
+        _count_error(loc.loc("layers"),
+                     f"layers must be 1 .. {limits.max_image_array_layers} (maxImageArrayLayers), got {layers}",
+                     layers, placeholder, model.layers)
+        layers = 1
     max_mips = int(math.floor(math.log2(max(width, height)))) + 1
     mips = env.integer(model.mips, loc, "mips")
     if not 1 <= mips <= max_mips:
@@ -303,14 +342,17 @@ def _resource(loc: Located, env: _Env, size: tuple[int, int], limits: Limits) ->
     )
 
 
-def _extent(value: Any, loc: Located, env: _Env, size: tuple[int, int], limits: Limits) -> tuple[int, int]:
+def _extent(value: Any, loc: Located, env: _Env, size: tuple[int, int], limits: Limits,
+            placeholder: bool = False) -> tuple[int, int]:
     limit = limits.max_image_dimension_2d
     if value == "output":
         dims = size
     elif isinstance(value, ScaleSize):
         scale = env.number(value.scale, loc, "size", "scale")
         if not 0 < scale <= MAX_SCALE:
-            raise RGraphError.at(loc.loc("size", "scale"), f"scale must be in (0, {MAX_SCALE:g}], got {scale}")
+            _count_error(loc.loc("size", "scale"), f"scale must be in (0, {MAX_SCALE:g}], got {scale}", scale,
+                         placeholder, value.scale)
+            scale = 1.0
         dims = (max(1, int(size[0] * scale)), max(1, int(size[1] * scale)))
     elif isinstance(value, list):
         if len(value) != 2:
@@ -321,8 +363,9 @@ def _extent(value: Any, loc: Located, env: _Env, size: tuple[int, int], limits: 
     for i, d in enumerate(dims):
         if not 1 <= d <= limit:
             where = loc.loc("size", i) if isinstance(value, list) else loc.loc("size")
-            raise RGraphError.at(where, f"image {('width', 'height')[i]} {d} is out of range (1 .. {limit}, maxImageDimension2D)")
-    return dims
+            _count_error(where, f"image {('width', 'height')[i]} {d} is out of range (1 .. {limit}, maxImageDimension2D)",
+                         d, placeholder, value[i] if isinstance(value, list) else None)
+    return (max(1, dims[0]), max(1, dims[1]))
 
 
 def _selector(template: str, located: Located, section: str, env: _Env) -> tuple[str, dict[str, tuple[int, int]]]:
@@ -388,11 +431,16 @@ def _pass(name: str, order: int, located: Located, resources: dict[str, Resource
     )
 
 
+def _a(kind: str) -> str:
+    """``an image``, ``a buffer``, ``an accel``."""
+    return ("an " if kind[0] in "aeiou" else "a ") + kind
+
+
 def _access(pass_name, pass_kind, section, res, ranges, entry, where, located, key) -> AccessSpec:
     usage = entry.usage
     if res.kind not in USAGE_RESOURCE_KINDS[usage]:
-        kinds = " or ".join(sorted(USAGE_RESOURCE_KINDS[usage]))
-        raise RGraphError.at(where, f"usage '{usage}' needs an {kinds}, but '{res.name}' is a {res.kind}")
+        kinds = " or ".join(_a(k) for k in sorted(USAGE_RESOURCE_KINDS[usage]))
+        raise RGraphError.at(where, f"usage '{usage}' needs {kinds}, but '{res.name}' is {_a(res.kind)}")
     if pass_kind not in USAGE_PASS_KINDS[usage]:
         kinds = ", ".join(sorted(USAGE_PASS_KINDS[usage]))
         raise RGraphError.at(where, f"usage '{usage}' is not possible in a {pass_kind} pass (only in: {kinds})")
@@ -418,7 +466,7 @@ def _access(pass_name, pass_kind, section, res, ranges, entry, where, located, k
                     f"{axis} range {a}:{b} is outside '{res.name}', which has {count} {axis}{'s' if count != 1 else ''}",
                 )
     elif ranges:
-        raise RGraphError.at(located.key_loc(section, key), f"'{res.name}' is a {res.kind}: it has no mips or layers")
+        raise RGraphError.at(located.key_loc(section, key), f"'{res.name}' is {_a(res.kind)}: it has no mips or layers")
     return AccessSpec(
         res.name, usage, writes, mips, layers, tuple(entry.stages) if entry.stages else None, entry.optional, where
     )

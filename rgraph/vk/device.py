@@ -246,7 +246,8 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         | ({"shaderOutputLayer"} if f12.shaderOutputLayer else set())
         | ({"drawIndirectCount"} if f12.drawIndirectCount else set()) | ({"multiview"} if multiview else set())
         | ({"shaderBufferInt64Atomics"} if int64_atomics else set())
-        | ({"bufferDeviceAddress", "accelerationStructure", "rayTracingPipeline"} if ray_tracing else set()),
+        | ({"bufferDeviceAddress", "accelerationStructure", "rayTracingPipeline"} if ray_tracing else set())
+        | ({"rayQuery"} if "VK_KHR_ray_query" in extensions else set()),
         timestamp_period_ns=float(props.limits.timestampPeriod),
         timestamp_valid_bits={q: families[f].timestampValidBits for q, f in plan_families.items()},
         capabilities={q: _capabilities(families[f].queueFlags) for q, f in plan_families.items()},

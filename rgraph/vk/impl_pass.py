@@ -58,7 +58,7 @@ class ImplPass:
         self.device = device
         self.p = plan_pass
         try:
-            impl_class = lookup(plan_pass["impl"]) if plan_pass.get("impl") else probe_class(plan_pass)
+            impl_class = lookup(plan_pass["impl"]) if plan_pass.get("impl") else probe_class(plan_pass, device)
         except KeyError as exc:
             raise ExecutionError(f"pass {plan_pass['name']!r}: {exc.args[0]}") from None
         self.render_pass = None
@@ -117,6 +117,11 @@ class ImplPass:
             pipelineBindPoint=v.VK_PIPELINE_BIND_POINT_GRAPHICS, colorAttachmentCount=len(color_refs),
             pColorAttachments=color_refs or None, pDepthStencilAttachment=depth_ref)
         views = int(plan.get("params", {}).get("views", 1))
+        if impl.multiview == "layers":  # every attachment layer is a view (whatever ``views``)
+            if layers > 1 and "multiview" not in self.device.enabled_features:
+                raise ExecutionError(f"pass {self.p['name']!r}: layered attachments need the Vulkan 1.1 feature "
+                                     "multiview; the device lacks it")
+            views = layers
         chain = {}
         if impl.multiview and views > 1:
             if layers != views:

@@ -104,7 +104,8 @@ def descriptor_types() -> dict[str, int]:
     return {"sampled": v.VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
             "storage_image": v.VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
             "storage_buffer": v.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-            "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+            "uniform_buffer": v.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+            "accel": v.VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR}
 
 
 class PassSetup:

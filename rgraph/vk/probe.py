@@ -70,6 +70,7 @@ class Probe(PassImpl):
         self.sampler = setup.sampler("nearest")
         self.res_plan = {r["name"]: r for r in self.plan["resources"]}
         self.plan_size = setup.size
+        self.accels: Any = setup.accels  # rgraph.vk.accel.AccelSet: accel_read bindings (ray queries)
         self.sets: list[Any] = []
         self.framebuffers: list[list[Any]] = []
         self.shaders: ProbeShaders | None = None
@@ -148,6 +149,13 @@ class Probe(PassImpl):
                 writes.append(v.VkWriteDescriptorSet(dstSet=self.sets[set_index], dstBinding=b.binding,
                                                      descriptorCount=1, descriptorType=kinds[b.kind],
                                                      pImageInfo=[info]))
+            elif b.kind == "accel":
+                handles = v.ffi.new("VkAccelerationStructureKHR[1]", [self.accels.tlas(a["resource"], set_index)])
+                info = v.VkWriteDescriptorSetAccelerationStructureKHR(accelerationStructureCount=1,
+                                                                      pAccelerationStructures=handles)
+                keep += [handles, info]
+                writes.append(v.VkWriteDescriptorSet(pNext=info, dstSet=self.sets[set_index], dstBinding=b.binding,
+                                                     descriptorCount=1, descriptorType=kinds[b.kind]))
             elif b.kind == "storage_image":
                 view = self.resources.view(r, (b.mip, b.mip + 1), tuple(a["subresource"]["layers"]))
                 info = v.VkDescriptorImageInfo(imageView=view, imageLayout=names.layout(a["layout"]))

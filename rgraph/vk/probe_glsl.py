@@ -3,7 +3,9 @@
 Bindings (set 0), in order: one combined image sampler per ``sampled`` access (a 2D-array
 view of its range), one storage image per (storage access, mip) (a 2D-array view of its
 layers), one storage buffer per storage buffer access, one uniform buffer per ``uniform``
-access. Vertex buffers feed one ``uint`` attribute each (stride 0). See
+access, then one acceleration structure per ``accel_read`` access (compute and raster passes:
+ray queries, the probe's rays of ``rgraph.vk.probe_rt_glsl`` in the compute shader or the
+fragment shader). Vertex buffers feed one ``uint`` attribute each (stride 0). See
 ``rgraph.probe.semantics`` for what is computed.
 """
 
@@ -12,11 +14,32 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from rgraph import formats
-from rgraph.probe.semantics import analyze, mip_extent, raster_read_stages
+from rgraph.probe.semantics import MISS_VALUE, analyze, mip_extent, raster_read_stages
 from rgraph.probe.values import HEADER_WORDS, Codec, codec, has_header, header_words, modulus
 from rgraph.vk.errors import ExecutionError
 
 STORAGE = ("storage_read", "storage_write", "storage_rw")
+#: (origin, direction) of the probe's rays, in the probe geometry's space
+#: (``rgraph.vk.accel.probe_geometry``): one hits instance 0, one instance 1, one misses.
+PROBE_RAYS = (((0.25, 0.5, -1.0), (0.0, 0.0, 1.0)), ((3.25, 0.5, -1.0), (0.0, 0.0, 1.0)),
+              ((0.25, 0.5, -1.0), (0.0, 0.0, -1.0)))
+
+
+def vec3(t: tuple[float, float, float]) -> str:
+    return "vec3(" + ", ".join(repr(float(x)) for x in t) + ")"
+
+
+def ray_query_lines(binding: int, indent: str) -> list[str]:
+    """The probe's rays against accel ``as{binding}`` as ray queries, each adding to ``s`` what
+    the ray tracing probe's closest-hit / miss shaders return."""
+    lines = []
+    for origin, direction in PROBE_RAYS:
+        lines += [f"{indent}{{ rayQueryEXT q; rayQueryInitializeEXT(q, as{binding}, gl_RayFlagsOpaqueEXT, 0xFFu, "
+                  f"{vec3(origin)}, 0.0, {vec3(direction)}, 100.0);",
+                  f"{indent}  while (rayQueryProceedEXT(q)) {{}}",
+                  f"{indent}  s += rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionTriangleEXT"
+                  f" ? uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true)) + 1u : {MISS_VALUE}u; }}"]
+    return lines
 
 
 @dataclass
@@ -97,8 +120,10 @@ def _words(resource: dict) -> int:
     return n
 
 
-def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, int]) -> ProbeShaders:
-    """The probe shaders of a compute or raster pass."""
+def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, int],
+             ray_queries: bool = True) -> ProbeShaders:
+    """The probe shaders of a compute or raster pass (``ray_queries=False``: no accel bindings,
+    the ray tracing probe adds its own)."""
     kind = plan_pass["kind"]
     if kind not in ("compute", "raster"):
         raise ExecutionError(f"pass {plan_pass['name']!r}: the probe has no shaders for kind {kind!r}")
@@ -135,6 +160,13 @@ def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, 
             bindings.append(BindingSpec(b, "uniform_buffer", i))
             decls.append(f"layout(set=0, binding={b}, std140) uniform U{b} {{ uvec4 w[{n}]; }} ubo{b};")
             by_access[(i, None)] = b
+    accels = []
+    for i, a in enumerate(accesses):
+        if a["usage"] == "accel_read" and ray_queries:
+            b = len(bindings)
+            bindings.append(BindingSpec(b, "accel", i))
+            decls.append(f"layout(set=0, binding={b}) uniform accelerationStructureEXT as{b};")
+            accels.append(b)
 
     def read_expr(access_index: int, sub, stage: str, xy: str) -> str:
         a = accesses[access_index]
@@ -227,11 +259,14 @@ def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, 
             lines.append(f"    if ({xy}.x < {w}u && {xy}.y < {h}u) imageStore(img{b}, {coord}, {_encode(c, value)});")
         return lines
 
-    header = ["#version 450", '#include "probe/common.glsl"', *decls]
+    version = ["#version 460", "#extension GL_EXT_ray_query : require"] if accels else ["#version 450"]
+    header = [*version, '#include "probe/common.glsl"', *decls]
     if kind == "compute":
         body = []
         for r in probe.reads:
             body.append(f"        s += {read_expr(r.access, r.sub, 'compute', 'p')};")
+        for b in accels:
+            body += ray_query_lines(b, "        ")
         for w in probe.writes:
             body += ["    " + line for line in write_block(w, "s", "p", "stride_total")]
         src = "\n".join([
@@ -302,6 +337,7 @@ def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, 
         "    uvec2 p = uvec2(gl_FragCoord.xy);",
         "    uint s = v_sum;",
         *frag_reads,
+        *(line for b in accels for line in ray_query_lines(b, "    ")),
         *stores,
         "}",
     ]) + "\n"

@@ -4,7 +4,8 @@
   then builds (or refits) each accel it writes from the probe geometry.
 - A raytrace pass runs a ray tracing pipeline whose raygen shader is the compute probe plus
   real rays against each accel it reads (``rgraph.vk.probe_rt_glsl``).
-Ray queries are never used.
+- A compute or raster pass that reads an accel casts the same rays as ray queries
+  (``rgraph.vk.probe_glsl``), where the device has them (VK_KHR_ray_query).
 """
 
 from __future__ import annotations
@@ -58,17 +59,19 @@ def refuse_layer_for_ray_tracing(plan: dict) -> None:
             "`rgraph check` cover them; the layer tracks no ray tracing hazards anyway)")
 
 
-def probe_class(plan_pass: dict) -> type[Probe]:
-    """The probe implementation of ``plan_pass`` (a pass without ``impl:``), ray tracing aware."""
+def probe_class(plan_pass: dict, device) -> type[Probe]:
+    """The probe implementation of ``plan_pass`` (a pass without ``impl:``), ray tracing aware.
+    A compute or raster pass reading an accel queries rays (FORMAT.md 5: "where the device has
+    them"): refused on a device without VK_KHR_ray_query."""
     from rgraph.impl import lookup
 
     if plan_pass["kind"] == "raytrace":
         return RayTraceProbe
+    if "rayQuery" not in device.enabled_features and any(a["usage"] == "accel_read" for a in plan_pass["accesses"]):
+        raise ExecutionError(f"pass {plan_pass['name']!r}: a {plan_pass['kind']} pass reads an accel (ray queries), "
+                             f"but {device.name} has no ray queries (VK_KHR_ray_query); make it a raytrace pass")
     if any(a["usage"] == "accel_build" for a in plan_pass["accesses"]):
         return AccelBuildProbe
-    if any(a["usage"] == "accel_read" for a in plan_pass["accesses"]):
-        raise ExecutionError(f"pass {plan_pass['name']!r}: the probe reads accels in raytrace passes only "
-                             "(no ray queries)")
     return lookup(PROBE)  # type: ignore[return-value]
 
 

@@ -13,13 +13,9 @@ from dataclasses import dataclass
 
 from rgraph.probe.semantics import MISS_VALUE
 from rgraph.vk.errors import ExecutionError
-from rgraph.vk.probe_glsl import ProbeShaders, generate
+from rgraph.vk.probe_glsl import PROBE_RAYS, ProbeShaders, generate, vec3
 
 RT_HEADER = "#version 460\n#extension GL_EXT_ray_tracing : require\n"
-
-#: (origin, direction) of the probe's rays, in the probe geometry's space.
-PROBE_RAYS = (((0.25, 0.5, -1.0), (0.0, 0.0, 1.0)), ((3.25, 0.5, -1.0), (0.0, 0.0, 1.0)),
-              ((0.25, 0.5, -1.0), (0.0, 0.0, -1.0)))
 
 
 @dataclass
@@ -31,13 +27,9 @@ class RayTraceProbeShaders:
     closest_hit: str
 
 
-def _vec(t: tuple[float, float, float]) -> str:
-    return "vec3(" + ", ".join(repr(float(x)) for x in t) + ")"
-
-
 def generate_rt(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, int]) -> RayTraceProbeShaders:
     accesses = plan_pass["accesses"]
-    base = generate(dict(plan_pass, kind="compute"), resources, plan_size)
+    base = generate(dict(plan_pass, kind="compute"), resources, plan_size, ray_queries=False)
     src = base.sources["comp"]
     accel_bindings = []
     decls, calls = [], []
@@ -48,8 +40,8 @@ def generate_rt(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[in
         accel_bindings.append((b, i))
         decls.append(f"layout(set=0, binding={b}) uniform accelerationStructureEXT as{b};")
         for origin, direction in PROBE_RAYS:
-            calls.append(f"        traceRayEXT(as{b}, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, {_vec(origin)}, 0.0, "
-                         f"{_vec(direction)}, 100.0, 0); s += probe_payload;")
+            calls.append(f"        traceRayEXT(as{b}, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, {vec3(origin)}, 0.0, "
+                         f"{vec3(direction)}, 100.0, 0); s += probe_payload;")
     for old, new in (("#version 450\n", RT_HEADER), ("layout(local_size_x = 8, local_size_y = 8) in;\n", ""),
                      ("gl_NumWorkGroups.xy * uvec2(8u, 8u)", "gl_LaunchSizeEXT.xy"),
                      ("gl_GlobalInvocationID", "gl_LaunchIDEXT"),

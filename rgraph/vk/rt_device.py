@@ -1,5 +1,7 @@
 """Ray tracing on the device: extensions, features and properties (VK_KHR_ray_tracing_pipeline,
-VK_KHR_acceleration_structure, buffer device addresses). Never ray queries.
+VK_KHR_acceleration_structure, buffer device addresses), and ray queries (VK_KHR_ray_query)
+where the device offers them: the probe of a compute or raster pass that reads an accel
+(FORMAT.md 5) queries rays.
 
 ``create_device(..., ray_tracing=True)`` calls :func:`chain` to extend its feature chain and
 extension list; extension commands come from :func:`proc` (vkGetDeviceProcAddr).
@@ -15,6 +17,7 @@ from rgraph.vk.loader import vk
 
 EXTENSIONS = ("VK_KHR_acceleration_structure", "VK_KHR_ray_tracing_pipeline", "VK_KHR_deferred_host_operations")
 MAINTENANCE6 = "VK_KHR_maintenance6"
+RAY_QUERY = "VK_KHR_ray_query"
 
 
 @dataclass(frozen=True)
@@ -50,6 +53,12 @@ def chain(physical: Any, device_name: str, next_struct: Any, bind2: bool = False
     if bind2 and MAINTENANCE6 in names:  # vkCmdBindDescriptorSets2KHR: see bind_descriptor_sets
         head = v.VkPhysicalDeviceMaintenance6FeaturesKHR(pNext=head, maintenance6=v.VK_TRUE)
         extensions.append(MAINTENANCE6)
+    q_rq = v.VkPhysicalDeviceRayQueryFeaturesKHR()
+    if RAY_QUERY in names:
+        v.vkGetPhysicalDeviceFeatures2(physical, v.VkPhysicalDeviceFeatures2(pNext=q_rq))
+    if RAY_QUERY in names and q_rq.rayQuery:
+        head = v.VkPhysicalDeviceRayQueryFeaturesKHR(pNext=head, rayQuery=v.VK_TRUE)
+        extensions.append(RAY_QUERY)
     e_as = v.VkPhysicalDeviceAccelerationStructureFeaturesKHR(pNext=head, accelerationStructure=v.VK_TRUE)
     e_rt = v.VkPhysicalDeviceRayTracingPipelineFeaturesKHR(
         pNext=e_as, rayTracingPipeline=v.VK_TRUE,

@@ -12,6 +12,17 @@ from rgraph.vk.resources import ResourceSet
 FRAMES_IN_FLIGHT = 2
 
 
+#: Timestamp queries past the passes' 2 per pass that no pass uses. Lavapipe (Mesa 25.0)
+#: writes as many timestamps as the last render pass had views, even outside a render pass
+#: (``handle_write_timestamp2`` counts ``state->info.view_mask``, which ending the pass does not
+#: clear): after a multiview pass, a command buffer's later timestamps each spill into the next
+#: query, and the last one past the pool, which crashed the driver (``clustered -p views=2``
+#: with no pass after ``forward`` in its batch, e.g. a device's share of a split frame). The
+#: spilled-into queries of later passes are reset and written again before they are read; the
+#: slack covers the most views a render pass can have (a 32-bit view mask).
+QUERY_SLACK = 32
+
+
 def create(ex: Any) -> None:
     """Resources, initial contents, frame 0's releases, pipelines, query pools, then recording."""
     from rgraph.vk.runtime import commands, one_time, submits
@@ -37,12 +48,13 @@ def create(ex: Any) -> None:
                                   scene=lambda: scene(ex), samplers=ex.samplers, accels=ex.accels))
     ex.updaters = [p for p in ex.passes if overrides_update(p)]
     n = len(ex.plan["passes"])
+    count = max(2 * n, 2) + QUERY_SLACK
     for _ in range(FRAMES_IN_FLIGHT):
         ex.query_pools.append(v.vkCreateQueryPool(dev.handle, v.VkQueryPoolCreateInfo(
-            queryType=v.VK_QUERY_TYPE_TIMESTAMP, queryCount=max(2 * n, 2)), None))
+            queryType=v.VK_QUERY_TYPE_TIMESTAMP, queryCount=count), None))
         # reset from the host (hostQueryReset): vkCmdResetQueryPool is not allowed on a
         # transfer-only queue family, and one host call per frame replaces one per pass
-        v.vkResetQueryPool(dev.handle, ex.query_pools[-1], 0, max(2 * n, 2))
+        v.vkResetQueryPool(dev.handle, ex.query_pools[-1], 0, count)
     ex.log.context = "recording"
     commands.record(ex)
     submits.build(ex)

@@ -250,28 +250,12 @@ def test_stereo_split_equals_one_device_in_both_eyes(mode: str) -> None:
     sampled its layered remote images through 2D views (4 validation errors, and wrong pixels in
     both eyes); now one multiview pass composites each eye."""
     import numpy as np
-    from multi_helpers import validated_pair
-
-    from rgraph.compiler.multi_device import Split
-    from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
-    from rgraph.vk.multi.run import MultiExecutable
-    from rgraph.vk.runtime.readback import decode_outputs
+    from multi_helpers import outputs_one_and_split, validated_pair
 
     pair = validated_pair()
     gpus = next(pair)
     params, size, scene = {"views": "2"}, (64, 48), _s("many_lights_odd")  # the old composite: 23 + 43 px wrong
-    plan = compile_graph("clustered", scene, params=params, size=size, memory=gpus[0].memory_requirements())
-    with gpus[0].load(plan) as exe:
-        exe.run(1)
-        one = decode_outputs(plan, exe.read_back())
-    split = compile_graph_plan("clustered", scene, params=params, size=size, memory=gpus[0].memory_requirements(),
-                               split=Split(2, mode))
-    multi = MultiExecutable(gpus, split)
-    try:
-        multi.run(1)
-        out = decode_outputs(multi.plans[0], multi.read_back())
-    finally:
-        multi.close()
+    _, one, out = outputs_one_and_split(gpus, "clustered", mode, size, scene, params)
     color = np.asarray(one["color"])
     assert color.shape[0] == 2 and not np.array_equal(color[0], color[1])  # two different eyes
     assert np.array_equal(color, np.asarray(out["color"]))

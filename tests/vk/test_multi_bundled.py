@@ -7,14 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from multi_helpers import validated_pair
+from multi_helpers import outputs_one_and_split, validated_pair
 
 from rgraph.api import open_device
-from rgraph.compiler.multi_device import Split
-from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
 from rgraph.resources import bundled_graphs
-from rgraph.vk.multi.run import MultiExecutable
-from rgraph.vk.runtime.readback import decode_outputs
 
 SIZE = (32, 24)
 COVERED_ELSEWHERE = {"surgery"}  # tests/vk/test_multi_device.py
@@ -42,21 +38,6 @@ def test_every_bundled_graph_is_listed():
     assert set(bundled_graphs()) <= set(VALIDATED) | COVERED_ELSEWHERE | RAY_TRACING
 
 
-def _outputs_one_and_split(gpus, graph, mode):
-    plan = compile_graph(graph, size=SIZE, memory=gpus[0].memory_requirements())
-    with gpus[0].load(plan) as exe:
-        exe.run(1)
-        one = decode_outputs(plan, exe.read_back())
-    split = compile_graph_plan(graph, size=SIZE, memory=gpus[0].memory_requirements(), split=Split(2, mode))
-    multi = MultiExecutable(gpus, split)
-    try:
-        multi.run(1)
-        out = decode_outputs(multi.plans[0], multi.read_back())
-    finally:
-        multi.close()
-    return plan, one, out
-
-
 def _assert_equal_outputs(plan, one, out):
     names = [r["name"] for r in plan["resources"] if r["lifetime"] == "output"]
     assert names
@@ -67,7 +48,7 @@ def _assert_equal_outputs(plan, one, out):
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("graph", VALIDATED)
 def test_bundled_graph_split_equals_one_device(gpus, graph, mode):
-    plan, one, out = _outputs_one_and_split(gpus, graph, mode)
+    plan, one, out = outputs_one_and_split(gpus, graph, mode, SIZE)
     _assert_equal_outputs(plan, one, out)
     assert [str(m) for g in gpus for m in g.instance.log.messages] == []
 
@@ -75,4 +56,4 @@ def test_bundled_graph_split_equals_one_device(gpus, graph, mode):
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("graph", sorted(RAY_TRACING & set(bundled_graphs())))
 def test_ray_tracing_graph_split_equals_one_device(rt_gpus, graph, mode):
-    _assert_equal_outputs(*_outputs_one_and_split(rt_gpus, graph, mode))
+    _assert_equal_outputs(*outputs_one_and_split(rt_gpus, graph, mode, SIZE))

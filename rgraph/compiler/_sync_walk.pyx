@@ -21,6 +21,10 @@ ctypedef uint64_t u64
 cdef dict _STAGE_BITS = {}, _ACCESS_BITS = {}  # name -> its bit
 cdef dict _SETS_STAGES = {}, _SETS_ACCESS = {}  # mask -> frozenset
 cdef bint _overflow = False
+#: A walk is running: its tables are in use. A walk started meanwhile (another thread, while
+#: this one is in ``plan_state``; or reentered through it) hands its cell to the Python walk,
+#: so a reset of the tables never happens under a running walk's pointers.
+cdef bint _busy = False
 
 
 cdef u64 _mask(object names, dict bits):
@@ -181,7 +185,20 @@ cdef Py_ssize_t _group_of(list uses, Py_ssize_t k, Py_ssize_t last, object layou
 
 def walk(list uses, bint image, tuple start, tuple aliases, tuple alias_waits, bint last_prev, sink, c, sub):
     """``sync._walk(uses, image, start, aliases, alias_waits, last_prev, sink, c, sub)``, or
-    None (sink untouched) where the walk's name sets do not fit its masks."""
+    None (sink untouched) where the walk's name sets do not fit its masks or another walk is
+    running (``_busy``)."""
+    global _busy
+    if _busy:
+        return None
+    _busy = True
+    try:
+        return _walk(uses, image, start, aliases, alias_waits, last_prev, sink, c, sub)
+    finally:
+        _busy = False
+
+
+cdef object _walk(list uses, bint image, tuple start, tuple aliases, tuple alias_waits, bint last_prev, sink, c,
+                  sub):
     global _overflow
     cdef Py_ssize_t n = len(uses), k, end = n - 1, covered_until = -1, i = 0, last_pass, release_at
     cdef SyncInfo *si

@@ -113,3 +113,62 @@ def test_the_compiled_trace_reads_any_access_type(tmp_path: Path) -> None:
     assert native[0] == python[0] and native[2] == python[2] and native[3] == python[3]
     assert {n: (r.usages, r.first, r.last, r.cells) for n, r in native[1].items()} == \
         {n: (r.usages, r.first, r.last, r.cells) for n, r in python[1].items()}
+
+
+def test_compiles_in_threads_give_the_same_plan(tmp_path: Path) -> None:
+    """The compiled cell walk keeps tables across calls: compiles in several threads at once
+    (the GIL changes hands inside a walk, at its Python calls) give the one-thread plan."""
+    import sys
+    import threading
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=11, passes=400)))
+    spec = frontend(path, size=(16, 16)).spec
+    expected = dump(compile_plan(spec))
+    results: list[str] = []
+    errors: list[BaseException] = []
+
+    def work() -> None:
+        try:
+            for _ in range(3):
+                results.append(dump(compile_plan(spec)))
+        except BaseException as exc:  # noqa: BLE001 - reported below
+            errors.append(exc)
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)  # hand the GIL over as often as possible
+    try:
+        threads = [threading.Thread(target=work) for _ in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert not errors, errors
+    assert len(results) == 12 and all(r == expected for r in results)
+
+
+def test_a_walk_started_during_a_walk_hands_its_cell_to_python(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A second compiled walk while one runs (from another thread, or reentered through the
+    Python calls it makes) declines (None: the caller runs the Python walk), so the tables the
+    running walk points into are never reset under it; the plan stays the same."""
+    from rgraph.compiler import sync as sync_module
+
+    walk_module = sync_module._WALK
+    start = ("GENERAL", None, None, None, None, (frozenset(), frozenset()))
+    assert walk_module.walk([], True, start, (), (), False, None, ("r", 0, 0), None) == start  # not busy
+    inner: list[object] = []
+    make_barrier = walk_module.make_barrier
+
+    def reentering(*fields):  # called by the walk for each barrier of a one-cell resource
+        inner.append(walk_module.walk([], True, start, (), (), False, None, ("r", 0, 0), None))
+        return make_barrier(*fields)
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=12, passes=80)))
+    spec = frontend(path, size=(16, 16)).spec
+    expected = dump(compile_plan(spec))
+    monkeypatch.setattr(walk_module, "make_barrier", reentering)
+    assert dump(compile_plan(spec)) == expected
+    assert inner and all(found is None for found in inner)

@@ -53,12 +53,12 @@ def chain(physical: Any, device_name: str, next_struct: Any, bind2: bool = False
     if bind2 and MAINTENANCE6 in names:  # vkCmdBindDescriptorSets2KHR: see bind_descriptor_sets
         head = v.VkPhysicalDeviceMaintenance6FeaturesKHR(pNext=head, maintenance6=v.VK_TRUE)
         extensions.append(MAINTENANCE6)
-    q_rq = v.VkPhysicalDeviceRayQueryFeaturesKHR()
     if RAY_QUERY in names:
+        q_rq = v.VkPhysicalDeviceRayQueryFeaturesKHR()
         v.vkGetPhysicalDeviceFeatures2(physical, v.VkPhysicalDeviceFeatures2(pNext=q_rq))
-    if RAY_QUERY in names and q_rq.rayQuery:
-        head = v.VkPhysicalDeviceRayQueryFeaturesKHR(pNext=head, rayQuery=v.VK_TRUE)
-        extensions.append(RAY_QUERY)
+        if q_rq.rayQuery:
+            head = v.VkPhysicalDeviceRayQueryFeaturesKHR(pNext=head, rayQuery=v.VK_TRUE)
+            extensions.append(RAY_QUERY)
     e_as = v.VkPhysicalDeviceAccelerationStructureFeaturesKHR(pNext=head, accelerationStructure=v.VK_TRUE)
     e_rt = v.VkPhysicalDeviceRayTracingPipelineFeaturesKHR(
         pNext=e_as, rayTracingPipeline=v.VK_TRUE,

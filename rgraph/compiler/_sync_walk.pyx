@@ -341,9 +341,10 @@ cdef object _walk(list uses, bint image, tuple start, tuple aliases, tuple alias
                 found[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
         if not has_key:
             continue
-        if multi is not None:  # per pass: [key, release pass, first cell position, cells] (few keys per pass)
-            key = ((_fs_stages(src_st), _fs_access(src_ac), key_src_layout, src_queue),
-                   (_fs_stages(dst_st), _fs_access(dst_ac), key_dst_layout, queue), key_aliases)
+        ps = _state(src_st, src_ac, key_src_layout, src_queue)
+        pd = _state(dst_st, dst_ac, key_dst_layout, queue)
+        if multi is not None:  # per pass: [(plan src, plan dst, aliases), release pass, first cell position, cells]
+            key = (ps, pd, key_aliases)
             rel = None if release_at < 0 else release_at
             groups = multi.get(i)
             cell = (c[1], c[2])
@@ -360,8 +361,7 @@ cdef object _walk(list uses, bint image, tuple start, tuple aliases, tuple alias
                 groups.append([key, rel, pos, [cell]])
             continue
         res = c[0]
-        barrier = make_barrier(res, sub, _state(src_st, src_ac, key_src_layout, src_queue),
-                               _state(dst_st, dst_ac, key_dst_layout, queue), key_aliases)
+        barrier = make_barrier(res, sub, ps, pd, key_aliases)
         found_list = bars[i]
         if found_list is None:
             bars[i] = [(res, barrier)]

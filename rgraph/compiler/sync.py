@@ -23,7 +23,6 @@ resource's last accesses and UNDEFINED.
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping, Sequence
-from operator import itemgetter
 
 from rgraph.compiler.alias_starts import alias_state, with_partial_handoffs
 from rgraph.compiler.plan_values import get_state, get_subresource, make_barrier, plan_state, subresource
@@ -41,7 +40,6 @@ __all__ = ["EMPTY", "StateKey", "SyncResult", "synchronize"]
 
 PERSISTENT = ("persistent", "imported")
 EMPTY2 = (EMPTY, EMPTY)
-_LAST = itemgetter(-1)
 _new_wait = builder(pm.Wait)
 #: The compiled cell walk (``rgraph/compiler/_sync_walk.pyx``: the cell's state in C locals), None
 #: where it is not built or ``RGRAPH_NATIVE=0``.
@@ -56,7 +54,8 @@ _START_BUFFER = (None, plan_state((EMPTY, EMPTY, None, None)))
 #: many passes costs no union over all of them at each barrier),
 #: visible the dst scope (stages, access) of the barriers since it.
 CellEnd = tuple
-#: A barrier's key: (src state, dst state, aliases); cells of one resource and pass with equal
+#: A barrier's key: (src state, dst state, aliases); in a group of several cells the plan's states
+#: (interned). Cells of one resource and pass with equal
 #: keys (and release pass) share one barrier rectangle.
 Key = tuple
 #: Where the walk puts what it finds, per executed pass: (barriers as (resource, [mips, layers,]
@@ -325,7 +324,15 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
                 found[q] = (max(j, prev[0]), prev[1] | wait_stages) if prev else (j, wait_stages)
         if key is None:
             continue
-        if multi is not None:  # per pass: [key, release pass, first cell position, cells] (few keys per pass)
+        src, dst, names = key
+        ps = get_state(src)
+        if ps is None:
+            ps = plan_state(src)
+        pd = get_state(dst)
+        if pd is None:
+            pd = plan_state(dst)
+        if multi is not None:  # per pass: [(plan src, plan dst, aliases), release pass, first cell position, cells]
+            key = (ps, pd, names)  # (few keys per pass; plan states are interned: compared by identity first)
             groups = multi.get(i)
             if groups is None:
                 multi[i] = [[key, release_at, pos, [(c[1], c[2])]]]
@@ -339,13 +346,6 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
             else:
                 groups.append([key, release_at, pos, [(c[1], c[2])]])
             continue
-        src, dst, names = key
-        ps = get_state(src)
-        if ps is None:
-            ps = plan_state(src)
-        pd = get_state(dst)
-        if pd is None:
-            pd = plan_state(dst)
         res = c[0]
         barrier = make_barrier(res, sub, ps, pd, names)
         found = bars[i]
@@ -365,17 +365,15 @@ def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...]
 def _rectangles(res: str, by_pass: dict[int, list[list]], bars: list, rels: list,
                 all_mips: tuple[int, int], all_layers: tuple[int, int]) -> None:
     """A resource of several cells (``all_mips`` x ``all_layers``): per pass, its cells with
-    one key and release pass (grouped by the walks: [key, release pass, first cell position,
-    (mip, layer) cells], each cell once) merged into mip x layer rectangles (an acquire's
+    one key and release pass (grouped by the walks: [(plan src state, plan dst state, aliases),
+    release pass, first cell position, (mip, layer) cells], each cell once) merged into mip x layer rectangles (an acquire's
     rectangles equal its release's: the layer pairs ownership transfers by exact subresource
     range). A group of every cell (most groups of several) is the one whole rectangle."""
     get_sub = get_subresource
     count = (all_mips[1] - all_mips[0]) * (all_layers[1] - all_layers[0])
     whole = None  # the whole resource's subresource, once needed
     for i, groups in by_pass.items():
-        for (src, dst, names), release_at, first, cells in groups:
-            ps = get_state(src) or plan_state(src)
-            pd = get_state(dst) or plan_state(dst)
+        for (ps, pd, names), release_at, first, cells in groups:
             if len(cells) == 1:
                 ((mip, layer),) = cells
                 mips, layers = (mip, mip + 1), (layer, layer + 1)
@@ -410,7 +408,6 @@ def _gather(bars: list, rels: list, waits: list, passes: Sequence[PassSpec], fin
     releases: list[tuple[pm.Barrier, ...]] = [()] * count
     pass_waits: list[tuple[pm.Wait, ...]] = [()] * count
     signals = [False] * count
-    last = _LAST
     for i in range(count):
         found = bars[i]
         if found is not None:
@@ -418,7 +415,7 @@ def _gather(bars: list, rels: list, waits: list, passes: Sequence[PassSpec], fin
                 barriers[i] = (found[0][-1],)
             else:
                 found.sort()  # (resource, [mips, layers]) never tie within a pass: barriers not compared
-                barriers[i] = tuple(map(last, found))
+                barriers[i] = tuple([e[-1] for e in found])  # compiled: no call per entry (``map(last, ...)``)
         found = rels[i]
         if found is not None:
             if len(found) == 1:

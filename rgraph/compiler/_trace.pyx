@@ -10,6 +10,9 @@ from rgraph.compiler.plan_values import get_subresource, subresource
 from rgraph.compiler.usages import merge
 from rgraph.plan import model as pm
 
+from libc.string cimport memset
+from cpython.ref cimport PyObject
+
 include "../plan/_slots.pxi"
 include "../plan/_spec_slots.pxi"
 
@@ -20,6 +23,76 @@ cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "co
 cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared, never replaced)
 
 
+# ---- each access's scope and subresource, by the access's identity ------------------------
+# An ``AccessSpec`` is frozen: its scope (``trace._SCOPES`` by (usage, kind, stages, code,
+# refit)) and its subresource (by (mips, layers)) depend only on it, its pass's kind and its
+# resource's format code. Those lookups hash nested tuples at every access of every compile;
+# this table finds them by pointers instead (each object kept alive while listed, so no
+# pointer is reused). The values are the ones the lookups give (equal ones, where those
+# tables were cleared since): the walk's results do not change.
+
+cdef enum:
+    _ACCESS_CAP = 8192  # table slots (power of two); at most half used, then emptied at a walk's start
+
+cdef struct AccessSlot:
+    PyObject *access
+    PyObject *kind
+    long code
+    PyObject *scope  # tuple: trace._SCOPES' value
+    PyObject *sub  # pm.Subresource or None
+
+cdef AccessSlot _accesses[_ACCESS_CAP]
+cdef Py_ssize_t _access_count = 0
+cdef list _access_keep = []  # what the table points at
+
+
+cdef inline size_t _access_home(PyObject *a, PyObject *kind, long code):
+    return ((<size_t> a >> 4) ^ ((<size_t> kind >> 4) * 31) ^ (<size_t> code * 0x9E37)) & (_ACCESS_CAP - 1)
+
+
+cdef inline AccessSlot *_access_find(object a, object kind, long code):
+    """The table's slot of (``a``, ``kind``, ``code``), or NULL."""
+    cdef size_t h = _access_home(<PyObject *> a, <PyObject *> kind, code)
+    while _accesses[h].access != NULL:
+        if (_accesses[h].access == <PyObject *> a and _accesses[h].kind == <PyObject *> kind
+                and _accesses[h].code == code):
+            return &_accesses[h]
+        h = (h + 1) & (_ACCESS_CAP - 1)
+    return NULL
+
+
+cdef inline void _access_add(object a, object kind, long code, tuple scope, object sub):
+    """Remember ``a``'s scope and subresource (not once the table is half full)."""
+    global _access_count
+    if _access_count >= _ACCESS_CAP // 2:
+        return
+    cdef size_t h = _access_home(<PyObject *> a, <PyObject *> kind, code)
+    while _accesses[h].access != NULL:
+        h = (h + 1) & (_ACCESS_CAP - 1)
+    _access_keep.append(a)
+    _access_keep.append(kind)
+    _access_keep.append(scope)
+    _access_keep.append(sub)
+    _accesses[h].access = <PyObject *> a
+    _accesses[h].kind = <PyObject *> kind
+    _accesses[h].code = code
+    _accesses[h].scope = <PyObject *> scope
+    _accesses[h].sub = <PyObject *> sub
+    _access_count += 1
+
+
+cdef void _access_reset():
+    global _access_count
+    memset(_accesses, 0, sizeof(_accesses))
+    _access_count = 0
+    _access_keep.clear()
+
+
+def reset_access_table():
+    """Empty the table (tests: a walk that fills it afresh gives the same results)."""
+    _access_reset()
+
+
 cdef class _Res:
     """A resource's ``ResourceTrace`` fields during the walk, and its whole-image ranges."""
 
@@ -27,6 +100,7 @@ cdef class _Res:
     cdef Py_ssize_t first, last
     cdef list cells
     cdef object code  # int
+    cdef long icode  # the same, for the access table
     cdef list group  # or None
     cdef bint single
     cdef object mips, layers  # read-group candidates: (0, mips), (0, layers)
@@ -42,7 +116,8 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     r.usages = {usage}
     r.first = r.last = i
     r.cells = []
-    r.code = image + 2 * depth + 4 * stencil
+    r.icode = image + 2 * depth + 4 * stencil
+    r.code = r.icode
     if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil:
         r.group = []
         r.mips, r.layers = (0, res.mips), (0, res.layers)
@@ -82,10 +157,13 @@ def walk(passes, resources, dict scopes, scope_of):
     cdef list plan_accesses = [], values, uses, cells
     cdef dict info = {}, timeline = {}, waits = {}
     cdef Py_ssize_t i = -1, j, pos
-    cdef bint raytrace
+    cdef bint raytrace, exact
+    cdef AccessSlot *slot
     cdef _Res r
     cdef tuple scope, prev, cs
     cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, stages, refit, a_cells
+    if _access_count >= _ACCESS_CAP // 2:
+        _access_reset()
     for p in passes:
         i += 1
         oi = i
@@ -96,6 +174,7 @@ def walk(passes, resources, dict scopes, scope_of):
         j = -1
         for a in <tuple> pass_field(p, 7, "accesses"):
             j += 1
+            exact = type(a) is ACCESS_SPEC  # frozen: its scope and subresource are in the table
             name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
             mips, layers, stages = access_field(a, 3, "mips"), access_field(a, 4, "layers"), access_field(a, 5, "stages")
             refit, a_cells = access_field(a, 8, "refit"), access_field(a, 9, "cells")
@@ -109,17 +188,24 @@ def walk(passes, resources, dict scopes, scope_of):
                 r.last = i
             if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 r.usages.add("trace_indirect")
-            key = (usage, kind, stages, r.code, refit)
-            found = scopes.get(key)
-            scope = <tuple> (scope_of(key) if found is None else found)
+            slot = _access_find(a, kind, r.icode) if exact else NULL
+            if slot != NULL:
+                scope = <tuple> slot.scope
+                sub = <object> slot.sub
+            else:
+                key = (usage, kind, stages, r.code, refit)
+                found = scopes.get(key)
+                scope = <tuple> (scope_of(key) if found is None else found)
+                if mips is None:  # buffers and accels
+                    sub = None
+                else:
+                    sub = SUBRESOURCES.get((mips, layers))
+                    if sub is None:
+                        sub = subresource(mips, layers)
+                if exact:
+                    _access_add(a, kind, r.icode, scope, sub)
             s = scope[0]
             layout = scope[3]
-            if mips is None:  # buffers and accels
-                sub = None
-            else:
-                sub = SUBRESOURCES.get((mips, layers))
-                if sub is None:
-                    sub = subresource(mips, layers)
             value = new_slots(ACCESS)
             put(value, ACCESS, 0, name)
             put(value, ACCESS, 1, sub)

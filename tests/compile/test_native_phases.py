@@ -172,3 +172,34 @@ def test_a_walk_started_during_a_walk_hands_its_cell_to_python(tmp_path: Path, m
     monkeypatch.setattr(walk_module, "make_barrier", reentering)
     assert dump(compile_plan(spec)) == expected
     assert inner and all(found is None for found in inner)
+
+
+def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
+    """The compiled trace walk finds each access's scope and subresource by the access object
+    (``_trace.pyx``'s table), keyed also by its pass's kind and its resource's format code:
+    the same access objects in passes of another kind, or on resources of another format,
+    give the Python walk's scopes, not the ones remembered from the first walk."""
+    from dataclasses import replace
+
+    from rgraph import formats
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=7, passes=120)))
+    spec = frontend(path, size=(16, 16)).spec
+    passes, resources = list(spec.passes), dict(spec.resources)
+
+    def walks_alike(ps, rs) -> None:
+        native = trace.NATIVE.walk(ps, rs, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, rs)
+        assert native[0] == python[0]  # the plan accesses (stages, access, layout, subresource)
+        assert [(n, r.cells) for n, r in native[1].items()] == [(n, r.cells) for n, r in python[1].items()]
+
+    trace.NATIVE.reset_access_table()
+    walks_alike(passes, resources)  # fills the table
+    swapped = [replace(p, kind="raytrace") if p.kind == "compute" else p for p in passes]
+    assert swapped != passes
+    walks_alike(swapped, resources)
+    depth = next(f for f in formats.all_formats() if f.has_depth and not f.has_stencil)
+    recoded = {n: replace(r, format=depth) if r.kind == "image" and r.format is not None and not r.format.has_depth
+               else r for n, r in resources.items()}
+    walks_alike(passes, recoded)

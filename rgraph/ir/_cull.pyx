@@ -1,6 +1,6 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False
 """Compiled mirror of ``rgraph.ir.cull._alive_python`` (the backwards walk)
-and of ``rgraph.ir.cull._split``: the same sets, with typed locals and the set tests of a write's
+and of ``rgraph.ir.cull._split`` (and ``_has_optional_python``): the same sets, with typed locals and the set tests of a write's
 few cells done cell by cell. Any change to the Python code must be made here too
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
@@ -94,3 +94,13 @@ def split(list kept, set alive, culled_class):
             put(value, CULLED, 1, "reaches no output")
             unreached.append(value)
     return final, unreached
+
+
+def has_optional(passes):
+    """``cull._has_optional(passes)``: whether any access of ``passes`` is optional (fields
+    read from the slots)."""
+    for p in passes:
+        for a in <tuple> pass_field(p, 7, "accesses"):
+            if access_field(a, 6, "optional"):
+                return True
+    return False

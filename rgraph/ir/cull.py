@@ -89,7 +89,14 @@ def _split(kept: list[PassSpec], alive: set[str]) -> tuple[list[PassSpec], list[
 
 
 def _has_optional(passes: list[PassSpec]) -> bool:
-    """Whether any access of ``passes`` is optional."""
+    """Whether any access of ``passes`` is optional (compiled where built: ``NATIVE``; it scans
+    every access of a graph without optional reads)."""
+    if NATIVE is not None:
+        return NATIVE.has_optional(passes)
+    return _has_optional_python(passes)
+
+
+def _has_optional_python(passes: list[PassSpec]) -> bool:
     for p in passes:
         for a in p.accesses:
             if a.optional:

@@ -203,3 +203,21 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
     recoded = {n: replace(r, format=depth) if r.kind == "image" and r.format is not None and not r.format.has_depth
                else r for n, r in resources.items()}
     walks_alike(passes, recoded)
+
+
+def test_the_optional_scan_agrees(tmp_path: Path) -> None:
+    """``cull._has_optional``'s compiled scan answers as the Python one, with and without an
+    optional access (first, last or none)."""
+    from dataclasses import replace
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=3, passes=60)))
+    passes = [replace(p, accesses=tuple(replace(a, optional=False) for a in p.accesses))
+              for p in frontend(path, size=(16, 16)).spec.passes]
+    with_last = [*passes[:-1], replace(passes[-1], accesses=(*passes[-1].accesses[:-1],
+                                                            replace(passes[-1].accesses[-1], optional=True)))]
+    with_first = [replace(passes[0], accesses=(replace(passes[0].accesses[0], optional=True),
+                                               *passes[0].accesses[1:])), *passes[1:]]
+    for ps, expected in ((passes, False), (with_last, True), (with_first, True), ([], False)):
+        assert cull.NATIVE.has_optional(ps) is expected
+        assert cull._has_optional_python(ps) is expected

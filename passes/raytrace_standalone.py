@@ -65,6 +65,22 @@ def deformed_tables(setup) -> Any:
     return getattr(setup.accels, "deformed", None)
 
 
+def scene_table_bindings(setup: Any, data) -> list[Binding]:
+    """Set 0 bindings 0-5 (the scene tables; over deformable meshes positions and normals are the
+    frame's, per set) and 6 (the sky) of the passes that shade with ``shaders/rt/common.glsl``."""
+    tables = pack_tables(data)
+    deformed = deformed_tables(setup)
+    bindings = []
+    for i, name in enumerate(TABLES):  # device-local: every hit reads them, every frame
+        if deformed is not None and name in ("positions", "normals"):  # per set, the frame's
+            buffers = deformed.position_buffers() if name == "positions" else deformed.normal_buffers()
+            bindings.append(Binding(i, "storage_buffer", buffers=buffers))
+            continue
+        bindings.append(Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)))
+    bindings.append(Binding(6, "sampled", "sky", array=True, sampler="nearest"))
+    return bindings
+
+
 def frame_constants(data, size: tuple[int, int], max_depth: int) -> bytes:
     _cam, basis, tan_half = camera_basis(data)
     right, up, fwd = basis
@@ -113,16 +129,7 @@ class RayTracingImpl(PassImpl):
         if not setup.plan.get("scene_source"):
             raise ValueError(f"pass {setup.name!r}: ray tracing needs a scene (--scene)")
         self.data = load_scene_data(setup.plan["scene_source"], setup.size, int(setup.plan.get("camera", 0)))
-        tables = pack_tables(self.data)
-        deformed = deformed_tables(setup)
-        bindings = []
-        for i, name in enumerate(TABLES):  # device-local: every hit reads them, every frame
-            if deformed is not None and name in ("positions", "normals"):  # per set, the frame's
-                buffers = deformed.position_buffers() if name == "positions" else deformed.normal_buffers()
-                bindings.append(Binding(i, "storage_buffer", buffers=buffers))
-                continue
-            bindings.append(Binding(i, "storage_buffer", buffers=(setup.device_buffer(tables[name]),)))
-        bindings.append(Binding(6, "sampled", "sky", array=True, sampler="nearest"))
+        bindings = scene_table_bindings(setup, self.data)
         images = [*images, *self.scene_bindings()]
         self.light_defines: dict[str, object] = {}
         if self.reads_light_maps and setup.has("light_maps"):

@@ -216,6 +216,9 @@ class VisClear(PassImpl):
         if setup.has("ray_args"):  # also reset the compacted ray list (instead of rt_reset_rays)
             bindings.append(Binding(9, "storage_buffer", "ray_args"))
             defines["RESET_RAYS"] = 1
+        if setup.has("first_args"):  # and the compute shading pass's list (passes/raytrace_first.py)
+            bindings.append(Binding(13, "storage_buffer", "first_args"))
+            defines["RESET_FIRST"] = 1
         levels = 0  # and the wavefront lists' arguments (passes/raytrace_wave.py)
         while levels < MAX_WAVE_RESETS and setup.has(list_args(levels + 1)):
             bindings.append(Binding(10 + levels, "storage_buffer", list_args(levels + 1)))

@@ -1,6 +1,7 @@
 """The hybrid's wavefront ray tree (graphs/rt_hybrid.yaml; docs/raytracing.md explains why):
 
-- ``rt_wave_shade`` (raytrace, every pixel): tree level 0. The first surface from the visibility
+- ``rt_wave_shade`` (raytrace, every pixel; when it reads ``first_list``, only the pixels listed
+  there by ``rt_hybrid_first``, passes/raytrace_first.py): tree level 0. The first surface from the visibility
   buffer, its opaque part (Phong + shadow rays) or the sky; a surface that reflects or refracts
   takes a slot of the pixel list (``ray_list``, ``ray_args`` = (0, 1, 1, count)),
   stores its own radiance in accumulator ``slot`` (``wave_color``: 3 x uint64 fixed point) and
@@ -120,8 +121,18 @@ class WaveShade(WaveImpl):
                 defines["LIST_FITS"] = 1
             else:
                 defines["SHADE_WALKS"] = 1
+        self.listed = setup.has("first_list")  # only the pixels rt_hybrid_first could not finish
+        if self.listed:
+            bindings.append(Binding(18, "storage_image", "first_list"))
+            defines["FIRST_LIST"] = 1
         super().__init__(setup, bindings, defines, True)
         self.extent = setup.extent_of("color")
+
+    def record(self, rec: Any, frame_set: int) -> None:
+        if self.listed:
+            self.trace_list(rec, frame_set, "first_args")
+        else:
+            super().record(rec, frame_set)
 
 
 @register("rt_wave")

@@ -1,13 +1,17 @@
 // Shared by the ray tracing passes: scene tables, sky cube map lookup, Wächter-Binder ray
 // offsets, the lighting model (passes/rt_model.py and its NumPy reference passes/rt_ref.py).
+#ifndef NO_TRACE  // NO_TRACE: a compute pass (hybrid_first.comp) that shades without tracing
 #extension GL_EXT_ray_tracing : require
+#endif
 
 #include "rt/tables.glsl"
 layout(set = 0, binding = 2, std430) readonly buffer Normals { float nrm[]; };
 layout(set = 0, binding = 4, std430) readonly buffer Materials { vec4 mat[]; };  // albedo.rgb ks | kr kt ior n
 layout(set = 0, binding = 5, std430) readonly buffer Lights { vec4 lights[]; };  // xyz type | radiance
 layout(set = 0, binding = 6) uniform sampler2DArray sky_map;
+#ifndef NO_TRACE
 layout(set = 1, binding = 0) uniform accelerationStructureEXT tlas;
+#endif
 
 layout(push_constant) uniform Frame {
     vec4 right;     // w: tan(fov_y / 2)

@@ -5,7 +5,7 @@
 // (common.glsl: surface). No depth is read. Where raster and ray may disagree (the pixel borders
 // another instance or the sky, or the pixel centre misses the rasterized triangle: snapped
 // vertices, edge rules) the camera ray is traced instead, as the stand-alone does.
-// Needs shade.glsl (trace_closest) included before.
+// Needs shade.glsl (trace_closest) included before; with NO_TRACE only raster_hit.
 #include "rt/gbuffer.glsl"
 layout(set = 0, binding = 8) uniform usampler2D visibility;
 
@@ -46,13 +46,23 @@ bool classified(uvec2 px) {
     return k.x > 0.0 || k.y > 0.0;
 }
 
-// false: nothing (the sky).
-bool first_hit(uvec2 px, vec3 d, out Hit h) {
+// The first surface from the visibility buffer alone: 1 the rasterized triangle's hit (h), 0 the
+// sky, -1 raster and ray may disagree (the camera ray must be traced).
+int raster_hit(uvec2 px, vec3 d, out Hit h) {
     uint id = texelFetch(visibility, ivec2(px), 0).r;
     uint instance = id == 0u ? 0xFFFFFFFFu : vis_instance(id);
     bool boundary = on_boundary(ivec2(px), instance);
-    if (id == 0u && !boundary) return false;
-    if (id != 0u && !boundary && hit_triangle(d, instance, vis_prim(id), h)) return true;
+    if (id == 0u && !boundary) return 0;
+    if (id != 0u && !boundary && hit_triangle(d, instance, vis_prim(id), h)) return 1;
+    return -1;
+}
+
+#ifndef NO_TRACE
+// false: nothing (the sky).
+bool first_hit(uvec2 px, vec3 d, out Hit h) {
+    int raster = raster_hit(px, d, h);
+    if (raster >= 0) return raster == 1;
     h = trace_closest(vec3(0.0), d);
     return h.t >= 0.0;
 }
+#endif

@@ -52,15 +52,17 @@ void light_map_tap(float stored, float expected, inout bool clear, inout bool bl
 
 // Mapped light `li` at point p with facing geometric normal ng (the shadow ray starts on the
 // ng side) and direction to the light to_light: 1 unblocked, 0 blocked, -1 not known (trace).
-// Only where a texel is no wider than LIGHT_MAP_GUARD pixel footprints at p (the camera is at
-// the origin; a reflected point's path is longer, so its footprint larger): an occluder the
-// taps miss is then narrower than a pixel there.
-int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light) {
+// Only where a texel is no wider than LIGHT_MAP_GUARD pixel footprints at p: an occluder the
+// taps miss is then narrower than a pixel there. The footprint is the pixel's cone at `path`, the
+// length of the ray path from the camera to p (|p| for a camera ray's hit: the camera is at the
+// origin; for a point seen in a mirror or through a pane, the whole path, as the cone spreads
+// along it).
+int light_map_test(uint li, vec3 p, vec3 ng, vec3 to_light, float path) {
     if (dot(ng, to_light) < 1e-3) return -1;  // the ray would start off the lit side: trace it
     ivec2 size = imageSize(light_maps).xy;
     uint b = 16u * li;
     vec4 m0 = maps[b];
-    float footprint = LIGHT_MAP_GUARD * length(p) * 2.0 * frame.right.w / float(frame.counts.y);
+    float footprint = LIGHT_MAP_GUARD * path * 2.0 * frame.right.w / float(frame.counts.y);
     bool clear = true, blocked = true;
     if (m0.w > 0.5) {
         vec3 v = p - m0.xyz;

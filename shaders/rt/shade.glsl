@@ -6,10 +6,18 @@ const uint MAX_STACK = 17u;
 #include "light_maps.glsl"
 #endif
 
-struct Ray { vec3 o; vec3 d; vec3 w; uint depth; };
+// path: the length of the path from the camera to o (0 for camera rays): with the ray's own t the
+// distance a hit's pixel footprint grows over (flat mirrors and panes keep a pixel's cone angle).
+struct Ray { vec3 o; vec3 d; vec3 w; uint depth; float path; };
 Ray stack[MAX_STACK];
 uint top = 0u;
 
+#ifdef NO_TRACE
+// Without ray tracing (hybrid_first.comp): a shadow ray the light maps cannot decide is not
+// traced; it marks the point `undecided`, and the caller hands the pixel to the ray tracing pass.
+bool undecided = false;
+bool lit(vec3 o, vec3 d, float dist) { undecided = true; return false; }
+#else
 Hit trace_closest(vec3 o, vec3 d) {
     hit.t = -1.0;
     traceRayEXT(tlas, gl_RayFlagsOpaqueEXT, 0xFF, 0, 0, 0, o, 0.0, d, T_MAX, 0);
@@ -22,8 +30,9 @@ bool lit(vec3 o, vec3 d, float dist) {
                 0xFF, 0, 0, 1, o, 0.0, d, dist, 1);
     return visible != 0u;
 }
+#endif
 
-vec3 shade_local(vec3 p, vec3 ng, vec3 ns, vec3 d, uint m) {
+vec3 shade_local(vec3 p, vec3 ng, vec3 ns, vec3 d, uint m, float path) {
     vec3 albedo = mat[2u * m].rgb;
     float ks = mat[2u * m].w, shininess = mat[2u * m + 1u].w;
     vec3 c = AMBIENT * albedo;
@@ -37,7 +46,7 @@ vec3 shade_local(vec3 p, vec3 ng, vec3 ns, vec3 d, uint m) {
         float n_dot_l = dot(ns, to_light);
         if (n_dot_l <= 0.0) continue;
 #ifdef LIGHT_MAPS
-        int known = i < MAPPED_LIGHTS ? light_map_test(i, p, ng, to_light) : -1;
+        int known = i < MAPPED_LIGHTS ? light_map_test(i, p, ng, to_light, path) : -1;
         if (known == 0 || (known < 0 && !lit(o, to_light, dist))) continue;
 #else
         if (!lit(o, to_light, dist)) continue;
@@ -50,7 +59,7 @@ vec3 shade_local(vec3 p, vec3 ng, vec3 ns, vec3 d, uint m) {
 }
 
 // Push the reflection/refraction rays of a surface hit by `r` (facing normals ngf/nsf).
-void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m) {
+void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m, float path) {
     if (r.depth + 1u >= frame.counts.z || top + 2u > MAX_STACK) return;
     vec4 k = mat[2u * m + 1u];  // kr kt ior n
     vec3 reflect_w = r.w * k.x;
@@ -61,12 +70,12 @@ void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m) {
         if (kk < 0.0) reflect_w += r.w * k.y;  // total internal reflection
         else {
             vec3 t = eta * r.d + (eta * cos_i - sqrt(kk)) * nsf;
-            stack[top++] = Ray(offset_ray(p, -ngf), safe_normalize(t, r.d), r.w * k.y * mat[2u * m].rgb, r.depth + 1u);
+            stack[top++] = Ray(offset_ray(p, -ngf), safe_normalize(t, r.d), r.w * k.y * mat[2u * m].rgb, r.depth + 1u, path);
         }
     }
     if (max(reflect_w.x, max(reflect_w.y, reflect_w.z)) > 0.0) {
         vec3 refl = r.d - 2.0 * dot(r.d, nsf) * nsf;
-        stack[top++] = Ray(offset_ray(p, ngf), safe_normalize(refl, ngf), reflect_w, r.depth + 1u);
+        stack[top++] = Ray(offset_ray(p, ngf), safe_normalize(refl, ngf), reflect_w, r.depth + 1u, path);
     }
 }
 
@@ -74,16 +83,18 @@ void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m) {
 // buffer): its weighted opaque radiance added to `color`, its children pushed on the stack.
 void shade_hit(Ray r, Hit h, inout vec3 color) {
     vec3 p = r.o + h.t * r.d;
+    float path = r.path + h.t;
     vec3 ng, ns; uint m;
     surface(h, r.d, ng, ns, m);
     bool entering = dot(r.d, ng) < 0.0;
     vec3 ngf = entering ? ng : -ng, nsf = entering ? ns : -ns;
     vec4 k = mat[2u * m + 1u];
     float opaque = 1.0 - k.x - k.y;
-    if (opaque > 0.0) color += r.w * opaque * shade_local(p, ngf, nsf, r.d, m);
-    push_children(r, p, ngf, nsf, entering, m);
+    if (opaque > 0.0) color += r.w * opaque * shade_local(p, ngf, nsf, r.d, m, path);
+    push_children(r, p, ngf, nsf, entering, m, path);
 }
 
+#ifndef NO_TRACE
 // One node of the ray tree: ray r's closest hit; adds its own radiance (the sky where it misses,
 // else the weighted opaque part) to `color` and pushes its children on the stack. The hybrid's
 // wavefront passes (hybrid_wave.rgen) run it once per listed ray.
@@ -99,6 +110,7 @@ vec3 walk() {
     while (top > 0u) visit(stack[--top], color);
     return color;
 }
+#endif
 
 vec3 camera_ray(uvec2 px) {
     float sx = (2.0 * (float(px.x) + 0.5) / float(frame.counts.x) - 1.0) * frame.right.w * frame.up.w;

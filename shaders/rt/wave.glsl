@@ -34,7 +34,7 @@ uint64_t to_fixed(float c) {
     return uint64_t(c > 0.0 ? min(c, FIXED_MAX) * FIXED_ONE : 0.0);  // NaN -> 0
 }
 
-// Ray records: (origin, owner slot bits), (direction, weight r), (weight g, b, -, -).
+// Ray records: (origin, owner slot bits), (direction, weight r), (weight g, b, path, -).
 struct RayRecord { vec4 a; vec4 b; vec4 c; };
 
 #ifdef NEXT_LIST
@@ -60,7 +60,7 @@ vec3 spill_and_walk(uint owner) {
 #endif
             for (uint i = 0u; i < n; ++i) {
                 Ray r = stack[i];
-                next_rays[first + i] = RayRecord(vec4(r.o, uintBitsToFloat(owner)), vec4(r.d, r.w.x), vec4(r.w.yz, 0.0, 0.0));
+                next_rays[first + i] = RayRecord(vec4(r.o, uintBitsToFloat(owner)), vec4(r.d, r.w.x), vec4(r.w.yz, r.path, 0.0));
             }
             top = 0u;
         } else {

@@ -8,10 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from locations import ROOT
+from rt_helpers import run_rt
 
-from rgraph.compiler.pipeline import compile_graph
 from rgraph.resources import builtin_passes
-from rgraph.vk.errors import VulkanUnavailable
 
 builtin_passes()
 from rgraph.passes.raytrace_hybrid import (  # noqa: E402
@@ -28,15 +27,7 @@ SIZE = 32
 
 
 def _run(graph, scene, params=None, extra=()):
-    from rgraph.vk.executor import execute_plan
-
-    plan = compile_graph(graph, scene_path=scene, size=(SIZE, SIZE), params=params or {}, extra_outputs=list(extra))
-    try:
-        result = execute_plan(plan, frames=2, read_outputs=True)
-    except VulkanUnavailable as exc:  # pragma: no cover
-        pytest.skip(str(exc))
-    assert result.messages == []
-    return result.outputs
+    return run_rt(graph, scene, (SIZE, SIZE), params, extra, frames=2)[1]
 
 
 def _image(outputs) -> np.ndarray:

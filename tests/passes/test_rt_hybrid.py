@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from locations import ROOT
+from rt_helpers import run_rt
 
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.resources import builtin_passes
-from rgraph.vk.errors import VulkanUnavailable
 
 builtin_passes()
 from rgraph.passes.raytrace_hybrid import (  # noqa: E402,E501
@@ -25,15 +25,7 @@ SCENE = ROOT / "graphs" / "scenes" / "rt_tiny.yaml"
 
 
 def _run(graph: str, size: int, scene=SCENE, extra=(), params=None):
-    from rgraph.vk.executor import execute_plan
-
-    plan = compile_graph(graph, scene_path=scene, size=(size, size), extra_outputs=list(extra), params=params or {})
-    try:
-        result = execute_plan(plan, frames=1, read_outputs=True)
-    except VulkanUnavailable as exc:  # pragma: no cover
-        pytest.skip(str(exc))
-    assert result.messages == []
-    return plan, result.outputs
+    return run_rt(graph, scene, (size, size), params, extra)
 
 
 def psnr(a, b) -> float:

@@ -9,10 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from locations import ROOT
+from rt_helpers import run_rt
 
-from rgraph.compiler.pipeline import compile_graph
 from rgraph.resources import builtin_passes
-from rgraph.vk.errors import VulkanUnavailable
 
 builtin_passes()
 from rgraph.passes import raytrace_lightmap  # noqa: E402
@@ -25,15 +24,7 @@ FAR = 3.0e38
 
 
 def _run(graph: str, scene, size: int, params=None, extra=()):
-    from rgraph.vk.executor import execute_plan
-
-    plan = compile_graph(graph, scene_path=scene, size=(size, size), params=params or {}, extra_outputs=list(extra))
-    try:
-        result = execute_plan(plan, frames=2, read_outputs=True)
-    except VulkanUnavailable as exc:  # pragma: no cover
-        pytest.skip(str(exc))
-    assert result.messages == []
-    return plan, result.outputs
+    return run_rt(graph, scene, (size, size), params, extra, frames=2)
 
 
 def _image(outputs) -> np.ndarray:

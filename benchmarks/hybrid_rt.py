@@ -12,9 +12,8 @@ rotating), so a clock change hits every plan alike; medians over the chunks' med
 Per scene and camera: stand-alone frame T (graphs/rt_standalone.yaml, the GPU span of the frame);
 the hybrid frame t (graphs/rt_hybrid.yaml: compute visibility buffer; its GPU span), split at
 the end of the visibility buffer: t_b = frame start -> visibility buffer end (the sky pass, tiny
-and independent of it, included), t_a = the rest (``first``: a compute pass shading every pixel
-that needs no ray and listing the others; ``shade``: those pixels' first surface with shadow rays,
-tree level 0; ``wave_1`` .. ``wave_3``: one indirect trace per tree level over its
+and independent of it, included), t_a = the rest (``shade``: every pixel's first surface with
+shadow rays, tree level 0; ``wave_1`` .. ``wave_3``: one indirect trace per tree level over its
 compacted ray list; ``resolve``); the ``raster`` columns are the same for
 graphs/rt_hybrid_raster.yaml (hardware-raster visibility buffer, the older classify + per-pixel
 walk design; ``--no-raster`` skips it); t_a / T,
@@ -25,10 +24,9 @@ Image agreement hybrid vs stand-alone:
 PSNR and SSIM of the tone-clamped [0, 1] images, FLIP (LDR) when flip-evaluator is installed;
 the share of pixels that traced secondary rays (the pixel list's length / pixels) and the rays of
 each wavefront level (``level_rays``; ``level_overflow``: a list was full and its rays walked
-in-thread, correct but slower); ``listed``: the share of pixels the compute pass handed to the
-shade pass's indirect trace. ``--all-pixels`` adds the hybrid as it was before that pass
-(benchmarks/graphs/rt_hybrid_all_pixels.yaml: the shade pass traces every pixel) in the same
-alternation.
+in-thread, correct but slower). ``--first`` adds benchmarks/graphs/rt_hybrid_first.yaml in the same
+alternation (``first`` columns; a compute pass shades every pixel that needs no ray and lists the
+others, the shade pass traces only those; ``first listed``: the share it listed).
 Output: a Markdown table on stdout and JSON lines (``--json``).
 """
 
@@ -52,7 +50,7 @@ WARMUP_S = 0.3  # seconds of frames of every plan before timing (GPU clocks ramp
 CHUNK = 5       # frames per timed run; the plans alternate run by run
 WAVE_LEVELS = 3  # the wavefront ray lists of graphs/rt_hybrid.yaml (rays_1 .. rays_3)
 ASYNC_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_async.yaml"  # --async: matte pixels on the async queue
-ALL_PIXELS_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_all_pixels.yaml"  # --all-pixels: no compute shading pass
+FIRST_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_first.yaml"  # --first: the compute shading pass
 
 
 def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: int, params: dict[str, str],
@@ -133,14 +131,14 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
             hybrid_params: dict[str, str] | None = None, async_shade: bool = False,
-            dump: Path | None = None, every_shadow_ray: bool = False, all_pixels: bool = False) -> dict[str, Any]:
+            dump: Path | None = None, every_shadow_ray: bool = False, first: bool = False) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
     (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns);
     with ``every_shadow_ray`` also the hybrid with ``rt.light_maps: 0`` (every shadow ray traced: ``traced_``);
-    with ``all_pixels`` also benchmarks/graphs/rt_hybrid_all_pixels.yaml (the shade pass over every pixel,
-    no compute shading pass: ``all_``).
+    with ``first`` also benchmarks/graphs/rt_hybrid_first.yaml (a compute pass shades the pixels that need
+    no ray, the shade pass traces the listed rest: ``first_``).
     ``dump``: a folder for ``SCENE_CAMERA.npz`` (the colour images as float16, the visibility ids)."""
     from rgraph.passes.raytrace_hybrid import prim_bits
 
@@ -151,17 +149,17 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
     params = {"rt.max_depth": str(depth)}
     levels = tuple(f"rays_{k}_args" for k in range(1, WAVE_LEVELS + 1))
     graphs = {"alone": ("rt_standalone", ()),
-              "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs", "first_args", *levels))}
+              "hybrid": ("rt_hybrid", ("ray_args", "visibility", "vis_jobs", *levels))}
     if raster:
         graphs["raster"] = (RASTER_GRAPH, ("visibility",))
     if async_shade:
         graphs["async"] = (str(ASYNC_GRAPH), ("ray_args",))
     if every_shadow_ray:
         graphs["traced"] = ("rt_hybrid", ())
-    if all_pixels:
-        graphs["all"] = (str(ALL_PIXELS_GRAPH), ())
+    if first:
+        graphs["first"] = (str(FIRST_GRAPH), ("first_args",))
     own = {"hybrid": {**params, **(hybrid_params or {})}, "traced": {**params, **(hybrid_params or {}), "rt.light_maps": "0"},
-           "all": {**params, **(hybrid_params or {})}}
+           "first": {**params, **(hybrid_params or {})}}
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=own.get(name, params),
                                  extra_outputs=list(extra), memory=gpu.memory_requirements())
              for name, (graph, extra) in graphs.items()}
@@ -178,8 +176,7 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
            "warmup_s": warmup_s, "T_ms": T, **_hybrid_columns(hybrid["timings"], T, out, alone["outputs"]),
            "traced_share": traced / (size[0] * size[1]),
            "boundary_share": boundary_share(out["visibility"][..., 0], prim_bits(data))}
-    if "first_args" in out:  # pixels the compute shading pass handed to the shade pass's trace
-        row["first_listed_share"] = int(np.frombuffer(out["first_args"].tobytes()[:4], dtype=np.uint32)[0]) / (size[0] * size[1])
+
     if dump is not None:
         dump.mkdir(parents=True, exist_ok=True)
         more = {"async": runs["async"]["outputs"]["color"].astype(np.float16)} if async_shade else {}
@@ -194,8 +191,10 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         row.update(_hybrid_columns(runs["async"]["timings"], T, runs["async"]["outputs"], alone["outputs"], "async_"))
     if every_shadow_ray:
         row.update(_hybrid_columns(runs["traced"]["timings"], T, runs["traced"]["outputs"], alone["outputs"], "traced_"))
-    if all_pixels:
-        row.update(_hybrid_columns(runs["all"]["timings"], T, runs["all"]["outputs"], alone["outputs"], "all_"))
+    if first:
+        listed = runs["first"]["outputs"]["first_args"].tobytes()[:4]  # pixels handed to the shade pass's trace
+        row.update(_hybrid_columns(runs["first"]["timings"], T, runs["first"]["outputs"], alone["outputs"], "first_"),
+                   first_listed_share=int(np.frombuffer(listed, dtype=np.uint32)[0]) / (size[0] * size[1]))
     if raster:
         raster_out = runs["raster"]["outputs"]
         row.update(_hybrid_columns(runs["raster"]["timings"], T, raster_out, alone["outputs"], "raster_"))
@@ -267,16 +266,15 @@ def table(rows: list[dict[str, Any]]) -> str:
     raster = any("raster_t_ms" in r for r in rows)
     extra = any("async_t_ms" in r for r in rows)
     traced = any("traced_t_ms" in r for r in rows)
-    every = any("all_t_ms" in r for r in rows)
-    listed = any("first_listed_share" in r for r in rows)
+    first = any("first_t_ms" in r for r in rows)
     head = ("| scene | camera | T (ms) | t_a (ms) | t_a/T | t_b (ms) | t (ms) | t/T | PSNR (dB) | SSIM | FLIP "
             "| traced | rays per level | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
             + (" async t (ms) | async t/T | async PSNR (dB) |" if extra else "")
             + (" traced t (ms) | traced t/T | traced PSNR (dB) |" if traced else "")
-            + (" all-pixels t (ms) | all-pixels t/T |" if every else "") + (" listed |" if listed else "")
+            + (" first t (ms) | first t/T | first PSNR (dB) | first listed |" if first else "")
             + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else "")
             + ("---:|---:|---:|" if extra else "") + ("---:|---:|---:|" if traced else "")
-            + ("---:|---:|" if every else "") + ("---:|" if listed else ""))
+            + ("---:|---:|---:|---:|" if first else ""))
     lines = [head]
     for r in rows:
         line = (f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
@@ -292,10 +290,9 @@ def table(rows: list[dict[str, Any]]) -> str:
         if traced:
             line += (f" {r['traced_t_ms']:.3f} | {r['traced_t_over_T']:.2f} | {_fmt(r['traced_psnr_db'], '.1f')} |"
                      if "traced_t_ms" in r else " - | - | - |")
-        if every:
-            line += f" {r['all_t_ms']:.3f} | {r['all_t_over_T']:.2f} |" if "all_t_ms" in r else " - | - |"
-        if listed:
-            line += f" {r['first_listed_share']:.1%} |" if "first_listed_share" in r else " - |"
+        if first:
+            line += (f" {r['first_t_ms']:.3f} | {r['first_t_over_T']:.2f} | {_fmt(r['first_psnr_db'], '.1f')} "
+                     f"| {r['first_listed_share']:.1%} |" if "first_t_ms" in r else " - | - | - | - |")
         lines.append(line)
     return "\n".join(lines)
 
@@ -333,8 +330,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
     parser.add_argument("--traced", action="store_true",
                         help="also time the hybrid with rt.light_maps=0 (every shadow ray traced)")
-    parser.add_argument("--all-pixels", action="store_true",
-                        help="also the hybrid whose shade pass traces every pixel (no compute shading pass)")
+    parser.add_argument("--first", action="store_true",
+                        help="also the hybrid with a compute pass shading the pixels that need no ray")
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
     parser.add_argument("--dump", type=Path, help="write each camera's two images (SCENE_CAMERA.npz) here")
     args = parser.parse_args(argv)
@@ -358,7 +355,7 @@ def main(argv: list[str] | None = None) -> int:
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
                                         chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
                                         async_shade=args.async_shade, dump=args.dump, every_shadow_ray=args.traced,
-                                        all_pixels=args.all_pixels))
+                                        first=args.first))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

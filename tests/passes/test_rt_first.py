@@ -1,7 +1,8 @@
-"""The hybrid's compute shading pass (``rt_hybrid_first``, passes/raytrace_first.py) on lavapipe:
-it finishes the pixels that need no ray and lists exactly the others for the shade pass, whose
-indirect trace then covers only those, and the image is the one the shade pass gives when it
-traces every pixel (benchmarks/graphs/rt_hybrid_all_pixels.yaml, the graph before the pass)."""
+"""The hybrid's compute shading pass (``rt_hybrid_first``, passes/raytrace_first.py;
+benchmarks/graphs/rt_hybrid_first.yaml) on lavapipe: it finishes the pixels that need no ray and
+lists exactly the others for the shade pass, whose indirect trace then covers only those, and
+the image is the one the bundled hybrid (graphs/rt_hybrid.yaml: the shade pass over every pixel)
+gives."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from rgraph.passes.raytrace_hybrid import (  # noqa: E402
     prim_bits,
 )
 
-ALL_PIXELS = ROOT / "benchmarks" / "graphs" / "rt_hybrid_all_pixels.yaml"
+FIRST = str(ROOT / "benchmarks" / "graphs" / "rt_hybrid_first.yaml")
 TIR = ROOT / "tests" / "data" / "rt" / "wave_tir.yaml"  # a directional and a point light, glass
 TINY = ROOT / "graphs" / "scenes" / "rt_tiny.yaml"
 SIZE = 32
@@ -65,8 +66,8 @@ def must_trace(outputs, scene) -> tuple[np.ndarray, np.ndarray]:
 @pytest.mark.vulkan
 @pytest.mark.parametrize("scene", [TIR, TINY], ids=["wave_tir", "rt_tiny"])
 def test_compute_pass_lists_only_what_needs_rays_and_keeps_the_image(scene):
-    first = _run("rt_hybrid", scene, extra=("first_args", "first_list", "visibility"))
-    every = _run(str(ALL_PIXELS), scene)
+    first = _run(FIRST, scene, extra=("first_args", "first_list", "visibility"))
+    every = _run("rt_hybrid", scene)
     count, listed = listed_pixels(first)
     needed, open_sky = must_trace(first, scene)
     assert listed[needed].all()  # every pixel that needs a ray is traced
@@ -83,10 +84,10 @@ def test_compute_pass_lists_only_what_needs_rays_and_keeps_the_image(scene):
 def test_without_light_maps_every_lit_surface_is_traced():
     """``rt.light_maps: 0``: no shadow test can be decided without a ray, so every surface the
     lights reach is listed, and the image is still the every-pixel one."""
-    first = _run("rt_hybrid", TIR, params={"rt.light_maps": "0"}, extra=("first_args", "first_list", "visibility"))
-    every = _run(str(ALL_PIXELS), TIR, params={"rt.light_maps": "0"})
+    first = _run(FIRST, TIR, params={"rt.light_maps": "0"}, extra=("first_args", "first_list", "visibility"))
+    every = _run("rt_hybrid", TIR, params={"rt.light_maps": "0"})
     _count, listed = listed_pixels(first)
-    mapped = _run("rt_hybrid", TIR, extra=("first_args", "first_list", "visibility"))
+    mapped = _run(FIRST, TIR, extra=("first_args", "first_list", "visibility"))
     _count, listed_mapped = listed_pixels(mapped)
     assert listed.sum() > listed_mapped.sum()  # the maps take pixels off the list
     assert listed[listed_mapped].all()

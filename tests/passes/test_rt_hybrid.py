@@ -70,7 +70,7 @@ def test_no_reflective_or_refractive_materials_culls_the_secondary_rays(tmp_path
     assert set(culled) == {"wave_1", "wave_2", "wave_3", "resolve"}
     assert all(reason == "scene has none of reflective_materials, refractive_materials" for reason in culled.values())
     assert {p["name"] for p in plan["passes"]} == {"build_as", "sky", "light_maps", "vis_clear", "vis_depth", "vis_depth_tiles",
-                                                   "vis_id", "vis_id_tiles", "first", "shade"}
+                                                   "vis_id", "vis_id_tiles", "shade"}
     sizes = {r["name"]: r["bytes"] for r in plan["resources"]}
     assert sizes["wave_color"] == 24 and sizes["rays_1"] == 48  # the wavefront's buffers shrink to one entry
     full = compile_graph("rt_hybrid", scene_path=SCENE, size=(16, 16))

@@ -64,10 +64,12 @@ def must_trace(outputs, scene) -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.mark.vulkan
-@pytest.mark.parametrize("scene", [TIR, TINY], ids=["wave_tir", "rt_tiny"])
-def test_compute_pass_lists_only_what_needs_rays_and_keeps_the_image(scene):
-    first = _run(FIRST, scene, extra=("first_args", "first_list", "visibility"))
-    every = _run("rt_hybrid", scene)
+@pytest.mark.parametrize("scene, wavefront", [(TIR, "0"), (TINY, "0"), (TIR, "1")],
+                         ids=["wave_tir", "rt_tiny", "wave_tir-by-levels"])
+def test_compute_pass_lists_only_what_needs_rays_and_keeps_the_image(scene, wavefront):
+    params = {"rt.wavefront": wavefront}  # 1: the listed pixels' trees traced level by level
+    first = _run(FIRST, scene, params, extra=("first_args", "first_list", "visibility"))
+    every = _run("rt_hybrid", scene, params)
     count, listed = listed_pixels(first)
     needed, open_sky = must_trace(first, scene)
     assert listed[needed].all()  # every pixel that needs a ray is traced

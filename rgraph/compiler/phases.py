@@ -176,9 +176,15 @@ def synchronize(c: Compilation) -> Compilation:
     # (heap, first byte, end byte) of the resources that alias or are aliased (``with_partial_handoffs``)
     named = {n for preds in aliases.values() for n in preds}.union(aliases)
     ranges = {n: (heap, off, off + c.memory[n].bytes) for n in named for heap, off in (offsets[n],)}
-    synchronize_passes = (SYNC_NATIVE or sync_python).synchronize
-    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, aliases, ranges,
-                                              set(c.spec.outputs)))
+    outputs = set(c.spec.outputs)
+    result = None
+    whole = sync_python._WALK  # the whole phase compiled (``_sync_walk.synchronize``); None: declined
+    if whole is not None:
+        result = whole.synchronize(c.passes, c.spec.resources, c.trace, aliases, ranges, outputs)
+    if result is None:
+        synchronize_passes = (SYNC_NATIVE or sync_python).synchronize
+        result = synchronize_passes(c.passes, c.spec.resources, c.trace, aliases, ranges, outputs)
+    return replace(c, sync=result)
 
 
 def emit(c: Compilation) -> Compilation:

@@ -590,11 +590,55 @@ cdef inline void _end_masks(CellState *st, u64 *stages, u64 *access):
         stages[0] = access[0] = 0
 
 
+cdef Py_ssize_t _group_at(list uses, SyncInfo **infos, Py_ssize_t k, Py_ssize_t last, object layout, object queue,
+                          u64 *stages, u64 *access):
+    """``_group_of`` with the uses' masks in ``infos``."""
+    cdef Py_ssize_t e = k
+    cdef tuple u
+    cdef SyncInfo *sj
+    stages[0] = infos[k].stages
+    access[0] = infos[k].access
+    while e < last:
+        u = <tuple> uses[e + 1]
+        sj = infos[e + 1]
+        if u[2] or _differ(<object> sj.layout, layout) or _differ(u[3], queue):
+            break
+        stages[0] |= sj.stages
+        access[0] |= sj.access
+        e += 1
+    return e
+
+
+cdef enum:
+    _INFOS_ON_STACK = 64
+
+
 cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alias_waits, bint last_prev,
                  _Sink sink, object res, long mip, long layer, object sub, bint multi) except -1:
     """``sync._walk`` from and into ``st`` (``sink`` None: the end state only). A barrier of a
     one-cell resource (``multi`` false) is built here (``sub``: its subresource); those of a
-    resource of several cells join its groups of their pass (``sink.head``)."""
+    resource of several cells join its groups of their pass (``sink.head``). Returns 1 (and
+    writes nothing) where a use's names do not fit the masks or the table is half full."""
+    cdef SyncInfo *on_stack[_INFOS_ON_STACK]
+    cdef SyncInfo **infos = on_stack
+    cdef Py_ssize_t n = len(uses), k
+    if n > _INFOS_ON_STACK:
+        infos = <SyncInfo **> malloc(n * sizeof(SyncInfo *))
+        if infos == NULL:
+            raise MemoryError()
+    try:
+        for k in range(n):  # every scope's masks before anything is written
+            infos[k] = _sync((<tuple> uses[k])[1])
+            if infos[k] == NULL:
+                return 1
+        return _walk_infos(uses, infos, image, st, aliases, alias_waits, last_prev, sink, res, mip, layer, sub, multi)
+    finally:
+        if infos != on_stack:
+            free(infos)
+
+
+cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tuple aliases, tuple alias_waits,
+                     bint last_prev, _Sink sink, object res, long mip, long layer, object sub, bint multi) except -1:
     cdef Py_ssize_t n = len(uses), k, end = n - 1, covered_until = -1, i = 0, last_pass = st.last_pass
     cdef Py_ssize_t release_at, pos, g, cr
     cdef SyncInfo *si
@@ -615,7 +659,7 @@ cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alia
         w = u[2]
         queue = u[3]
         pos = <Py_ssize_t> u[4]
-        si = _sync(s)  # registered before the walks
+        si = infos[k]
         wait_on = None
         transfer = False
         release_at = -1
@@ -650,7 +694,7 @@ cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alia
                 if w:
                     dst_st, dst_ac = si.stages, si.access
                 else:  # a transition for a read group: cover the whole group
-                    covered_until = _group_of(uses, k, end, new_layout, queue, si, &dst_st, &dst_ac)
+                    covered_until = _group_at(uses, infos, k, end, new_layout, queue, &dst_st, &dst_ac)
                     vis_st, vis_ac = dst_st, dst_ac
                 has_key = True
                 key_src_layout = layout
@@ -681,7 +725,7 @@ cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alia
                     src_st, src_ac = w_st, w_ac
                 else:
                     src_st = src_ac = 0
-                covered_until = _group_of(uses, k, end, new_layout, queue, si, &dst_st, &dst_ac)
+                covered_until = _group_at(uses, infos, k, end, new_layout, queue, &dst_st, &dst_ac)
                 vis_st, vis_ac = dst_st, dst_ac
                 if transfer or src_st or src_ac:
                     has_key = True
@@ -1124,26 +1168,17 @@ def synchronize(passes, resources, trace, alias_sources=None, ranges=None, outpu
         return None
     _busy = True
     try:
-        return _synchronize(passes, resources, trace, alias_sources, ranges, outputs)
+        result = _synchronize(passes, resources, trace, alias_sources, ranges, outputs)
+        if result is None and not _overflow:  # the mask table filled up: once more from empty tables
+            _reset()
+            result = _synchronize(passes, resources, trace, alias_sources, ranges, outputs)
+        return result
     finally:
         _busy = False
 
 
-cdef bint _register(dict traced):
-    """Every use's Sync in the mask table (False: a name set past the masks, or too many)."""
-    global _overflow
-    cdef list uses
-    _overflow = False
-    for r in traced.values():
-        for cell in <list> r.cells:
-            uses = <list> (<tuple> cell)[1]
-            for u in uses:
-                if _sync((<tuple> u)[1]) == NULL:
-                    return False
-    return True
-
-
 cdef object _synchronize(passes, resources, trace, alias_sources, ranges, outputs):
+    global _overflow
     cdef Py_ssize_t count = len(passes), ncell, g0
     cdef dict traced = trace.resources, sources, touched, initial = {}, final = {}, ends = {}
     cdef set wanted, kept_outputs
@@ -1157,10 +1192,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
         _reset()
     if _sub_count > _SUB_CAP // 4:
         _sub_reset()
-    if not _register(traced):
-        _reset()
-        if not _register(traced):
-            return None
+    _overflow = False
     alias_sources = alias_sources or {}
     touched = {n: len(traced[n].cells) for preds in alias_sources.values() for n in preds if n in traced}
     sources = with_partial_handoffs(alias_sources, touched, resources, ranges)
@@ -1190,7 +1222,8 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
             else:
                 aliases = alias_waits = ()
                 initial[name] = _state(0, 0, layout, None)
-            _walk_c(uses, image, &st, aliases, alias_waits, False, sink, c[0], mip, layer, sub, False)
+            if _walk_c(uses, image, &st, aliases, alias_waits, False, sink, c[0], mip, layer, sub, False):
+                return None
             final[name] = _end_state_of(&st)
             if want:
                 _end_masks(&st, &es, &ea)
@@ -1208,10 +1241,12 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
                 c = <tuple> cell[0]
                 uses = <list> cell[1]
                 _fresh(&st, layout)
-                _walk_c(uses, image, &st, (), (), False, None, c[0], 0, 0, None, False)
+                if _walk_c(uses, image, &st, (), (), False, None, c[0], 0, 0, None, False):
+                    return None
                 starts.append(_end_state_of(&st))
-                _walk_c(uses, image, &st, (), (), True, sink, c[0], c[1] if image else 0, c[2] if image else 0, sub,
-                        ncell > 1)
+                if _walk_c(uses, image, &st, (), (), True, sink, c[0], c[1] if image else 0, c[2] if image else 0,
+                           sub, ncell > 1):
+                    return None
                 finals.append(_end_state_of(&st))
                 if kept is not None:
                     _end_masks(&st, &es, &ea)
@@ -1227,8 +1262,9 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
                 uses = <list> cell[1]
                 st = first
                 starts.append(first_state)
-                _walk_c(uses, image, &st, aliases, alias_waits, False, sink, c[0], c[1] if image else 0,
-                        c[2] if image else 0, sub, ncell > 1)
+                if _walk_c(uses, image, &st, aliases, alias_waits, False, sink, c[0], c[1] if image else 0,
+                           c[2] if image else 0, sub, ncell > 1):
+                    return None
                 finals.append(_end_state_of(&st))
                 if kept is not None:
                     _end_masks(&st, &es, &ea)

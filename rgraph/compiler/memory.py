@@ -167,9 +167,12 @@ def place_resources(
     ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
     kept = set(outputs)
     aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
-    blocks = [
-        Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
-    ]
+    if NATIVE is None:
+        blocks = [
+            Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
+        ]
+    else:  # the same blocks, built in C with their aligned sizes
+        blocks = NATIVE.blocks(aliasable, memory)
     from rgraph.memory import place
 
     placed = place(blocks, policy, conflicts=conflicts)

@@ -11,8 +11,10 @@ queue). ``measure`` reads the usages and lifetimes, ``place`` the cross-queue wa
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from operator import itemgetter
 
 from rgraph.compiler.plan_values import get_subresource, names, subresource
 from rgraph.compiler.read_layouts import to_general
@@ -48,6 +50,7 @@ class ResourceTrace:
 
 
 _new_trace = builder(ResourceTrace)
+_pass_of = itemgetter(0)  # a Use's pass
 _new_access = builder(pm.Access)
 
 #: The compiled mirror of :func:`walk_python` (``rgraph/compiler/_trace.pyx``), None where it
@@ -237,8 +240,6 @@ def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], ti
         uses = timeline.get(c)
         if uses is None:  # a resource of one cell
             uses = info[c[0]].cells[0][1]
-        for k in range(len(uses) - 1, -1, -1):
-            if uses[k][0] == i:
-                _, _, w, queue, pos = uses[k]
-                uses[k] = (i, merged, w, queue, pos)
-                break
+        k = bisect_left(uses, i, key=_pass_of)  # uses are in pass order, one per pass: the use of pass i
+        _, _, w, queue, pos = uses[k]
+        uses[k] = (i, merged, w, queue, pos)

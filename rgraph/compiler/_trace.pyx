@@ -7,6 +7,7 @@ and becomes a ``ResourceTrace`` at the end; plan values are stored slot by slot
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
 from rgraph.compiler.plan_values import get_subresource, subresource
+from rgraph.compiler.read_layouts import GENERAL_READS
 from rgraph.compiler.usages import merge
 from rgraph.plan import model as pm
 
@@ -102,8 +103,27 @@ cdef class _Res:
     cdef object code  # int
     cdef long icode  # the same, for the access table
     cdef list group  # or None
+    # ``walk(..., moved=[])``: read_layouts.to_general's groups kept as they go, not as ``group``
+    cdef bint candidate  # still a read-group candidate (every access so far the whole image)
+    cdef list closed  # the movable reads of the groups closed so far that move to GENERAL
+    cdef list cur  # the movable reads since the last write (None: none)
+    cdef object lay0  # the layout of the first of them
+    cdef bint mixed  # another layout among them
     cdef bint single
     cdef object mips, layers  # read-group candidates: (0, mips), (0, layers)
+
+
+cdef inline void _close(_Res r):
+    """``to_general`` at a write (or the end): the reads since the last write move to GENERAL
+    where there are several and their layouts differ."""
+    if r.cur is not None:
+        if len(r.cur) > 1 and r.mixed:
+            if r.closed is None:
+                r.closed = r.cur
+            else:
+                r.closed += r.cur
+        r.cur = None
+        r.mixed = False
 
 
 cdef _Res _start(res, Py_ssize_t i, usage):
@@ -120,9 +140,11 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     r.code = r.icode
     if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil:
         r.group = []
+        r.candidate = True
         r.mips, r.layers = (0, res.mips), (0, res.layers)
     else:
         r.group = None
+        r.candidate = False
     r.single = not image or res.mips * res.layers == 1
     return r
 
@@ -151,9 +173,12 @@ cdef inline void _wait(dict waits, object i, tuple prev, object q):
         found[q] = prev[0]
 
 
-def walk(passes, resources, dict scopes, scope_of):
+def walk(passes, resources, dict scopes, scope_of, list moved=None):
     """``walk_python(passes, resources)``; ``scopes``: ``trace._SCOPES``, ``scope_of``: its
-    filler (``trace._scope``)."""
+    filler (``trace._scope``). With a list ``moved``: no read-group candidates in the traces
+    (``group`` None); ``moved`` gets ``read_layouts.to_general`` of them instead, found during
+    the walk (no tuple per candidate access)."""
+    cdef bint keep_groups = moved is None
     cdef list plan_accesses = [], values, uses, cells
     cdef dict info = {}, timeline = {}, waits = {}
     cdef Py_ssize_t i = -1, j, pos
@@ -215,11 +240,22 @@ def walk(passes, resources, dict scopes, scope_of):
             put(value, ACCESS, 5, layout)
             put(value, ACCESS, 6, w)
             values.append(value)
-            if r.group is not None:
+            if r.candidate:
                 if mips != r.mips or layers != r.layers:  # not the whole image: never unified
                     r.group = None
-                else:
+                    r.candidate = False
+                elif keep_groups:
                     r.group.append((oi, j, w, usage, layout))
+                elif w:
+                    _close(r)
+                elif usage in GENERAL_READS:
+                    if r.cur is None:
+                        r.cur = [(oi, j)]
+                        r.lay0 = layout
+                    else:
+                        r.cur.append((oi, j))
+                        if not r.mixed and layout is not r.lay0 and layout != r.lay0:
+                            r.mixed = True
             if r.single:  # most resources: the one cell's uses without a lookup by cell
                 cells = r.cells
                 if not cells:
@@ -242,13 +278,17 @@ def walk(passes, resources, dict scopes, scope_of):
     traced = {}
     for name, found in info.items():
         r = <_Res> found
+        if not keep_groups and r.candidate:
+            _close(r)
+            if r.closed is not None:
+                moved += r.closed
         value = new_slots(TRACE)
         put(value, TRACE, 0, r.usages)
         put(value, TRACE, 1, r.first)
         put(value, TRACE, 2, r.last)
         put(value, TRACE, 3, r.cells)
         put(value, TRACE, 4, r.code)
-        put(value, TRACE, 5, r.group)
+        put(value, TRACE, 5, r.group if keep_groups else None)
         put(value, TRACE, 6, r.single)
         traced[name] = value
     return plan_accesses, traced, timeline, waits

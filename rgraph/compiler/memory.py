@@ -55,6 +55,7 @@ class ResourceMemory:
 
 
 _requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  # one per used resource
+_heap = builder(Heap)  # one per resource placed apart
 
 #: The compiled mirror of :func:`requirements_python`, :func:`resource_memory_python`,
 #: :func:`alias_sources_python` and ``phases._culled_only_python`` (``rgraph/compiler/_memory.pyx``),
@@ -181,7 +182,7 @@ def place_resources(
     extra = 0
     for n in sorted(set(memory) - set(aliasable)):
         m = memory[n]
-        heap = Heap(len(heaps), m.bytes, m.memory_class, m.alignment)
+        heap = _heap(len(heaps), m.bytes, m.memory_class, m.alignment)
         heaps.append(heap)
         offsets[n] = (heap.id, 0)
         extra += m.bytes

@@ -93,10 +93,9 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
     built: :data:`NATIVE`, else :func:`walk_python`); the reads ``read_layouts`` moves to
     GENERAL are patched in afterwards (a few per graph)."""
     if NATIVE is None:
-        walked = walk_python(passes, resources)
-    else:
-        walked = NATIVE.walk(passes, resources, _SCOPES, _scope)
-    return _finish(passes, *walked)
+        return _finish(passes, *walk_python(passes, resources))
+    moved: list[tuple[int, int]] = []  # the compiled walk groups the reads for read_layouts itself
+    return _finish(passes, *NATIVE.walk(passes, resources, _SCOPES, _scope, moved), moved=moved)
 
 
 Walked = tuple[list[list[pm.Access]], dict[str, ResourceTrace], dict[Cell, list[Use]], dict[int, dict[str, int]]]
@@ -197,9 +196,12 @@ def walk_python(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
 
 
 def _finish(passes: Sequence[PassSpec], plan_accesses: list[list[pm.Access]], info: dict[str, ResourceTrace],
-            timeline: dict[Cell, list[Use]], waits: dict[int, dict[str, int]]) -> Trace:
-    """The walk's results with the reads ``read_layouts`` moves to GENERAL patched in."""
-    moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
+            timeline: dict[Cell, list[Use]], waits: dict[int, dict[str, int]],
+            moved: list[tuple[int, int]] | None = None) -> Trace:
+    """The walk's results with the reads ``read_layouts`` moves to GENERAL patched in (``moved``:
+    those, where the walk found them; else ``to_general`` of its read groups)."""
+    if moved is None:
+        moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
     general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
     rows: dict[int, list[Sync]] = {}  # the passes with a moved read: the scope of each access
     for i, j in moved:

@@ -223,3 +223,34 @@ def test_the_optional_scan_agrees(tmp_path: Path) -> None:
     for ps, expected in ((passes, False), (with_last, True), (with_first, True), ([], False)):
         assert cull.NATIVE.has_optional(ps) is expected
         assert cull._has_optional_python(ps) is expected
+
+
+@pytest.mark.parametrize("seed,passes", [(1, 40), (9, 150), (1000, 1000)])
+def test_the_compiled_walk_groups_reads_as_read_layouts(tmp_path: Path, seed: int, passes: int) -> None:
+    """``walk(..., moved=[])`` finds ``read_layouts.to_general``'s reads during the walk (no read
+    groups kept): the same reads as ``to_general`` of the Python walk's groups; and, among those
+    graphs' groups, some of several reads in one layout (they stay) and some mixed (they move)."""
+    from rgraph.compiler.read_layouts import GENERAL_READS, to_general
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=passes)))
+    spec = frontend(path, size=(16, 16)).spec
+    moved: list[tuple[int, int]] = []
+    native = trace.NATIVE.walk(spec.passes, spec.resources, trace._SCOPES, trace._scope, moved)
+    python = trace.walk_python(spec.passes, spec.resources)
+    groups = {n: r.group for n, r in python[1].items() if r.group is not None}
+    assert moved == to_general(groups)
+    assert all(r.group is None for r in native[1].values())
+    assert native[0] == python[0] and native[2] == python[2] and native[3] == python[3]
+    if passes == 1000:
+        alike = 0  # groups of several movable reads in one layout (a walk that moved any group would fail)
+        for seq in groups.values():
+            run: list[str | None] = []
+            for _, _, write, usage, layout in [*seq, (-1, -1, True, "", None)]:
+                if not write:
+                    if usage in GENERAL_READS:
+                        run.append(layout)
+                    continue
+                alike += len(run) > 1 and len(set(run)) == 1
+                run = []
+        assert moved and alike

@@ -38,7 +38,7 @@ def requirements(resources, used, outputs, provider, dict same_buffer_flag):
             usage_set.add("transfer_src")
         usages = sorted(usage_set)
         try:
-            if res.is_image:
+            if res.kind == "image":  # ``res.is_image``
                 fmt = res.format
                 assert fmt is not None
                 found = None

@@ -441,6 +441,12 @@ cdef struct GroupRec:  # a multi-cell resource's cells of one pass with one key 
     PyObject *ps
     PyObject *pd
     PyObject *al
+    # the key as the walk has it (equal keys <=> equal plan states): masks, layouts, queues
+    u64 s_st, s_ac, d_st, d_ac
+    PyObject *s_lay
+    PyObject *s_q
+    PyObject *d_lay
+    PyObject *d_q
     Py_ssize_t rel  # -1: none
     Py_ssize_t first  # least cell position
     Py_ssize_t ncells, head, tail  # cells: a list through CellRec.next
@@ -613,6 +619,13 @@ cdef enum:
     _INFOS_ON_STACK = 64
 
 
+cdef inline bint _same(PyObject *a, object b) except -1:
+    """``a == b`` (identity first) for a key's layouts, queues (str or None) and alias tuples."""
+    if a == <PyObject *> b:
+        return True
+    return <object> a == b
+
+
 cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alias_waits, bint last_prev,
                  _Sink sink, object res, long mip, long layer, object sub, bint multi) except -1:
     """``sync._walk`` from and into ``st`` (``sink`` None: the end state only). A barrier of a
@@ -764,21 +777,24 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
                     found[q] = (max(j, prev[0]), <u64> prev[1] | wait_st)
         if not has_key:
             continue
-        ps = _state(src_st, src_ac, key_src_layout, src_queue)
-        pd = _state(dst_st, dst_ac, new_layout, queue)
         if multi:  # the pass's group of this key and release pass, else a new one
             g = sink.head[i]
             while g >= 0:
                 gr = &sink.groups[g]
-                if gr.rel == release_at and (gr.ps == <PyObject *> ps or <object> gr.ps == ps) \
-                        and (gr.pd == <PyObject *> pd or <object> gr.pd == pd) \
-                        and (gr.al == <PyObject *> key_aliases or <object> gr.al == key_aliases):
+                if (gr.rel == release_at and gr.s_st == src_st and gr.s_ac == src_ac and gr.d_st == dst_st
+                        and gr.d_ac == dst_ac and _same(gr.s_lay, key_src_layout) and _same(gr.s_q, src_queue)
+                        and _same(gr.d_lay, new_layout) and _same(gr.d_q, queue) and _same(gr.al, key_aliases)):
                     break
                 g = gr.next
             cr = sink.cell(mip, layer)
             if g < 0:
+                ps = _state(src_st, src_ac, key_src_layout, src_queue)
+                pd = _state(dst_st, dst_ac, new_layout, queue)
                 g = sink.group()
                 gr = &sink.groups[g]
+                gr.s_st, gr.s_ac, gr.d_st, gr.d_ac = src_st, src_ac, dst_st, dst_ac
+                gr.s_lay, gr.s_q = <PyObject *> key_src_layout, <PyObject *> src_queue
+                gr.d_lay, gr.d_q = <PyObject *> new_layout, <PyObject *> queue
                 sink.keep.append(ps)
                 sink.keep.append(pd)
                 sink.keep.append(key_aliases)
@@ -795,6 +811,8 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
                 if pos < gr.first:
                     gr.first = pos
             continue
+        ps = _state(src_st, src_ac, key_src_layout, src_queue)
+        pd = _state(dst_st, dst_ac, new_layout, queue)
         barrier = new_slots(BARRIER)
         put(barrier, BARRIER, 0, res)
         put(barrier, BARRIER, 1, sub)
@@ -980,6 +998,13 @@ cdef inline void _fresh(CellState *st, object layout):
     st.last_pass = -1
 
 
+cdef bint _states_equal(a, b) except -1:
+    """``a == b`` for two plan states, field by field (not the dataclass's ``__eq__``)."""
+    if type(a) is not type(b):
+        return a == b
+    return a.stages == b.stages and a.access == b.access and a.layout == b.layout and a.queue == b.queue
+
+
 cdef object _end_state_c(bint per_cell, list cells, list states):
     """``sync._end_state``: ``states`` the plan states of ``cells`` ((cell, uses) pairs), alike."""
     cdef Py_ssize_t n = len(states), k
@@ -990,7 +1015,7 @@ cdef object _end_state_c(bint per_cell, list cells, list states):
         return first
     for k in range(1, n):
         other = states[k]
-        if other is not first and other != first:
+        if other is not first and not _states_equal(other, first):
             break
     else:
         return first
@@ -1136,6 +1161,20 @@ cdef list _rels_by_pass(_Sink sink):
     return out
 
 
+cdef dict _STAGE_NAMES = {}  # stage mask -> the plan's sorted names
+
+
+cdef object _stage_names(u64 m):
+    """``plan_values.names`` of the stages of mask ``m``."""
+    key = m
+    found = _STAGE_NAMES.get(key)
+    if found is None:
+        if len(_STAGE_NAMES) > 4096:
+            _STAGE_NAMES.clear()
+        found = _STAGE_NAMES[key] = _sorted_names(_fs_stages(m))
+    return found
+
+
 cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     """``sync._gather``."""
     cdef Py_ssize_t count = sink.count, i
@@ -1153,7 +1192,7 @@ cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     for i in range(count):
         found = waits[i]
         if found is not None:
-            pass_waits[i] = tuple([_new_wait(q, values[<Py_ssize_t> jm[0]], _sorted_names(_fs_stages(<u64> jm[1])))
+            pass_waits[i] = tuple([_new_wait(q, values[<Py_ssize_t> jm[0]], _stage_names(<u64> jm[1]))
                                    for q, jm in sorted(found.items())])
     return SyncResult(_bars_by_pass(sink), _rels_by_pass(sink), pass_waits, signals, values, final, initial)
 

@@ -96,7 +96,10 @@ def size_accels(c: Compilation) -> Compilation:
     also write the scratch (refits read the accel)."""
     from rgraph.compiler.accel import size_accels as size
 
-    if not any(r.kind == "accel" for r in c.spec.resources.values()):
+    for r in c.spec.resources.values():  # (a loop: a generator's resumptions cost more)
+        if r.kind == "accel":
+            break
+    else:
         return replace(c)
     spec = replace(c.spec, resources=dict(c.spec.resources))
     return replace(c, spec=spec, passes=tuple(size(spec, list(c.passes), c.provider)))

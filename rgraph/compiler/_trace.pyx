@@ -292,3 +292,81 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
         put(value, TRACE, 6, r.single)
         traced[name] = value
     return plan_accesses, traced, timeline, waits
+
+
+# ---- trace._finish: the reads read_layouts moves to GENERAL ---------------------------------
+
+from dataclasses import replace as _replace
+
+
+cdef list _row(p, dict info, dict scopes, scope_of):
+    """``trace._row``: the scope of each access of ``p`` (from the access table where listed)."""
+    cdef list out = []
+    cdef AccessSlot *slot
+    cdef long code
+    kind = pass_field(p, 2, "kind")
+    for a in <tuple> pass_field(p, 7, "accesses"):
+        code_obj = info[access_field(a, 0, "resource")].code
+        slot = NULL
+        if type(a) is ACCESS_SPEC:
+            code = code_obj
+            slot = _access_find(a, kind, code)
+        if slot != NULL:
+            out.append((<tuple> slot.scope)[0])
+            continue
+        key = (access_field(a, 1, "usage"), kind, access_field(a, 5, "stages"), code_obj, access_field(a, 8, "refit"))
+        found = scopes.get(key)
+        out.append((<tuple> (scope_of(key) if found is None else found))[0])
+    return out
+
+
+def patch(passes, list plan_accesses, dict info, dict timeline, list moved, dict scopes, scope_of):
+    """``trace._finish``'s patching of the ``moved`` reads (their plan accesses and their
+    passes' uses of their cells), in place."""
+    cdef dict general = {}, rows = {}
+    cdef list row, values, uses
+    cdef tuple found, u
+    cdef Py_ssize_t i, j, lo, hi, mid
+    for pair in moved:
+        i, j = pair
+        row = rows.get(i)
+        if row is None:
+            row = rows[i] = _row(passes[i], info, scopes, scope_of)
+        scope = row[j]
+        found = general.get(id(scope))
+        if found is None:
+            found = general[id(scope)] = (scope, _replace(scope, layout="GENERAL"))
+        row[j] = found[1]
+        values = <list> plan_accesses[i]
+        v = values[j]
+        value = new_slots(ACCESS)
+        put(value, ACCESS, 0, v.resource)
+        put(value, ACCESS, 1, v.subresource)
+        put(value, ACCESS, 2, v.usage)
+        put(value, ACCESS, 3, v.stages)
+        put(value, ACCESS, 4, v.access)
+        put(value, ACCESS, 5, "GENERAL")
+        put(value, ACCESS, 6, v.write)
+        values[j] = value
+    for pair in moved:  # ``trace._repatch``
+        i, j = pair
+        p = passes[i]
+        accesses = <tuple> pass_field(p, 7, "accesses")
+        row = rows[i]
+        for c in <tuple> access_field(accesses[j], 9, "cells"):
+            merged = None
+            for k in range(len(accesses)):
+                if c in <tuple> access_field(accesses[k], 9, "cells"):
+                    merged = row[k] if merged is None else merge(merged, row[k])
+            uses = timeline.get(c)
+            if uses is None:  # a resource of one cell
+                uses = <list> (<tuple> (<list> info[c[0]].cells)[0])[1]
+            lo, hi = 0, len(uses)  # uses are in pass order, one per pass: the use of pass i
+            while lo < hi:
+                mid = (lo + hi) >> 1
+                if <Py_ssize_t> (<tuple> uses[mid])[0] < i:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            u = <tuple> uses[lo]
+            uses[lo] = (u[0], merged, u[2], u[3], u[4])

@@ -202,6 +202,9 @@ def _finish(passes: Sequence[PassSpec], plan_accesses: list[list[pm.Access]], in
     those, where the walk found them; else ``to_general`` of its read groups)."""
     if moved is None:
         moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
+    elif NATIVE is not None:  # the compiled walk's: patched by the compiled mirror of what follows
+        NATIVE.patch(passes, plan_accesses, info, timeline, moved, _SCOPES, _scope)
+        return Trace(plan_accesses, info, waits)
     general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
     rows: dict[int, list[Sync]] = {}  # the passes with a moved read: the scope of each access
     for i, j in moved:

@@ -254,3 +254,21 @@ def test_the_compiled_walk_groups_reads_as_read_layouts(tmp_path: Path, seed: in
                 alike += len(run) > 1 and len(set(run)) == 1
                 run = []
         assert moved and alike
+
+
+@pytest.mark.parametrize("seed,passes", [(9, 150), (1000, 1000)])
+def test_the_compiled_trace_patches_moved_reads_alike(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, seed: int,
+                                                      passes: int) -> None:
+    """``trace.trace`` with the compiled walk and patch (``_trace.patch``: the reads moved to
+    GENERAL, their plan accesses and their passes' merged uses) gives the Python trace."""
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=passes)))
+    spec = frontend(path, size=(16, 16)).spec
+    native = trace.trace(spec.passes, spec.resources)
+    with monkeypatch.context() as m:
+        m.setattr(trace, "NATIVE", None)
+        python = trace.trace(spec.passes, spec.resources)
+    assert native.accesses == python.accesses and native.waits == python.waits
+    assert any(a.layout == "GENERAL" and a.usage == "sampled" for row in native.accesses for a in row)
+    assert [(n, r.usages, r.first, r.last, r.cells) for n, r in native.resources.items()] == \
+        [(n, r.usages, r.first, r.last, r.cells) for n, r in python.resources.items()]

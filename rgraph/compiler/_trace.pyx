@@ -186,7 +186,7 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
     cdef AccessSlot *slot
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, stages, refit, a_cells
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value
     if _access_count >= _ACCESS_CAP // 2:
         _access_reset()
     for p in passes:
@@ -200,9 +200,8 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
         for a in <tuple> pass_field(p, 7, "accesses"):
             j += 1
             exact = type(a) is ACCESS_SPEC  # frozen: its scope and subresource are in the table
+            # (the other fields are read where needed: each read touches its object)
             name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
-            mips, layers, stages = access_field(a, 3, "mips"), access_field(a, 4, "layers"), access_field(a, 5, "stages")
-            refit, a_cells = access_field(a, 8, "refit"), access_field(a, 9, "cells")
             found = info.get(name)
             if found is None:
                 r = _start(resources[name], i, usage)
@@ -218,9 +217,10 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
                 scope = <tuple> slot.scope
                 sub = <object> slot.sub
             else:
-                key = (usage, kind, stages, r.code, refit)
+                key = (usage, kind, access_field(a, 5, "stages"), r.code, access_field(a, 8, "refit"))
                 found = scopes.get(key)
                 scope = <tuple> (scope_of(key) if found is None else found)
+                mips, layers = access_field(a, 3, "mips"), access_field(a, 4, "layers")
                 if mips is None:  # buffers and accels
                     sub = None
                 else:
@@ -241,7 +241,8 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
             put(value, ACCESS, 6, w)
             values.append(value)
             if r.candidate:
-                if mips != r.mips or layers != r.layers:  # not the whole image: never unified
+                if access_field(a, 3, "mips") != r.mips or access_field(a, 4, "layers") != r.layers:
+                    # not the whole image: never unified
                     r.group = None
                     r.candidate = False
                 elif keep_groups:
@@ -259,12 +260,12 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
             if r.single:  # most resources: the one cell's uses without a lookup by cell
                 cells = r.cells
                 if not cells:
-                    cells.append(((<tuple> a_cells)[0], [(oi, s, w, queue, pos)]))
+                    cells.append(((<tuple> access_field(a, 9, "cells"))[0], [(oi, s, w, queue, pos)]))
                     pos += 1
                     continue
                 pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
                 continue
-            cs = a_cells
+            cs = access_field(a, 9, "cells")
             for c in cs:
                 found = timeline.get(c)
                 if found is None:

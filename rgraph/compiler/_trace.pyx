@@ -13,6 +13,7 @@ from rgraph.plan import model as pm
 
 from libc.string cimport memset
 from cpython.ref cimport PyObject
+from cpython.tuple cimport PyTuple_New, PyTuple_SET_ITEM
 
 include "../plan/_slots.pxi"
 include "../plan/_spec_slots.pxi"
@@ -179,7 +180,8 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
     (``group`` None); ``moved`` gets ``read_layouts.to_general`` of them instead, found during
     the walk (no tuple per candidate access)."""
     cdef bint keep_groups = moved is None
-    cdef list plan_accesses = [], values, uses, cells
+    cdef list plan_accesses = [], uses, cells
+    cdef tuple values, accs
     cdef dict info = {}, timeline = {}, waits = {}
     cdef Py_ssize_t i = -1, j, pos
     cdef bint raytrace, exact
@@ -194,10 +196,11 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
         oi = i
         queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
         raytrace = kind == "raytrace"
-        values = []
+        accs = <tuple> pass_field(p, 7, "accesses")
+        values = PyTuple_New(len(accs))  # the plan's tuple (emit keeps it)
         pos = 0
         j = -1
-        for a in <tuple> pass_field(p, 7, "accesses"):
+        for a in accs:
             j += 1
             exact = type(a) is ACCESS_SPEC  # frozen: its scope and subresource are in the table
             # (the other fields are read where needed: each read touches its object)
@@ -239,7 +242,8 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
             put(value, ACCESS, 4, scope[2])
             put(value, ACCESS, 5, layout)
             put(value, ACCESS, 6, w)
-            values.append(value)
+            Py_INCREF(value)
+            PyTuple_SET_ITEM(values, j, value)
             if r.candidate:
                 if access_field(a, 3, "mips") != r.mips or access_field(a, 4, "layers") != r.layers:
                     # not the whole image: never unified
@@ -325,7 +329,7 @@ def patch(passes, list plan_accesses, dict info, dict timeline, list moved, dict
     """``trace._finish``'s patching of the ``moved`` reads (their plan accesses and their
     passes' uses of their cells), in place."""
     cdef dict general = {}, rows = {}
-    cdef list row, values, uses
+    cdef list row, uses
     cdef tuple found, u
     cdef Py_ssize_t i, j, lo, hi, mid
     for pair in moved:
@@ -338,7 +342,9 @@ def patch(passes, list plan_accesses, dict info, dict timeline, list moved, dict
         if found is None:
             found = general[id(scope)] = (scope, _replace(scope, layout="GENERAL"))
         row[j] = found[1]
-        values = <list> plan_accesses[i]
+        values = plan_accesses[i]
+        if type(values) is tuple:  # the walk's: a list while patched, a tuple again below
+            values = plan_accesses[i] = list(values)
         v = values[j]
         value = new_slots(ACCESS)
         put(value, ACCESS, 0, v.resource)
@@ -349,6 +355,8 @@ def patch(passes, list plan_accesses, dict info, dict timeline, list moved, dict
         put(value, ACCESS, 5, "GENERAL")
         put(value, ACCESS, 6, v.write)
         values[j] = value
+    for i in rows:
+        plan_accesses[i] = tuple(plan_accesses[i])
     for pair in moved:  # ``trace._repatch``
         i, j = pair
         p = passes[i]

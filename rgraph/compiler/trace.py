@@ -60,7 +60,8 @@ NATIVE = load("rgraph.compiler._trace")
 
 @dataclass
 class Trace:
-    accesses: list[list[pm.Access]]  # per pass, per declared access: the plan's values
+    accesses: list[Sequence[pm.Access]]  # per pass, per declared access: the plan's values (tuples from the
+    # compiled walk: the plan keeps them; lists from the Python one)
     resources: dict[str, ResourceTrace]  # used resources, in the order of their first use
     #: per pass (only those that have one): queue -> the latest pass on that queue that a cell's
     #: previous use was, i.e. the semaphore waits the dedicated plan has there

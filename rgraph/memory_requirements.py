@@ -154,7 +154,8 @@ class ProfileMemoryRequirements:
 
     def image(self, format_vk_name: str, extent: Sequence[int], mips: int, layers: int, samples: int,
               usage_names: Sequence[str]) -> Requirements:
-        """The requirements of an image (memoized per argument tuple: a profile does not change)."""
+        """The requirements of an image (memoized per argument tuple: a profile does not change;
+        ``rgraph/compiler/_memory.pyx`` reads ``_image_memo`` by this key itself)."""
         memo = self.__dict__.setdefault("_image_memo", {})
         args = (format_vk_name, tuple(extent), mips, layers, samples, tuple(usage_names))
         found = memo.get(args)
@@ -228,7 +229,8 @@ class ProfileMemoryRequirements:
         return int(self._accel_section()["scratch_alignment"])
 
     def buffer(self, size: int, usage_names: Sequence[str]) -> Requirements:
-        """The requirements of a buffer (memoized per argument tuple, like ``image``)."""
+        """The requirements of a buffer (memoized per argument tuple, like ``image``; read by
+        ``_memory.pyx`` too)."""
         memo = self.__dict__.setdefault("_buffer_memo", {})
         args = (size, tuple(usage_names))
         found = memo.get(args)

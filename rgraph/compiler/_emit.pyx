@@ -37,7 +37,8 @@ def passes(list passes, list accesses, barriers, releases, waits, signals, signa
         put(value, PASS, 4, p.kind)
         put(value, PASS, 5, p.impl)
         put(value, PASS, 6, frozen(params) if params else EMPTY)
-        put(value, PASS, 7, tuple(<list> accesses[i]))
+        found = accesses[i]  # a tuple from the compiled trace (kept), a list from the Python one
+        put(value, PASS, 7, found if type(found) is tuple else tuple(found))
         put(value, PASS, 8, barriers[i])
         put(value, PASS, 9, releases[i])
         put(value, PASS, 10, waits[i])

@@ -10,6 +10,8 @@ from libc.stdlib cimport free, malloc
 
 from rgraph.compiler.memory import Requirement, ResourceMemory
 from rgraph.errors import RGraphError
+from rgraph.memory.model import Block
+from rgraph.memory_requirements import ProfileMemoryRequirements
 
 include "../plan/_slots.pxi"
 
@@ -23,9 +25,12 @@ cdef Slots MEMORY = Slots(ResourceMemory, ("bytes", "alignment", "memory_type_bi
 def requirements(resources, used, outputs, provider, dict same_buffer_flag):
     """``requirements_python(resources, used, outputs, provider)``; ``same_buffer_flag``:
     ``memory._SAME_BUFFER_FLAG``."""
-    cdef dict out = {}
+    cdef dict out = {}, memo = None, buffer_memo = None
     cdef set kept = set(outputs), usage_set
     cdef list usages
+    if type(provider) is ProfileMemoryRequirements:  # its memos read here: no call per resource once filled
+        memo = provider.__dict__.get("_image_memo")
+        buffer_memo = provider.__dict__.get("_buffer_memo")
     for name in sorted(used):
         res = resources[name]
         usage_set = set(used[name])
@@ -33,13 +38,25 @@ def requirements(resources, used, outputs, provider, dict same_buffer_flag):
             usage_set.add("transfer_src")
         usages = sorted(usage_set)
         try:
-            if res.is_image:
+            if res.kind == "image":  # ``res.is_image``
                 fmt = res.format
                 assert fmt is not None
-                size, align, bits = provider.image(fmt.vk_name, res.extent, res.mips, res.layers, res.samples, usages)
+                found = None
+                if memo is not None:  # ``ProfileMemoryRequirements.image``'s key
+                    found = memo.get((fmt.vk_name, tuple(res.extent), res.mips, res.layers, res.samples,
+                                      tuple(usages)))
+                if found is None:
+                    found = provider.image(fmt.vk_name, res.extent, res.mips, res.layers, res.samples, usages)
+                size, align, bits = found
                 tiling = "optimal"
             else:
-                size, align, bits = provider.buffer(res.bytes, sorted({same_buffer_flag.get(u, u) for u in usages}))
+                flags = sorted({same_buffer_flag.get(u, u) for u in usages})
+                found = None
+                if buffer_memo is not None:  # ``ProfileMemoryRequirements.buffer``'s key
+                    found = buffer_memo.get((res.bytes, tuple(flags)))
+                if found is None:
+                    found = provider.buffer(res.bytes, flags)
+                size, align, bits = found
                 tiling = "linear"
         except RGraphError as err:
             raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None
@@ -181,4 +198,27 @@ def alias_sources(placement, memory):
         if len(<list> names) < 2:
             continue
         _heap_sources(<list> names, offsets, memory, out)
+    return out
+
+
+def blocks(list names, memory):
+    """``place_resources``' blocks: ``[Block(n, m.first, m.last, m.bytes, m.alignment,
+    m.memory_class) for n in names for m in (memory[n],)]``, each built without a call to its
+    ``__init__`` (its fields in its ``__dict__``, as that ``__init__`` writes them) and with its
+    ``aligned_size`` stored already (what ``Block.aligned_size`` computes on first use; not where
+    the alignment is below 1: ``check_blocks`` reports that)."""
+    cdef list out = []
+    cdef dict d
+    new = Block.__new__
+    for n in names:
+        m = memory[n]
+        b = new(Block)
+        d = b.__dict__
+        size, alignment = m.bytes, m.alignment
+        d["name"], d["start"], d["end"], d["size"] = n, m.first, m.last, size
+        d["alignment"], d["memory_class"] = alignment, m.memory_class
+        if type(size) is int and type(alignment) is int and alignment >= 1:
+            rem = size % alignment
+            d["aligned_size"] = size if rem == 0 else size + alignment - rem
+        out.append(b)
     return out

@@ -7,11 +7,13 @@ and becomes a ``ResourceTrace`` at the end; plan values are stored slot by slot
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
 from rgraph.compiler.plan_values import get_subresource, subresource
+from rgraph.compiler.read_layouts import GENERAL_READS
 from rgraph.compiler.usages import merge
 from rgraph.plan import model as pm
 
 from libc.string cimport memset
 from cpython.ref cimport PyObject
+from cpython.tuple cimport PyTuple_New, PyTuple_SET_ITEM
 
 include "../plan/_slots.pxi"
 include "../plan/_spec_slots.pxi"
@@ -102,8 +104,27 @@ cdef class _Res:
     cdef object code  # int
     cdef long icode  # the same, for the access table
     cdef list group  # or None
+    # ``walk(..., moved=[])``: read_layouts.to_general's groups kept as they go, not as ``group``
+    cdef bint candidate  # still a read-group candidate (every access so far the whole image)
+    cdef list closed  # the movable reads of the groups closed so far that move to GENERAL
+    cdef list cur  # the movable reads since the last write (None: none)
+    cdef object lay0  # the layout of the first of them
+    cdef bint mixed  # another layout among them
     cdef bint single
     cdef object mips, layers  # read-group candidates: (0, mips), (0, layers)
+
+
+cdef inline void _close(_Res r):
+    """``to_general`` at a write (or the end): the reads since the last write move to GENERAL
+    where there are several and their layouts differ."""
+    if r.cur is not None:
+        if len(r.cur) > 1 and r.mixed:
+            if r.closed is None:
+                r.closed = r.cur
+            else:
+                r.closed += r.cur
+        r.cur = None
+        r.mixed = False
 
 
 cdef _Res _start(res, Py_ssize_t i, usage):
@@ -120,9 +141,11 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     r.code = r.icode
     if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil:
         r.group = []
+        r.candidate = True
         r.mips, r.layers = (0, res.mips), (0, res.layers)
     else:
         r.group = None
+        r.candidate = False
     r.single = not image or res.mips * res.layers == 1
     return r
 
@@ -151,17 +174,21 @@ cdef inline void _wait(dict waits, object i, tuple prev, object q):
         found[q] = prev[0]
 
 
-def walk(passes, resources, dict scopes, scope_of):
+def walk(passes, resources, dict scopes, scope_of, list moved=None):
     """``walk_python(passes, resources)``; ``scopes``: ``trace._SCOPES``, ``scope_of``: its
-    filler (``trace._scope``)."""
-    cdef list plan_accesses = [], values, uses, cells
+    filler (``trace._scope``). With a list ``moved``: no read-group candidates in the traces
+    (``group`` None); ``moved`` gets ``read_layouts.to_general`` of them instead, found during
+    the walk (no tuple per candidate access)."""
+    cdef bint keep_groups = moved is None
+    cdef list plan_accesses = [], uses, cells
+    cdef tuple values, accs
     cdef dict info = {}, timeline = {}, waits = {}
     cdef Py_ssize_t i = -1, j, pos
     cdef bint raytrace, exact
     cdef AccessSlot *slot
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, stages, refit, a_cells
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value
     if _access_count >= _ACCESS_CAP // 2:
         _access_reset()
     for p in passes:
@@ -169,15 +196,15 @@ def walk(passes, resources, dict scopes, scope_of):
         oi = i
         queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
         raytrace = kind == "raytrace"
-        values = []
+        accs = <tuple> pass_field(p, 7, "accesses")
+        values = PyTuple_New(len(accs))  # the plan's tuple (emit keeps it)
         pos = 0
         j = -1
-        for a in <tuple> pass_field(p, 7, "accesses"):
+        for a in accs:
             j += 1
             exact = type(a) is ACCESS_SPEC  # frozen: its scope and subresource are in the table
+            # (the other fields are read where needed: each read touches its object)
             name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
-            mips, layers, stages = access_field(a, 3, "mips"), access_field(a, 4, "layers"), access_field(a, 5, "stages")
-            refit, a_cells = access_field(a, 8, "refit"), access_field(a, 9, "cells")
             found = info.get(name)
             if found is None:
                 r = _start(resources[name], i, usage)
@@ -193,9 +220,10 @@ def walk(passes, resources, dict scopes, scope_of):
                 scope = <tuple> slot.scope
                 sub = <object> slot.sub
             else:
-                key = (usage, kind, stages, r.code, refit)
+                key = (usage, kind, access_field(a, 5, "stages"), r.code, access_field(a, 8, "refit"))
                 found = scopes.get(key)
                 scope = <tuple> (scope_of(key) if found is None else found)
+                mips, layers = access_field(a, 3, "mips"), access_field(a, 4, "layers")
                 if mips is None:  # buffers and accels
                     sub = None
                 else:
@@ -214,21 +242,34 @@ def walk(passes, resources, dict scopes, scope_of):
             put(value, ACCESS, 4, scope[2])
             put(value, ACCESS, 5, layout)
             put(value, ACCESS, 6, w)
-            values.append(value)
-            if r.group is not None:
-                if mips != r.mips or layers != r.layers:  # not the whole image: never unified
+            Py_INCREF(value)
+            PyTuple_SET_ITEM(values, j, value)
+            if r.candidate:
+                if access_field(a, 3, "mips") != r.mips or access_field(a, 4, "layers") != r.layers:
+                    # not the whole image: never unified
                     r.group = None
-                else:
+                    r.candidate = False
+                elif keep_groups:
                     r.group.append((oi, j, w, usage, layout))
+                elif w:
+                    _close(r)
+                elif usage in GENERAL_READS:
+                    if r.cur is None:
+                        r.cur = [(oi, j)]
+                        r.lay0 = layout
+                    else:
+                        r.cur.append((oi, j))
+                        if not r.mixed and layout is not r.lay0 and layout != r.lay0:
+                            r.mixed = True
             if r.single:  # most resources: the one cell's uses without a lookup by cell
                 cells = r.cells
                 if not cells:
-                    cells.append(((<tuple> a_cells)[0], [(oi, s, w, queue, pos)]))
+                    cells.append(((<tuple> access_field(a, 9, "cells"))[0], [(oi, s, w, queue, pos)]))
                     pos += 1
                     continue
                 pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
                 continue
-            cs = a_cells
+            cs = access_field(a, 9, "cells")
             for c in cs:
                 found = timeline.get(c)
                 if found is None:
@@ -242,13 +283,99 @@ def walk(passes, resources, dict scopes, scope_of):
     traced = {}
     for name, found in info.items():
         r = <_Res> found
+        if not keep_groups and r.candidate:
+            _close(r)
+            if r.closed is not None:
+                moved += r.closed
         value = new_slots(TRACE)
         put(value, TRACE, 0, r.usages)
         put(value, TRACE, 1, r.first)
         put(value, TRACE, 2, r.last)
         put(value, TRACE, 3, r.cells)
         put(value, TRACE, 4, r.code)
-        put(value, TRACE, 5, r.group)
+        put(value, TRACE, 5, r.group if keep_groups else None)
         put(value, TRACE, 6, r.single)
         traced[name] = value
     return plan_accesses, traced, timeline, waits
+
+
+# ---- trace._finish: the reads read_layouts moves to GENERAL ---------------------------------
+
+from dataclasses import replace as _replace
+
+
+cdef list _row(p, dict info, dict scopes, scope_of):
+    """``trace._row``: the scope of each access of ``p`` (from the access table where listed)."""
+    cdef list out = []
+    cdef AccessSlot *slot
+    cdef long code
+    kind = pass_field(p, 2, "kind")
+    for a in <tuple> pass_field(p, 7, "accesses"):
+        code_obj = info[access_field(a, 0, "resource")].code
+        slot = NULL
+        if type(a) is ACCESS_SPEC:
+            code = code_obj
+            slot = _access_find(a, kind, code)
+        if slot != NULL:
+            out.append((<tuple> slot.scope)[0])
+            continue
+        key = (access_field(a, 1, "usage"), kind, access_field(a, 5, "stages"), code_obj, access_field(a, 8, "refit"))
+        found = scopes.get(key)
+        out.append((<tuple> (scope_of(key) if found is None else found))[0])
+    return out
+
+
+def patch(passes, list plan_accesses, dict info, dict timeline, list moved, dict scopes, scope_of):
+    """``trace._finish``'s patching of the ``moved`` reads (their plan accesses and their
+    passes' uses of their cells), in place."""
+    cdef dict general = {}, rows = {}
+    cdef list row, uses
+    cdef tuple found, u
+    cdef Py_ssize_t i, j, lo, hi, mid
+    for pair in moved:
+        i, j = pair
+        row = rows.get(i)
+        if row is None:
+            row = rows[i] = _row(passes[i], info, scopes, scope_of)
+        scope = row[j]
+        found = general.get(id(scope))
+        if found is None:
+            found = general[id(scope)] = (scope, _replace(scope, layout="GENERAL"))
+        row[j] = found[1]
+        values = plan_accesses[i]
+        if type(values) is tuple:  # the walk's: a list while patched, a tuple again below
+            values = plan_accesses[i] = list(values)
+        v = values[j]
+        value = new_slots(ACCESS)
+        put(value, ACCESS, 0, v.resource)
+        put(value, ACCESS, 1, v.subresource)
+        put(value, ACCESS, 2, v.usage)
+        put(value, ACCESS, 3, v.stages)
+        put(value, ACCESS, 4, v.access)
+        put(value, ACCESS, 5, "GENERAL")
+        put(value, ACCESS, 6, v.write)
+        values[j] = value
+    for i in rows:
+        plan_accesses[i] = tuple(plan_accesses[i])
+    for pair in moved:  # ``trace._repatch``
+        i, j = pair
+        p = passes[i]
+        accesses = <tuple> pass_field(p, 7, "accesses")
+        row = rows[i]
+        for c in <tuple> access_field(accesses[j], 9, "cells"):
+            merged = None
+            for k in range(len(accesses)):
+                if c in <tuple> access_field(accesses[k], 9, "cells"):
+                    merged = row[k] if merged is None else merge(merged, row[k])
+            uses = timeline.get(c)
+            if uses is None:  # a resource of one cell
+                uses = <list> (<tuple> (<list> info[c[0]].cells)[0])[1]
+            lo, hi = 0, len(uses)  # uses are in pass order, one per pass: the use of pass i
+            while lo < hi:
+                mid = (lo + hi) >> 1
+                if <Py_ssize_t> (<tuple> uses[mid])[0] < i:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            u = <tuple> uses[lo]
+            uses[lo] = (u[0], merged, u[2], u[3], u[4])

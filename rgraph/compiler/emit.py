@@ -24,6 +24,7 @@ SIGNAL_STAGES = ("ALL_COMMANDS",)
 # from the sync phase as plan values.
 _Access, _Pass, _Resource = (builder(c) for c in (pm.Access, pm.PlanPass, pm.PlanResource))
 _Wait, _Signal, _Culled = (builder(c) for c in (pm.Wait, pm.Signal, pm.Culled))
+_Heap = builder(pm.Heap)
 
 #: The compiled mirror of :func:`_passes_python`, :func:`_resources_python` and
 #: :func:`_culled_python` (``rgraph/compiler/_emit.pyx``), None where it is not built or
@@ -124,7 +125,7 @@ def emit(c: Compilation) -> pm.Plan:
         culled=_culled(c),
         dropped_reads=tuple(pm.DroppedRead(d.pass_name, d.resource, d.reason) for d in culling.dropped_reads),
         resources=_resources(c),
-        heaps=tuple(pm.Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps),
+        heaps=tuple([_Heap(h.id, h.bytes, h.memory_class, h.alignment) for h in placement.heaps]),
         outputs=tuple(c.spec.outputs),
         stats=pm.Stats(
             barriers=sum(map(len, sync.barriers)), semaphores=sum(sync.signals),

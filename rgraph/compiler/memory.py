@@ -55,6 +55,7 @@ class ResourceMemory:
 
 
 _requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  # one per used resource
+_heap = builder(Heap)  # one per resource placed apart
 
 #: The compiled mirror of :func:`requirements_python`, :func:`resource_memory_python`,
 #: :func:`alias_sources_python` and ``phases._culled_only_python`` (``rgraph/compiler/_memory.pyx``),
@@ -167,9 +168,12 @@ def place_resources(
     ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
     kept = set(outputs)
     aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
-    blocks = [
-        Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
-    ]
+    if NATIVE is None:
+        blocks = [
+            Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
+        ]
+    else:  # the same blocks, built in C with their aligned sizes
+        blocks = NATIVE.blocks(aliasable, memory)
     from rgraph.memory import place
 
     placed = place(blocks, policy, conflicts=conflicts)
@@ -178,7 +182,7 @@ def place_resources(
     extra = 0
     for n in sorted(set(memory) - set(aliasable)):
         m = memory[n]
-        heap = Heap(len(heaps), m.bytes, m.memory_class, m.alignment)
+        heap = _heap(len(heaps), m.bytes, m.memory_class, m.alignment)
         heaps.append(heap)
         offsets[n] = (heap.id, 0)
         extra += m.bytes

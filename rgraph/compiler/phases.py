@@ -96,7 +96,10 @@ def size_accels(c: Compilation) -> Compilation:
     also write the scratch (refits read the accel)."""
     from rgraph.compiler.accel import size_accels as size
 
-    if not any(r.kind == "accel" for r in c.spec.resources.values()):
+    for r in c.spec.resources.values():  # (a loop: a generator's resumptions cost more)
+        if r.kind == "accel":
+            break
+    else:
         return replace(c)
     spec = replace(c.spec, resources=dict(c.spec.resources))
     return replace(c, spec=spec, passes=tuple(size(spec, list(c.passes), c.provider)))
@@ -176,9 +179,15 @@ def synchronize(c: Compilation) -> Compilation:
     # (heap, first byte, end byte) of the resources that alias or are aliased (``with_partial_handoffs``)
     named = {n for preds in aliases.values() for n in preds}.union(aliases)
     ranges = {n: (heap, off, off + c.memory[n].bytes) for n in named for heap, off in (offsets[n],)}
-    synchronize_passes = (SYNC_NATIVE or sync_python).synchronize
-    return replace(c, sync=synchronize_passes(c.passes, c.spec.resources, c.trace, aliases, ranges,
-                                              set(c.spec.outputs)))
+    outputs = set(c.spec.outputs)
+    result = None
+    whole = sync_python._WALK  # the whole phase compiled (``_sync_walk.synchronize``); None: declined
+    if whole is not None:
+        result = whole.synchronize(c.passes, c.spec.resources, c.trace, aliases, ranges, outputs)
+    if result is None:
+        synchronize_passes = (SYNC_NATIVE or sync_python).synchronize
+        result = synchronize_passes(c.passes, c.spec.resources, c.trace, aliases, ranges, outputs)
+    return replace(c, sync=result)
 
 
 def emit(c: Compilation) -> Compilation:

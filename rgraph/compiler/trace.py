@@ -11,8 +11,10 @@ queue). ``measure`` reads the usages and lifetimes, ``place`` the cross-queue wa
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from operator import itemgetter
 
 from rgraph.compiler.plan_values import get_subresource, names, subresource
 from rgraph.compiler.read_layouts import to_general
@@ -48,6 +50,7 @@ class ResourceTrace:
 
 
 _new_trace = builder(ResourceTrace)
+_pass_of = itemgetter(0)  # a Use's pass
 _new_access = builder(pm.Access)
 
 #: The compiled mirror of :func:`walk_python` (``rgraph/compiler/_trace.pyx``), None where it
@@ -57,7 +60,8 @@ NATIVE = load("rgraph.compiler._trace")
 
 @dataclass
 class Trace:
-    accesses: list[list[pm.Access]]  # per pass, per declared access: the plan's values
+    accesses: list[Sequence[pm.Access]]  # per pass, per declared access: the plan's values (tuples from the
+    # compiled walk: the plan keeps them; lists from the Python one)
     resources: dict[str, ResourceTrace]  # used resources, in the order of their first use
     #: per pass (only those that have one): queue -> the latest pass on that queue that a cell's
     #: previous use was, i.e. the semaphore waits the dedicated plan has there
@@ -90,10 +94,9 @@ def trace(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec]) -> 
     built: :data:`NATIVE`, else :func:`walk_python`); the reads ``read_layouts`` moves to
     GENERAL are patched in afterwards (a few per graph)."""
     if NATIVE is None:
-        walked = walk_python(passes, resources)
-    else:
-        walked = NATIVE.walk(passes, resources, _SCOPES, _scope)
-    return _finish(passes, *walked)
+        return _finish(passes, *walk_python(passes, resources))
+    moved: list[tuple[int, int]] = []  # the compiled walk groups the reads for read_layouts itself
+    return _finish(passes, *NATIVE.walk(passes, resources, _SCOPES, _scope, moved), moved=moved)
 
 
 Walked = tuple[list[list[pm.Access]], dict[str, ResourceTrace], dict[Cell, list[Use]], dict[int, dict[str, int]]]
@@ -194,9 +197,15 @@ def walk_python(passes: Sequence[PassSpec], resources: Mapping[str, ResourceSpec
 
 
 def _finish(passes: Sequence[PassSpec], plan_accesses: list[list[pm.Access]], info: dict[str, ResourceTrace],
-            timeline: dict[Cell, list[Use]], waits: dict[int, dict[str, int]]) -> Trace:
-    """The walk's results with the reads ``read_layouts`` moves to GENERAL patched in."""
-    moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
+            timeline: dict[Cell, list[Use]], waits: dict[int, dict[str, int]],
+            moved: list[tuple[int, int]] | None = None) -> Trace:
+    """The walk's results with the reads ``read_layouts`` moves to GENERAL patched in (``moved``:
+    those, where the walk found them; else ``to_general`` of its read groups)."""
+    if moved is None:
+        moved = to_general({name: r.group for name, r in info.items() if r.group is not None})
+    elif NATIVE is not None:  # the compiled walk's: patched by the compiled mirror of what follows
+        NATIVE.patch(passes, plan_accesses, info, timeline, moved, _SCOPES, _scope)
+        return Trace(plan_accesses, info, waits)
     general: dict[int, tuple[Sync, Sync]] = {}  # id(scope): (scope, in GENERAL); few distinct scopes
     rows: dict[int, list[Sync]] = {}  # the passes with a moved read: the scope of each access
     for i, j in moved:
@@ -237,8 +246,6 @@ def _repatch(p: PassSpec, i: int, cells: Sequence[Cell], row: Sequence[Sync], ti
         uses = timeline.get(c)
         if uses is None:  # a resource of one cell
             uses = info[c[0]].cells[0][1]
-        for k in range(len(uses) - 1, -1, -1):
-            if uses[k][0] == i:
-                _, _, w, queue, pos = uses[k]
-                uses[k] = (i, merged, w, queue, pos)
-                break
+        k = bisect_left(uses, i, key=_pass_of)  # uses are in pass order, one per pass: the use of pass i
+        _, _, w, queue, pos = uses[k]
+        uses[k] = (i, merged, w, queue, pos)

@@ -46,7 +46,7 @@ class Block:
         return self.start <= other.end and other.start <= self.end
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Heap:
     """One memory allocation holding placed blocks of a single memory class."""
 

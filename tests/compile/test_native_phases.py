@@ -1,5 +1,5 @@
 """The compiled compiler phases (``rgraph/**/_*.pyx``: cull, trace, measure, place, emit, the
-best fit and the elastic dive; sync.py compiled as it is, and its cell walk `_sync_walk.pyx`) against the pure-Python code they mirror: byte-identical plans
+best fit and the elastic dive; sync.py compiled as it is, and the whole phase and its cell walk `_sync_walk.pyx`) against the pure-Python code they mirror: byte-identical plans
 on random graphs under every policy, on graphs with optional reads, culled passes and
 several queues, and on every bundled graph. A plan differing anywhere fails."""
 
@@ -26,6 +26,11 @@ BUILT = [getattr(module, name) is not None for module, name in SWITCHES]
 GRAPHS = sorted((Path(__file__).resolve().parents[2] / "graphs").glob("*.yaml"))
 
 pytestmark = pytest.mark.skipif(not all(BUILT), reason="compiled accelerators not built (setup.py build_ext)")
+
+
+def rows(accesses) -> list[tuple]:
+    """A trace's plan accesses per pass as tuples (the compiled walk's are, the Python walk's lists)."""
+    return [tuple(row) for row in accesses]
 
 
 def both(spec, monkeypatch: pytest.MonkeyPatch, **options) -> tuple[str, str]:
@@ -110,7 +115,7 @@ def test_the_compiled_trace_reads_any_access_type(tmp_path: Path) -> None:
     assert type(passes[0].accesses[0]) is Access
     native = trace.NATIVE.walk(passes, spec.resources, trace._SCOPES, trace._scope)
     python = trace.walk_python(spec.passes, spec.resources)
-    assert native[0] == python[0] and native[2] == python[2] and native[3] == python[3]
+    assert rows(native[0]) == rows(python[0]) and native[2] == python[2] and native[3] == python[3]
     assert {n: (r.usages, r.first, r.last, r.cells) for n, r in native[1].items()} == \
         {n: (r.usages, r.first, r.last, r.cells) for n, r in python[1].items()}
 
@@ -170,6 +175,8 @@ def test_a_walk_started_during_a_walk_hands_its_cell_to_python(tmp_path: Path, m
     spec = frontend(path, size=(16, 16)).spec
     expected = dump(compile_plan(spec))
     monkeypatch.setattr(walk_module, "make_barrier", reentering)
+    # the cell walk runs where the whole compiled phase declines (tests/compile/test_sync_compiled.py)
+    monkeypatch.setattr(walk_module, "synchronize", lambda *args: None)
     assert dump(compile_plan(spec)) == expected
     assert inner and all(found is None for found in inner)
 
@@ -191,7 +198,7 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
     def walks_alike(ps, rs) -> None:
         native = trace.NATIVE.walk(ps, rs, trace._SCOPES, trace._scope)
         python = trace.walk_python(ps, rs)
-        assert native[0] == python[0]  # the plan accesses (stages, access, layout, subresource)
+        assert rows(native[0]) == rows(python[0])  # the plan accesses (stages, access, layout, subresource)
         assert [(n, r.cells) for n, r in native[1].items()] == [(n, r.cells) for n, r in python[1].items()]
 
     trace.NATIVE.reset_access_table()
@@ -221,3 +228,53 @@ def test_the_optional_scan_agrees(tmp_path: Path) -> None:
     for ps, expected in ((passes, False), (with_last, True), (with_first, True), ([], False)):
         assert cull.NATIVE.has_optional(ps) is expected
         assert cull._has_optional_python(ps) is expected
+
+
+@pytest.mark.parametrize("seed,passes", [(1, 40), (9, 150), (1000, 1000)])
+def test_the_compiled_walk_groups_reads_as_read_layouts(tmp_path: Path, seed: int, passes: int) -> None:
+    """``walk(..., moved=[])`` finds ``read_layouts.to_general``'s reads during the walk (no read
+    groups kept): the same reads as ``to_general`` of the Python walk's groups; and, among those
+    graphs' groups, some of several reads in one layout (they stay) and some mixed (they move)."""
+    from rgraph.compiler.read_layouts import GENERAL_READS, to_general
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=passes)))
+    spec = frontend(path, size=(16, 16)).spec
+    moved: list[tuple[int, int]] = []
+    native = trace.NATIVE.walk(spec.passes, spec.resources, trace._SCOPES, trace._scope, moved)
+    python = trace.walk_python(spec.passes, spec.resources)
+    groups = {n: r.group for n, r in python[1].items() if r.group is not None}
+    assert moved == to_general(groups)
+    assert all(r.group is None for r in native[1].values())
+    assert rows(native[0]) == rows(python[0]) and native[2] == python[2] and native[3] == python[3]
+    if passes == 1000:
+        alike = 0  # groups of several movable reads in one layout (a walk that moved any group would fail)
+        for seq in groups.values():
+            run: list[str | None] = []
+            for _, _, write, usage, layout in [*seq, (-1, -1, True, "", None)]:
+                if not write:
+                    if usage in GENERAL_READS:
+                        run.append(layout)
+                    continue
+                alike += len(run) > 1 and len(set(run)) == 1
+                run = []
+        assert moved and alike
+
+
+@pytest.mark.parametrize("seed,passes", [(9, 150), (1000, 1000)])
+def test_the_compiled_trace_patches_moved_reads_alike(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, seed: int,
+                                                      passes: int) -> None:
+    """``trace.trace`` with the compiled walk and patch (``_trace.patch``: the reads moved to
+    GENERAL, their plan accesses and their passes' merged uses) gives the Python trace."""
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=passes)))
+    spec = frontend(path, size=(16, 16)).spec
+    native = trace.trace(spec.passes, spec.resources)
+    with monkeypatch.context() as m:
+        m.setattr(trace, "NATIVE", None)
+        python = trace.trace(spec.passes, spec.resources)
+    assert rows(native.accesses) == rows(python.accesses) and native.waits == python.waits
+    assert all(type(row) is tuple for row in native.accesses)  # the plan keeps them
+    assert any(a.layout == "GENERAL" and a.usage == "sampled" for row in native.accesses for a in row)
+    assert [(n, r.usages, r.first, r.last, r.cells) for n, r in native.resources.items()] == \
+        [(n, r.usages, r.first, r.last, r.cells) for n, r in python.resources.items()]

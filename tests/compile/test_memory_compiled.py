@@ -1,0 +1,55 @@
+"""The compiled measure and place helpers (``rgraph/compiler/_memory.pyx``) against the Python
+code: the blocks ``place_resources`` builds, and the requirements read from the profile
+provider's memos by the keys its ``image`` and ``buffer`` use."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rgraph.compiler import memory
+from rgraph.compiler.pipeline import _default_provider, compilation, frontend
+from rgraph.memory.model import Block
+from rgraph.memory_requirements import ProfileMemoryRequirements
+from rgraph.random_graph import random_graph, to_yaml
+
+pytestmark = pytest.mark.skipif(memory.NATIVE is None, reason="compiled accelerators not built")
+
+
+def test_blocks_equal_the_python_ones() -> None:
+    mem = {
+        "a": memory.ResourceMemory(1000, 256, 7, "device_local_optimal", ("sampled",), 0, 3),
+        "b": memory.ResourceMemory(1024, 256, 7, "device_local_optimal", ("sampled",), 2, 5),
+        "c": memory.ResourceMemory(5, 1, 7, "device_local_linear", (), 1, 1),
+        "z": memory.ResourceMemory(64, 0, 7, "device_local_linear", (), 1, 1),  # check_blocks' error, not here
+    }
+    names = ["a", "b", "c", "z"]
+    native = memory.NATIVE.blocks(names, mem)
+    python = [Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in names for m in (mem[n],)]
+    assert native == python and [type(b) for b in native] == [Block] * 4
+    assert [b.aligned_size for b in native[:3]] == [1024, 1024, 5] == [b.aligned_size for b in python[:3]]
+    assert "aligned_size" not in vars(native[3])  # computed on use, as before: ZeroDivisionError then
+    with pytest.raises(ZeroDivisionError):
+        _ = native[3].aligned_size
+
+
+def test_requirements_read_the_provider_memos_by_its_keys(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Once ``image`` and ``buffer`` filled their memos, the compiled requirements make no call:
+    a key of its own (one field left out or in another form) would miss and call them."""
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=4, passes=120)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    provider = ProfileMemoryRequirements(_default_provider().profile, "copy")
+    used = {name: r.usages for name, r in c.trace.resources.items()}
+    python = memory.requirements_python(spec.resources, used, spec.outputs, provider)  # fills the memos
+    assert provider.__dict__["_image_memo"] and provider.__dict__["_buffer_memo"]
+
+    def no_call(*args, **kwargs):
+        raise AssertionError("called")
+
+    monkeypatch.setattr(provider, "image", no_call)
+    monkeypatch.setattr(provider, "buffer", no_call)
+    native = memory.NATIVE.requirements(spec.resources, used, spec.outputs, provider, memory._SAME_BUFFER_FLAG)
+    assert native == python and list(native) == list(python)

@@ -1,0 +1,122 @@
+"""The whole sync phase compiled (``rgraph/compiler/_sync_walk.pyx``: ``synchronize``) against
+``rgraph.compiler.sync.synchronize``, the Python reference: the same barriers (and their order),
+releases, waits, signals and start and end states, on a graph whose barrier groups make
+rectangles of every shape (one cell, the whole image, runs of layers merged over mips, an L),
+on queues that hand cells over, and on random graphs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rgraph.compiler import sync
+from rgraph.compiler.pipeline import compilation, frontend
+from rgraph.random_graph import random_graph, to_yaml
+
+WHOLE = sync._WALK
+pytestmark = pytest.mark.skipif(WHOLE is None or not hasattr(WHOLE, "synchronize"),
+                                reason="compiled sync not built (setup.py build_ext)")
+
+#: ``arr`` (3 mips x 4 layers): after ``z``, ``a`` and ``b`` its cells have three histories, so
+#: the whole-image read in ``c`` (on the compute queue: releases on graphics) gets three groups:
+#: a's 2 cells (mip 0, layers 0-1), b's square (mips 1-2, layers 1-2: merged over mips) and z's
+#: L (mip 0 layers 2-3; mips 1-2 layers 0 and 3). ``d`` reads part of it back on graphics; the
+#: persistent ``side`` ends with one cell in another state (a per-cell end state).
+RECTANGLES = """\
+rgraph: 1
+name: rectangles
+resources:
+  arr: {kind: image, format: r32_sfloat, size: output, mips: 3, layers: 4}
+  side: {kind: image, format: r32_sfloat, size: output, mips: 2, layers: 3, lifetime: persistent}
+  out: {kind: buffer, bytes: 256}
+  out2: {kind: buffer, bytes: 256}
+passes:
+  z: {kind: compute, writes: {arr: storage_write}}
+  a: {kind: transfer, writes: {"arr[mip=0, layer=0:2]": transfer_dst, "side[mip=1, layer=1:3]": transfer_dst}}
+  b: {kind: raster, writes: {"arr[mip=1:3, layer=1:3]": storage_write}}
+  c: {kind: compute, queue: compute, reads: {arr: sampled, "side[mip=0:2, layer=0:2]": sampled},
+      writes: {out: storage_write}}
+  d: {kind: compute, reads: {"arr[mip=0:2, layer=0:4]": sampled, "side[mip=0:2, layer=0:2]": sampled},
+      writes: {out2: storage_write}}
+outputs: [out, out2]
+"""
+
+
+def both(c) -> tuple[object, object]:
+    """The compiled phase's result, then the Python reference's, for compilation ``c``."""
+    offsets, aliases = c.placement.offsets, c.aliases
+    named = {n for preds in aliases.values() for n in preds}.union(aliases)
+    ranges = {n: (heap, off, off + c.memory[n].bytes) for n in named for heap, off in (offsets[n],)}
+    args = (c.passes, c.spec.resources, c.trace, aliases, ranges, set(c.spec.outputs))
+    native = WHOLE.synchronize(*args)
+    assert native is not None
+    saved = sync._WALK
+    sync._WALK = None  # the reference's own cell walk in Python too
+    try:
+        python = sync.synchronize(*args)
+    finally:
+        sync._WALK = saved
+    return native, python
+
+
+def same(native, python) -> None:
+    for field in ("barriers", "releases", "waits", "signals", "signal_values", "final", "initial"):
+        assert getattr(native, field) == getattr(python, field), field
+
+
+def test_rectangles_of_every_shape(tmp_path: Path) -> None:
+    path = tmp_path / "g.yaml"
+    path.write_text(RECTANGLES)
+    c = compilation(frontend(path, size=(16, 16)).spec)
+    native, python = both(c)
+    same(native, python)
+    index = {p.name: i for i, p in enumerate(c.passes)}
+    got = [(b.subresource.mips, b.subresource.layers, b.src.layout, b.src.stages)
+           for b in native.barriers[index["c"]] if b.resource == "arr"]
+    # sorted by subresource; the square merged over mips 1-2, the L's layer-0 and layer-3 runs too
+    assert got == [((0, 1), (0, 2), "TRANSFER_DST_OPTIMAL", ("COPY",)),
+                   ((0, 1), (2, 4), "GENERAL", ("COMPUTE_SHADER",)),
+                   ((1, 3), (0, 1), "GENERAL", ("COMPUTE_SHADER",)),
+                   ((1, 3), (1, 3), "GENERAL", ("FRAGMENT_SHADER",)),
+                   ((1, 3), (3, 4), "GENERAL", ("COMPUTE_SHADER",))]
+    # z releases its L to c's queue: the acquire's rectangles, in rectangle order
+    assert [(b.subresource.mips, b.subresource.layers) for b in native.releases[index["z"]]] == [
+        ((0, 1), (2, 4)), ((1, 3), (0, 1)), ((1, 3), (3, 4))]
+    assert [b.resource for b in native.releases[index["a"]]] == ["arr", "side"]  # by resource
+    assert native.waits[index["c"]] and native.waits[index["d"]] and any(native.signals)
+    assert isinstance(native.final["side"], tuple) and native.final["arr"] is None
+
+
+@pytest.mark.parametrize("seed,passes", [(0, 60), (5, 200), (32, 10), (77, 400), (1000, 1000)])
+def test_random_graphs_synchronize_alike(tmp_path: Path, seed: int, passes: int) -> None:
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=passes)))
+    same(*both(compilation(frontend(path, size=(16, 16)).spec)))
+
+
+def test_a_synchronize_started_during_one_declines(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A second compiled phase (or cell walk) while one runs (another thread, or reentered
+    through the Python it calls) returns None (the caller runs the Python phase), so the tables
+    the running one points into are never reset under it; the plan stays the same."""
+    from rgraph.compiler.pipeline import compile_plan
+    from rgraph.plan import dump
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=12, passes=80)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    expected = dump(c.plan)
+    args = (c.passes, c.spec.resources, c.trace, c.aliases, None, set(spec.outputs))
+    inner: list[object] = []
+    handoffs = WHOLE.with_partial_handoffs
+
+    def reentering(*a, **k):  # called by the compiled phase once, while it runs
+        inner.append(WHOLE.synchronize(*args))
+        start = ("GENERAL", None, None, None, None, (frozenset(), frozenset()))
+        inner.append(WHOLE.walk([], True, start, (), (), False, None, ("r", 0, 0), None))
+        return handoffs(*a, **k)
+
+    monkeypatch.setattr(WHOLE, "with_partial_handoffs", reentering)
+    assert dump(compile_plan(spec)) == expected
+    assert len(inner) == 2 and all(found is None for found in inner)

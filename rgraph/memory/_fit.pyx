@@ -686,3 +686,33 @@ def orderings(start, end, size, sec_lo, sec_hi, totals):
         free(peak)
         free(keys)
         free(tot)
+
+
+def peak(offsets, size):
+    """``Instance.peak``: ``max(map(add, offsets, size), default=0)``. OverflowError where a
+    value passes 62 bits (the Python code then runs)."""
+    cdef Py_ssize_t n = len(offsets), i
+    cdef i64 top = 0, o, z
+    if len(size) != n:
+        raise ValueError("inconsistent instance arrays")
+    for i in range(n):
+        o, z = offsets[i], size[i]
+        if not (-LIMIT < o < LIMIT and -LIMIT < z < LIMIT):
+            raise OverflowError("values past 62 bits")
+        if i == 0 or o + z > top:
+            top = o + z
+    return top
+
+
+def live_at(sec_lo, sec_hi, Py_ssize_t section):
+    """The blocks living in ``section``, ascending: ``[i for i, (lo, hi) in
+    enumerate(zip(sec_lo, sec_hi)) if lo <= section < hi]`` (``bounds.clique_bound``)."""
+    cdef Py_ssize_t n = len(sec_lo), i, lo, hi
+    cdef list out = []
+    if len(sec_hi) != n:
+        raise ValueError("inconsistent instance arrays")
+    for i in range(n):
+        lo, hi = sec_lo[i], sec_hi[i]
+        if lo <= section < hi:
+            out.append(i)
+    return out

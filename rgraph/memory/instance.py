@@ -305,5 +305,10 @@ class Instance:
         return max(self.section_totals(), default=0)
 
     def peak(self, offsets: Sequence[int]) -> int:
-        """The highest top of ``offsets`` (one per block)."""
+        """The highest top of ``offsets`` (one per block); compiled where built."""
+        if _NATIVE is not None and len(offsets) == self.n:
+            try:
+                return _NATIVE.peak(offsets, self.size)  # type: ignore[no-any-return]
+            except OverflowError:  # past 62 bits
+                pass
         return max(map(add, offsets, self.size), default=0)

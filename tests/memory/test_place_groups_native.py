@@ -120,3 +120,26 @@ def test_orderings_overflow_falls_back() -> None:
     with pytest.raises(OverflowError):
         NATIVE.orderings(inst.start, inst.end, inst.size, inst.sec_lo, inst.sec_hi, inst._totals)
     assert list(greedy.orderings(inst)) == list(greedy._orderings_python(inst))
+
+
+@pytest.mark.parametrize("blocks", cases())
+def test_peak_and_live_at_match(blocks: list[Block]) -> None:
+    """``_fit.peak`` (``Instance.peak``) and ``_fit.live_at`` (``clique_bound``'s members)
+    against the Python expressions, on best-fit offsets and every section."""
+    from operator import add
+
+    for group, *_ in class_groups_python(blocks).values():
+        inst = Instance.build(group)
+        for _, order in greedy.orderings(inst):
+            offsets = greedy.best_fit_python(inst, order)
+            assert offsets is not None
+            assert NATIVE.peak(offsets, inst.size) == max(map(add, offsets, inst.size), default=0)
+        for s in range(-1, inst.section_count + 1):
+            assert NATIVE.live_at(inst.sec_lo, inst.sec_hi, s) == [
+                i for i, (lo, hi) in enumerate(zip(inst.sec_lo, inst.sec_hi, strict=True)) if lo <= s < hi]
+    assert NATIVE.peak([], []) == 0
+    assert NATIVE.peak([-5, -9], [1, 2]) == -4  # no floor at 0 where every top is negative (as max)
+    with pytest.raises(OverflowError):
+        NATIVE.peak([1 << 63], [1])
+    big = Instance.build([Block("a", 0, 1, 1 << 70, 1, "x")])
+    assert big.peak([5]) == 5 + (1 << 70)  # the Python code, past 62 bits

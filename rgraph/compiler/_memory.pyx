@@ -222,3 +222,29 @@ def blocks(list names, memory):
             d["aligned_size"] = size if rem == 0 else size + alignment - rem
         out.append(b)
     return out
+
+
+def split(resources, memory, outputs):
+    """``place_resources``' ``(aliasable, rest)``: the names of ``memory`` in sorted order,
+    the transients that are not ``outputs`` in the first list, the others in the second."""
+    cdef set kept = set(outputs)
+    cdef list aliasable = [], rest = []
+    for n in sorted(memory):
+        if resources[n].lifetime == "transient" and n not in kept:
+            aliasable.append(n)
+        else:
+            rest.append(n)
+    return aliasable, rest
+
+
+def dedicated(list rest, memory, list heaps, dict offsets, heap):
+    """``place_resources``' loop giving each of ``rest`` its own heap (``heap``: the ``Heap``
+    builder), appended to ``heaps`` and written to ``offsets``; returns their bytes."""
+    extra = 0
+    for n in rest:
+        m = memory[n]
+        h = heap(len(heaps), m.bytes, m.memory_class, m.alignment)
+        heaps.append(h)
+        offsets[n] = (h.id, 0)
+        extra += m.bytes
+    return extra

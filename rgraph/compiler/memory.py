@@ -58,8 +58,8 @@ _requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  
 _heap = builder(Heap)  # one per resource placed apart
 
 #: The compiled mirror of :func:`requirements_python`, :func:`resource_memory_python`,
-#: :func:`alias_sources_python` and ``phases._culled_only_python`` (``rgraph/compiler/_memory.pyx``),
-#: None where it is not built or ``RGRAPH_NATIVE=0``.
+#: :func:`alias_sources_python`, ``phases._culled_only_python`` and ``place_resources``' loops
+#: (``rgraph/compiler/_memory.pyx``), None where it is not built or ``RGRAPH_NATIVE=0``.
 NATIVE = load("rgraph.compiler._memory")
 
 # Usages that set the same VkBufferUsageFlags bit (STORAGE_BUFFER) have the same requirements.
@@ -166,26 +166,30 @@ def place_resources(
 ) -> Placement:
     """Place transients with ``policy``; give every other resource its own heap.
     ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
-    kept = set(outputs)
-    aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
     if NATIVE is None:
+        kept = set(outputs)
+        aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
         blocks = [
             Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
         ]
-    else:  # the same blocks, built in C with their aligned sizes
+    else:  # the same names, and the same blocks built in C with their aligned sizes
+        aliasable, rest = NATIVE.split(resources, memory, outputs)
         blocks = NATIVE.blocks(aliasable, memory)
     from rgraph.memory import place
 
     placed = place(blocks, policy, conflicts=conflicts)
     offsets = dict(placed.offsets)
     heaps = list(placed.heaps)
-    extra = 0
-    for n in sorted(set(memory) - set(aliasable)):
-        m = memory[n]
-        heap = _heap(len(heaps), m.bytes, m.memory_class, m.alignment)
-        heaps.append(heap)
-        offsets[n] = (heap.id, 0)
-        extra += m.bytes
+    if NATIVE is None:
+        extra = 0
+        for n in sorted(set(memory) - set(aliasable)):
+            m = memory[n]
+            heap = _heap(len(heaps), m.bytes, m.memory_class, m.alignment)
+            heaps.append(heap)
+            offsets[n] = (heap.id, 0)
+            extra += m.bytes
+    else:  # the same loop over the same names, compiled
+        extra = NATIVE.dedicated(rest, memory, heaps, offsets, _heap)
     s = placed.stats
     stats = PlacementStats(
         s.policy, s.peak_bytes + extra, s.lower_bound_bytes + extra, s.unaliased_bytes + extra,

@@ -163,7 +163,8 @@ def _culled_only_python(spec: Spec, culled: Sequence[Culled], traced: Mapping[st
 def place(c: Compilation) -> Compilation:
     """Heaps and offsets: transients by the allocator policy (may alias), others dedicated."""
     try:
-        aliasable = [n for n in c.memory if c.spec.resources[n].lifetime == "transient"]
+        resources = c.spec.resources
+        aliasable = [n for n in c.memory if resources[n].lifetime == "transient"]
         assert c.trace is not None
         conflicts = cross_queue_conflicts(c.passes, c.trace, aliasable)
         placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs, conflicts)

@@ -9,12 +9,17 @@ from __future__ import annotations
 import time
 from collections.abc import Collection, Mapping, Sequence
 
-from rgraph.memory.aliased import place_class, too_dense
+from rgraph.memory.aliased import overlapping_pairs, place_class, too_dense_pairs
 from rgraph.memory.bounds import class_lower_bound
 from rgraph.memory.instance import Instance
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats, by_class, check_blocks
 from rgraph.memory.online import place_blocks, place_tlsf
 from rgraph.memory.policy import Policy, parse_policy
+from rgraph.native import load
+
+#: ``rgraph/memory/_fit.pyx`` (its ``class_groups``: the checks, the classes and their
+#: overlapping pairs in one pass), None where not built or ``RGRAPH_NATIVE=0``.
+_NATIVE = load("rgraph.memory._fit")
 
 __all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "parse_place_args", "place"]
 
@@ -45,6 +50,25 @@ def parse_place_args(policy: str, budget: float | None, source: str = "<command 
     return chosen, budget
 
 
+def class_groups(blocks: Sequence[Block]) -> dict[str, tuple[list[Block], int, int, int]]:
+    """Check ``blocks`` (``check_blocks``: ValueError for blocks no policy can place), then
+    per memory class (sorted): its blocks in input order, their highest alignment, their
+    ordered pairs overlapping in time (``aliased.overlapping_pairs``) and their aligned
+    bytes. Compiled where built (``_fit.class_groups``), else :func:`class_groups_python`."""
+    if _NATIVE is not None and isinstance(blocks, list):
+        found = _NATIVE.class_groups(blocks)
+        if found is not None:
+            return found  # type: ignore[no-any-return]
+    return class_groups_python(blocks)
+
+
+def class_groups_python(blocks: Sequence[Block]) -> dict[str, tuple[list[Block], int, int, int]]:
+    check_blocks(blocks)
+    return {cls: (group, max(b.alignment for b in group), overlapping_pairs(group),
+                  sum(b.aligned_size for b in group))
+            for cls, group in by_class(blocks).items()}
+
+
 def place(
     blocks: Sequence[Block], policy: str | Policy = "aliased", *, time_budget_s: float = DEFAULT_BUDGET_S,
     conflicts: Mapping[str, Collection[str]] | None = None,
@@ -55,7 +79,7 @@ def place(
     although apart in time."""
     began = time.perf_counter()
     chosen = parse_policy(policy)
-    check_blocks(blocks)
+    grouped = class_groups(blocks)
     if chosen.kind == "optimal" and time_budget_s == DEFAULT_BUDGET_S:
         time_budget_s = OPTIMAL_BUDGET_S
     offsets: dict[str, tuple[int, int]] = {}
@@ -66,9 +90,10 @@ def place(
         heaps.append(Heap(len(heaps), size, memory_class, alignment))
         return len(heaps) - 1
 
-    for memory_class, group in by_class(blocks).items():
-        max_align = max(b.alignment for b in group)
-        searched = chosen.kind in ("aliased", "optimal") and not too_dense(group, time_budget_s)
+    unaliased = 0
+    for memory_class, (group, max_align, pairs, group_bytes) in grouped.items():
+        unaliased += group_bytes
+        searched = chosen.kind in ("aliased", "optimal") and not too_dense_pairs(pairs, time_budget_s)
         if not searched:  # place_class gives it otherwise
             bound += class_lower_bound(group)
         if chosen.kind == "dedicated":
@@ -102,7 +127,7 @@ def place(
         policy=str(chosen),
         peak_bytes=sum(h.bytes for h in heaps),
         lower_bound_bytes=bound,
-        unaliased_bytes=sum(b.aligned_size for b in blocks),
+        unaliased_bytes=unaliased,
         allocations=len(heaps),
         seconds=time.perf_counter() - began,
     )

@@ -14,7 +14,7 @@ or by sorting its own placed neighbours. Which way is used changes the time only
 scan depends only on the first of equal offsets and the highest top so far. ``Flat`` is
 one instance's arrays, made once per ``Instance`` (``greedy.native_flat``)."""
 
-from libc.stdlib cimport free, malloc, qsort, realloc
+from libc.stdlib cimport calloc, free, malloc, qsort, realloc
 from libc.string cimport memmove
 
 ctypedef long long i64
@@ -381,3 +381,338 @@ def conflict_matrix(start, end, names, conflicts):
         free(s)
         free(e)
         free(pairs)
+
+
+cdef int by_i64(const void *a, const void *b) noexcept nogil:
+    cdef i64 x = (<const i64 *> a)[0], y = (<const i64 *> b)[0]
+    return (x > y) - (x < y)
+
+
+cdef Py_ssize_t lower_bound(const i64 *a, Py_ssize_t n, i64 x) noexcept nogil:
+    """The first index of ``a`` (ascending) holding ``x`` or more."""
+    cdef Py_ssize_t lo = 0, hi = n, mid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if a[mid] < x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+cdef Py_ssize_t upper_bound(const i64 *a, Py_ssize_t n, i64 x) noexcept nogil:
+    """The first index of ``a`` (ascending) holding more than ``x``."""
+    cdef Py_ssize_t lo = 0, hi = n, mid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if a[mid] <= x:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+def class_arrays(list blocks):
+    """``Instance.build``'s per-block lists and sections, and ``Instance._totals``, for the
+    blocks of one class: ``(start, end, size, align, sec_lo, sec_hi, section_count, totals)``
+    (``size``: the aligned sizes), the values ``instance.sections`` and the Python lists
+    give. OverflowError where a time or a size passes 62 bits (the Python code then runs)."""
+    cdef Py_ssize_t n = len(blocks), i, m = 0, count
+    cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *z = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *coords = <i64 *> malloc(max(2 * n, 1) * sizeof(i64))
+    cdef i64 *diff = NULL
+    cdef i64 total = 0, run = 0
+    cdef Py_ssize_t *lo = <Py_ssize_t *> malloc(max(n, 1) * sizeof(Py_ssize_t))
+    cdef Py_ssize_t *hi = <Py_ssize_t *> malloc(max(n, 1) * sizeof(Py_ssize_t))
+    cdef list start = [], end = [], size = [], align = [], sec_lo = [], sec_hi = [], totals = []
+    try:
+        if not (s and e and z and coords and lo and hi):
+            raise MemoryError()
+        for i in range(n):
+            b = blocks[i]
+            x, y, w = b.start, b.end, b.aligned_size
+            start.append(x)
+            end.append(y)
+            size.append(w)
+            align.append(b.alignment)
+            s[i], e[i], z[i] = x, y, w  # OverflowError past 64 bits
+            if not (-LIMIT < s[i] < LIMIT and -LIMIT < e[i] < LIMIT and 0 <= z[i] < LIMIT):
+                raise OverflowError("times and sizes must be within 2**62")
+            total += z[i]
+            if total >= LIMIT:
+                raise OverflowError("sizes sum past 2**62")
+            coords[2 * i], coords[2 * i + 1] = s[i], e[i] + 1
+        if n:
+            qsort(coords, 2 * n, sizeof(i64), by_i64)
+            m = 1
+            for i in range(1, 2 * n):
+                if coords[i] != coords[m - 1]:
+                    coords[m] = coords[i]
+                    m += 1
+        count = m - 1 if m > 1 else 0
+        diff = <i64 *> calloc(count + 1, sizeof(i64))
+        if not diff:
+            raise MemoryError()
+        for i in range(n):
+            lo[i] = lower_bound(coords, m, s[i])
+            hi[i] = lower_bound(coords, m, e[i] + 1)
+            sec_lo.append(lo[i])
+            sec_hi.append(hi[i])
+            diff[lo[i]] += z[i]
+            diff[hi[i]] -= z[i]
+        for i in range(count):
+            run += diff[i]
+            totals.append(run)
+        return start, end, size, align, sec_lo, sec_hi, count, tuple(totals)
+    finally:
+        free(s)
+        free(e)
+        free(z)
+        free(coords)
+        free(diff)
+        free(lo)
+        free(hi)
+
+
+def class_groups(list blocks):
+    """``place``'s checks and grouping in one pass: ``{class: (blocks, max alignment,
+    overlapping pairs, sum of aligned sizes)}``, classes sorted, blocks in input order, the
+    pairs as ``aliased.overlapping_pairs`` counts them. None where ``model.check_blocks``
+    would raise (the caller then runs it) or a time passes 62 bits."""
+    cdef Py_ssize_t n = len(blocks), i, k, g
+    cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *ss = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *es = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 pairs
+    cdef set seen = set()
+    cdef dict groups = {}, at = {}, out = {}
+    cdef list members, where
+    try:
+        if not (s and e and ss and es):
+            raise MemoryError()
+        for i in range(n):
+            b = blocks[i]
+            name = b.name
+            if name in seen:
+                return None
+            seen.add(name)
+            x, y = b.start, b.end
+            if x > y or b.size < 0 or b.alignment < 1:
+                return None
+            try:
+                s[i], e[i] = x, y
+            except OverflowError:
+                return None
+            if not (-LIMIT < s[i] < LIMIT and -LIMIT < e[i] < LIMIT):
+                return None
+            cls = b.memory_class
+            members = groups.get(cls)
+            if members is None:
+                members = groups[cls] = []
+                at[cls] = []
+            members.append(b)
+            (<list> at[cls]).append(i)
+        for cls in sorted(groups):
+            members, where = groups[cls], at[cls]
+            g = len(where)
+            top = None
+            bytes_ = 0
+            for k in range(g):
+                i = where[k]
+                ss[k], es[k] = s[i], e[i]
+                b = members[k]
+                a = b.alignment
+                if top is None or a > top:
+                    top = a
+                bytes_ += b.aligned_size
+            qsort(ss, g, sizeof(i64), by_i64)
+            qsort(es, g, sizeof(i64), by_i64)
+            pairs = 0
+            for k in range(g):  # j overlaps i: start_j <= end_i, less those with end_j < start_i
+                i = where[k]
+                pairs += upper_bound(ss, g, e[i]) - lower_bound(es, g, s[i])
+            out[cls] = (members, top, pairs - g, bytes_)
+        return out
+    finally:
+        free(s)
+        free(e)
+        free(ss)
+        free(es)
+
+
+cdef struct Key:
+    i64 a  # most significant
+    i64 b
+    Py_ssize_t i  # ties: by index (np.lexsort is stable)
+
+
+cdef int by_key(const void *x, const void *y) noexcept nogil:
+    cdef const Key *p = <const Key *> x
+    cdef const Key *q = <const Key *> y
+    if p.a != q.a:
+        return (p.a > q.a) - (p.a < q.a)
+    if p.b != q.b:
+        return (p.b > q.b) - (p.b < q.b)
+    return (p.i > q.i) - (p.i < q.i)
+
+
+cdef inline bint key_less(const Key *p, const Key *q) noexcept nogil:
+    if p.a != q.a:
+        return p.a < q.a
+    if p.b != q.b:
+        return p.b < q.b
+    return p.i < q.i
+
+
+cdef list sorted_by(Key *keys, Key *spare, Py_ssize_t n):
+    """The indices of ``keys`` sorted by (a, b, index): a merge sort (runs of 8 by insertion)
+    with the comparison inlined (``qsort``'s call per comparison cost more than the rest)."""
+    cdef Py_ssize_t k, j, width, lo, mid, hi, x, y, o
+    cdef Key item
+    cdef Key *src = keys
+    cdef Key *dst = spare
+    cdef Key *swap
+    with nogil:
+        lo = 0
+        while lo < n:
+            hi = min(lo + 8, n)
+            for k in range(lo + 1, hi):
+                item = src[k]
+                j = k
+                while j > lo and key_less(&item, &src[j - 1]):
+                    src[j] = src[j - 1]
+                    j -= 1
+                src[j] = item
+            lo = hi
+        width = 8
+        while width < n:
+            lo = 0
+            while lo < n:
+                mid, hi = min(lo + width, n), min(lo + 2 * width, n)
+                x, y, o = lo, mid, lo
+                while x < mid and y < hi:
+                    if key_less(&src[y], &src[x]):
+                        dst[o] = src[y]
+                        y += 1
+                    else:
+                        dst[o] = src[x]
+                        x += 1
+                    o += 1
+                while x < mid:
+                    dst[o] = src[x]
+                    x += 1
+                    o += 1
+                while y < hi:
+                    dst[o] = src[y]
+                    y += 1
+                    o += 1
+                lo = hi
+            swap = src
+            src = dst
+            dst = swap
+            width *= 2
+    return [src[k].i for k in range(n)]
+
+
+def orderings(start, end, size, sec_lo, sec_hi, totals):
+    """``greedy.orderings``' six orders (size, area, length, start, contention,
+    contention_size), all at once, as a list: ``start``, ``end``, ``size`` (aligned),
+    ``sec_lo``, ``sec_hi`` and the section ``totals`` of an ``Instance``. OverflowError
+    where a key passes 62 bits (``greedy.orderings`` then sorts in Python)."""
+    cdef Py_ssize_t n = len(start), i, s
+    cdef i64 *s_ = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *z = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *w = <i64 *> malloc(max(n, 1) * sizeof(i64))  # minus the width
+    cdef i64 *area = <i64 *> malloc(max(n, 1) * sizeof(i64))  # minus the area
+    cdef i64 *peak = <i64 *> malloc(max(n, 1) * sizeof(i64))  # minus the contention
+    cdef Key *keys = <Key *> malloc(2 * max(n, 1) * sizeof(Key))
+    cdef Key *spare = keys + max(n, 1)
+    cdef i64 e, top, width
+    cdef Py_ssize_t lo, hi, count = len(totals)
+    cdef i64 *tot = <i64 *> malloc(max(count, 1) * sizeof(i64))
+    cdef list out = []
+    try:
+        if not (s_ and z and w and area and peak and keys and tot):
+            raise MemoryError()
+        for s in range(count):
+            tot[s] = totals[s]
+            if not (-LIMIT < tot[s] < LIMIT):
+                raise OverflowError("totals past 62 bits")
+        if len(end) != n or len(size) != n or len(sec_lo) != n or len(sec_hi) != n:
+            raise ValueError("inconsistent instance arrays")
+        for i in range(n):
+            s_[i], e, z[i] = start[i], end[i], size[i]  # OverflowError past 64 bits
+            if not (-LIMIT < s_[i] < LIMIT and -LIMIT < e < LIMIT and 0 <= z[i] < LIMIT):
+                raise OverflowError("keys past 62 bits")
+            width = e - s_[i] + 1
+            if width > 0 and z[i] > LIMIT // width:
+                raise OverflowError("area past 62 bits")
+            w[i], area[i] = -width, -width * z[i]
+            lo, hi = sec_lo[i], sec_hi[i]
+            if not (0 <= lo < hi <= count):
+                raise ValueError("a block outside the sections")
+            top = tot[lo]
+            for s in range(lo + 1, hi):
+                if tot[s] > top:
+                    top = tot[s]
+            peak[i] = -top
+        for i in range(n):
+            keys[i].a, keys[i].b, keys[i].i = -z[i], s_[i], i
+        out.append(sorted_by(keys, spare, n))  # size
+        for i in range(n):
+            keys[i].a, keys[i].b, keys[i].i = area[i], 0, i
+        out.append(sorted_by(keys, spare, n))  # area
+        for i in range(n):
+            keys[i].a, keys[i].b, keys[i].i = w[i], -z[i], i
+        out.append(sorted_by(keys, spare, n))  # length
+        for i in range(n):
+            keys[i].a, keys[i].b, keys[i].i = s_[i], -z[i], i
+        out.append(sorted_by(keys, spare, n))  # start
+        for i in range(n):
+            keys[i].a, keys[i].b, keys[i].i = peak[i], area[i], i
+        out.append(sorted_by(keys, spare, n))  # contention
+        for i in range(n):
+            keys[i].a, keys[i].b, keys[i].i = peak[i], -z[i], i
+        out.append(sorted_by(keys, spare, n))  # contention_size
+        return out
+    finally:
+        free(s_)
+        free(z)
+        free(w)
+        free(area)
+        free(peak)
+        free(keys)
+        free(tot)
+
+
+def peak(offsets, size):
+    """``Instance.peak``: ``max(map(add, offsets, size), default=0)``. OverflowError where a
+    value passes 62 bits (the Python code then runs)."""
+    cdef Py_ssize_t n = len(offsets), i
+    cdef i64 top = 0, o, z
+    if len(size) != n:
+        raise ValueError("inconsistent instance arrays")
+    for i in range(n):
+        o, z = offsets[i], size[i]
+        if not (-LIMIT < o < LIMIT and -LIMIT < z < LIMIT):
+            raise OverflowError("values past 62 bits")
+        if i == 0 or o + z > top:
+            top = o + z
+    return top
+
+
+def live_at(sec_lo, sec_hi, Py_ssize_t section):
+    """The blocks living in ``section``, ascending: ``[i for i, (lo, hi) in
+    enumerate(zip(sec_lo, sec_hi)) if lo <= section < hi]`` (``bounds.clique_bound``)."""
+    cdef Py_ssize_t n = len(sec_lo), i, lo, hi
+    cdef list out = []
+    if len(sec_hi) != n:
+        raise ValueError("inconsistent instance arrays")
+    for i in range(n):
+        lo, hi = sec_lo[i], sec_hi[i]
+        if lo <= section < hi:
+            out.append(i)
+    return out

@@ -78,7 +78,12 @@ def overlapping_pairs(blocks: Sequence[Block]) -> int:
 
 def too_dense(blocks: Sequence[Block], time_budget_s: float) -> bool:
     """Whether the offline greedy would overrun ``time_budget_s`` on ``blocks``."""
-    return overlapping_pairs(blocks) > max(MIN_GREEDY_PAIRS, time_budget_s * PAIRS_PER_SECOND)
+    return too_dense_pairs(overlapping_pairs(blocks), time_budget_s)
+
+
+def too_dense_pairs(pairs: int, time_budget_s: float) -> bool:
+    """``too_dense`` of blocks with ``pairs`` overlapping pairs (``overlapping_pairs``)."""
+    return pairs > max(MIN_GREEDY_PAIRS, time_budget_s * PAIRS_PER_SECOND)
 
 
 #: Bisection closes when the best peak is within this fraction of the highest capacity

@@ -46,10 +46,11 @@ def clique_bound(inst: Instance) -> int:
         return max(totals, default=0)
     busiest = totals.index(max(totals))  # the first busiest
     weight = totals[busiest]
-    members = [i for i, (lo, hi) in enumerate(zip(inst.sec_lo, inst.sec_hi, strict=True)) if lo <= busiest < hi]
     flat = None if greedy.NATIVE is None else greedy.native_flat(greedy.NATIVE, inst)
-    if flat is not None:  # the same growth, compiled (rgraph/memory/_fit.pyx)
+    if flat is not None:  # the same members and growth, compiled (rgraph/memory/_fit.pyx)
+        members = greedy.NATIVE.live_at(inst.sec_lo, inst.sec_hi, busiest)
         return weight + greedy.NATIVE.clique_extra(flat, members)  # type: ignore[no-any-return]
+    members = [i for i, (lo, hi) in enumerate(zip(inst.sec_lo, inst.sec_hi, strict=True)) if lo <= busiest < hi]
     return weight + _clique_extra(inst, members)
 
 

@@ -361,9 +361,22 @@ def _sorted_by(*columns: Sequence[int]) -> list[int]:
     return np.lexsort(keys).tolist()  # stable: ties keep index order
 
 
+#: The names of :func:`orderings`' orders, in turn.
+ORDERINGS = ("size", "area", "length", "start", "contention", "contention_size")
+
+
 def orderings(inst: Instance) -> Iterator[tuple[str, list[int]]]:
     """The static orderings tried by the heuristic, in turn (all deterministic, ties by
-    index); each is sorted only when asked for, so a caller that stops early pays less."""
+    index); each is sorted only when asked for, so a caller that stops early pays less.
+    Compiled where built (``_fit.orderings``: all six at once, cheaper than one numpy sort)."""
+    if NATIVE is not None and inst.n:
+        try:
+            orders = NATIVE.orderings(inst.start, inst.end, inst.size, inst.sec_lo, inst.sec_hi, inst._totals)
+        except OverflowError:  # keys past 62 bits
+            pass
+        else:
+            yield from zip(ORDERINGS, orders, strict=True)
+            return
     keys = inst.order_keys
     if keys is None:  # keys past 63 bits
         yield from _orderings_python(inst)

@@ -153,8 +153,17 @@ class Instance:
         """``conflicts``: pairs of block names that may not share bytes although they are
         apart in time (symmetric), added to ``neighbors``."""
         blocks = list(blocks)
-        start = [b.start for b in blocks]
-        end = [b.end for b in blocks]
+        arrays = None
+        if _NATIVE is not None:
+            try:  # the lists, the sections and their totals, compiled
+                arrays = _NATIVE.class_arrays(blocks)
+            except OverflowError:  # past 62 bits
+                pass
+        if arrays is None:
+            start = [b.start for b in blocks]
+            end = [b.end for b in blocks]
+        else:
+            start, end = arrays[0], arrays[1]
         adjacency, rows, separable = None, None, True
         if len(blocks) < SWEEP_FROM and _NATIVE is not None:
             try:  # the same matrix, compiled
@@ -163,6 +172,13 @@ class Instance:
                 pass
         if adjacency is None:
             adjacency, rows, separable = _conflict_graph(blocks, start, end, conflicts)
+        if arrays is not None:
+            _, _, size, align, sec_lo, sec_hi, section_count, totals = arrays
+            inst = cls(blocks=blocks, start=start, end=end, size=size, align=align, sec_lo=sec_lo,
+                       sec_hi=sec_hi, section_count=section_count, separable=separable,
+                       adjacency=adjacency, rows=rows)
+            inst.__dict__["_totals"] = totals  # the cached property, already computed
+            return inst
         sec_lo, sec_hi, section_count = sections(start, end)
         return cls(
             blocks=blocks,
@@ -289,5 +305,10 @@ class Instance:
         return max(self.section_totals(), default=0)
 
     def peak(self, offsets: Sequence[int]) -> int:
-        """The highest top of ``offsets`` (one per block)."""
+        """The highest top of ``offsets`` (one per block); compiled where built."""
+        if _NATIVE is not None and len(offsets) == self.n:
+            try:
+                return _NATIVE.peak(offsets, self.size)  # type: ignore[no-any-return]
+            except OverflowError:  # past 62 bits
+                pass
         return max(map(add, offsets, self.size), default=0)

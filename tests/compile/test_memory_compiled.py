@@ -53,3 +53,35 @@ def test_requirements_read_the_provider_memos_by_its_keys(tmp_path: Path, monkey
     monkeypatch.setattr(provider, "buffer", no_call)
     native = memory.NATIVE.requirements(spec.resources, used, spec.outputs, provider, memory._SAME_BUFFER_FLAG)
     assert native == python and list(native) == list(python)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_place_resources_compiled_loops_match_python(seed: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``place_resources`` with the compiled ``split`` and ``dedicated`` against the Python
+    loops: the same offsets, heaps and stats, on random resources (transients, outputs,
+    persistent ones, names out of order, and none left to alias at all on seed 0)."""
+    import random
+    from types import SimpleNamespace
+
+    rng = random.Random(seed)
+    names = [f"r{k}" for k in rng.sample(range(100), 40)]
+    lifetimes = ["persistent"] if seed == 0 else ["transient", "transient", "persistent", "output", "imported"]
+    resources = {n: SimpleNamespace(lifetime=rng.choice(lifetimes)) for n in names}
+    mem = {}
+    for n in names:
+        first = rng.randrange(20)
+        mem[n] = memory.ResourceMemory(rng.randrange(1, 1 << 20), rng.choice([1, 256, 65536]), 7,
+                                       rng.choice(["device_local_optimal", "device_local_linear"]), (),
+                                       first, first + rng.randrange(5))
+    outputs = rng.sample(names, 5)
+    aliasable, rest = memory.NATIVE.split(resources, mem, outputs)
+    assert aliasable == [n for n in sorted(mem) if resources[n].lifetime == "transient" and n not in outputs]
+    assert rest == sorted(set(mem) - set(aliasable))
+    native = memory.place_resources(resources, mem, "aliased", outputs)
+    monkeypatch.setattr(memory, "NATIVE", None)
+    python = memory.place_resources(resources, mem, "aliased", outputs)
+    assert native.offsets == python.offsets and list(native.offsets) == list(python.offsets)
+    assert native.heaps == python.heaps
+    assert native.stats.peak_bytes == python.stats.peak_bytes
+    assert native.stats.allocations == python.stats.allocations
+    assert native.stats.lower_bound_bytes == python.stats.lower_bound_bytes

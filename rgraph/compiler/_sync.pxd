@@ -28,6 +28,3 @@ cdef _gather(list bars, list rels, list waits, passes, dict final, dict initial)
 
 @cython.locals(end=Py_ssize_t, last=Py_ssize_t, stages=set, access=set)
 cdef tuple _group(list uses, Py_ssize_t k, layout, queue)
-
-cdef tuple _walk_cell(list uses, bint image, tuple start, tuple aliases, tuple alias_waits, bint last_prev, sink, c,
-                      sub)

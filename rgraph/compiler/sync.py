@@ -41,8 +41,8 @@ __all__ = ["EMPTY", "StateKey", "SyncResult", "synchronize"]
 PERSISTENT = ("persistent", "imported")
 EMPTY2 = (EMPTY, EMPTY)
 _new_wait = builder(pm.Wait)
-#: The compiled cell walk (``rgraph/compiler/_sync_walk.pyx``: the cell's state in C locals), None
-#: where it is not built or ``RGRAPH_NATIVE=0``.
+#: This phase compiled as a whole (``rgraph/compiler/_sync_walk.pyx``: ``synchronize``; the cell's
+#: state in a C struct), None where it is not built or ``RGRAPH_NATIVE=0``.
 _WALK = load("rgraph.compiler._sync_walk")
 #: A transient with nothing aliased before it starts in this layout and plan state (an image, a buffer).
 _START_IMAGE = ("UNDEFINED", plan_state((EMPTY, EMPTY, "UNDEFINED", None)))
@@ -117,11 +117,11 @@ def synchronize(
                 write = (stages, access) if stages or access else None
                 first = _state((layout, queue, write, None, last, EMPTY2))
                 initial[name] = get_state(first) or plan_state(first)
-                end = _walk_cell(uses, image, (layout, queue, write, None, last, EMPTY2), aliases, alias_waits, False,
+                end = _walk(uses, image, (layout, queue, write, None, last, EMPTY2), aliases, alias_waits, False,
                                  one_sink, c, sub)
             else:
                 layout, initial[name] = fresh[image]
-                end = _walk_cell(uses, image, (layout, None, None, None, None, EMPTY2), (), (), False, one_sink, c, sub)
+                end = _walk(uses, image, (layout, None, None, None, None, EMPTY2), (), (), False, one_sink, c, sub)
             st = _state(end)
             final[name] = get_state(st) or plan_state(st)
             if name in wanted:
@@ -143,11 +143,11 @@ def synchronize(
         sink = (bars, rels, waits, multi)
         if lifetime in PERSISTENT:  # frame 1 from scratch gives the end state frame 2 starts in
             for c, uses in cells:
-                lay, queue, write, reads, last, visible = _walk_cell(uses, image, (layout, None, None, None, None, EMPTY2),
+                lay, queue, write, reads, last, visible = _walk(uses, image, (layout, None, None, None, None, EMPTY2),
                                                                      (), (), False, None, c, None)
                 start = (lay, queue, write, reads, last, visible)
                 starts[c] = _state(start)
-                end = _walk_cell(uses, image, start, (), (), True, sink, c, sub)
+                end = _walk(uses, image, start, (), (), True, sink, c, sub)
                 finals[c] = st = _state(end)
                 if kept is not None:
                     kept.append((st, end[4]))
@@ -163,7 +163,7 @@ def synchronize(
             for c, uses in cells:
                 start = (layout, queue, write, None, last, EMPTY2)
                 starts[c] = first_state
-                end = _walk_cell(uses, image, start, aliases, alias_waits, False, sink, c, sub)
+                end = _walk(uses, image, start, aliases, alias_waits, False, sink, c, sub)
                 finals[c] = st = _state(end)
                 if kept is not None:
                     kept.append((st, end[4]))
@@ -201,17 +201,6 @@ def _state(end: CellEnd) -> StateKey:
     if write:
         return (write[0], write[1], layout, queue)
     return (EMPTY, EMPTY, layout, queue)
-
-
-def _walk_cell(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...],
-               alias_waits: tuple[tuple[str, int], ...], last_prev: bool, sink: Sink | None, c: Cell,
-               sub: pm.Subresource | None) -> CellEnd:
-    """``_walk``, compiled where built (``_WALK``; it declines name sets past its masks)."""
-    if _WALK is not None:
-        end = _WALK.walk(uses, image, start, aliases, alias_waits, last_prev, sink, c, sub)
-        if end is not None:
-            return end
-    return _walk(uses, image, start, aliases, alias_waits, last_prev, sink, c, sub)
 
 
 def _walk(uses: list[Use], image: bool, start: CellEnd, aliases: tuple[str, ...],

@@ -154,33 +154,6 @@ def test_compiles_in_threads_give_the_same_plan(tmp_path: Path) -> None:
     assert len(results) == 12 and all(r == expected for r in results)
 
 
-def test_a_walk_started_during_a_walk_hands_its_cell_to_python(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """A second compiled walk while one runs (from another thread, or reentered through the
-    Python calls it makes) declines (None: the caller runs the Python walk), so the tables the
-    running walk points into are never reset under it; the plan stays the same."""
-    from rgraph.compiler import sync as sync_module
-
-    walk_module = sync_module._WALK
-    start = ("GENERAL", None, None, None, None, (frozenset(), frozenset()))
-    assert walk_module.walk([], True, start, (), (), False, None, ("r", 0, 0), None) == start  # not busy
-    inner: list[object] = []
-    make_barrier = walk_module.make_barrier
-
-    def reentering(*fields):  # called by the walk for each barrier of a one-cell resource
-        inner.append(walk_module.walk([], True, start, (), (), False, None, ("r", 0, 0), None))
-        return make_barrier(*fields)
-
-    path = tmp_path / "g.yaml"
-    path.write_text(to_yaml(random_graph(seed=12, passes=80)))
-    spec = frontend(path, size=(16, 16)).spec
-    expected = dump(compile_plan(spec))
-    monkeypatch.setattr(walk_module, "make_barrier", reentering)
-    # the cell walk runs where the whole compiled phase declines (tests/compile/test_sync_compiled.py)
-    monkeypatch.setattr(walk_module, "synchronize", lambda *args: None)
-    assert dump(compile_plan(spec)) == expected
-    assert inner and all(found is None for found in inner)
-
-
 def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
     """The compiled trace walk finds each access's scope and subresource by the access object
     (``_trace.pyx``'s table), keyed also by its pass's kind and its resource's format code:

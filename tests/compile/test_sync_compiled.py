@@ -116,3 +116,42 @@ def test_a_synchronize_started_during_one_declines(tmp_path: Path, monkeypatch: 
     monkeypatch.setattr(WHOLE, "synchronize", lambda *a: None)
     assert phases.SYNC_NATIVE is not None  # the twin
     assert dump(compile_plan(spec)) == expected
+
+
+def depth_reads_yaml(count: int) -> str:
+    """``count - 1`` passes each reading a depth image as depth_read and sampled at once: each
+    pass's use of it is a merged scope, a new object for the compiled phase's scope table."""
+    lines = ["rgraph: 1", f"name: depth_reads_{count}", "resources:", "  acc: {kind: buffer, bytes: 256}",
+             "  d: {kind: image, format: d32_sfloat, size: output}", "passes:",
+             "  p0: {kind: raster, writes: {acc: storage_write, d: depth_attachment}}"]
+    lines += [f"  p{i}: {{kind: raster, reads: {{d: [depth_read, sampled]}}, writes: {{acc: storage_rw}}}}"
+              for i in range(1, count)]
+    return "\n".join(lines + ["outputs: [acc]"]) + "\n"
+
+
+def test_a_full_scope_table_retries_from_empty_tables(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """1,500 merged scopes (the next phase then starts from empty tables), 800, then 1,500 again:
+    that last phase starts with the table 800 full and fills it past half; it then runs once
+    more from empty tables (not the twin) and gives the Python reference's result."""
+    class NoTwin:
+        @staticmethod
+        def synchronize(*args):
+            raise AssertionError("the compiled phase declined")
+
+    calls: list[int] = []
+    handoffs = WHOLE.with_partial_handoffs
+
+    def counting(*args):  # called once per run of the compiled phase
+        calls.append(1)
+        return handoffs(*args)
+
+    monkeypatch.setattr(phases, "SYNC_NATIVE", NoTwin)
+    monkeypatch.setattr(WHOLE, "with_partial_handoffs", counting)
+    for count, runs in ((1500, None), (800, 1), (1500, 2)):
+        path = tmp_path / f"g{count}.yaml"
+        path.write_text(depth_reads_yaml(count))
+        c = compilation(frontend(path, size=(16, 16)).spec)
+        assert runs is None or len(calls) == runs, count
+        calls.clear()
+        same(*both(c))
+        calls.clear()

@@ -178,7 +178,7 @@ from rgraph.plan.builders import builder
 include "../plan/_slots.pxi"
 
 cdef Slots BARRIER = Slots(pm.Barrier, ("resource", "subresource", "src", "dst", "aliases"))
-_new_wait = builder(pm.Wait)
+cdef Slots WAIT = Slots(pm.Wait, ("queue", "value", "stages"))  # ``device``: its default
 _new_cell_state = builder(pm.CellState)
 
 
@@ -946,6 +946,15 @@ cdef object _stage_names(u64 m):
     return found
 
 
+cdef object _wait(queue, value, stages):
+    """``pm.Wait(queue, value, stages)``."""
+    w = new_slots(WAIT)
+    put(w, WAIT, 0, queue)
+    put(w, WAIT, 1, value)
+    put(w, WAIT, 2, stages)
+    return w
+
+
 cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     """``sync._gather``."""
     cdef Py_ssize_t count = sink.count, i
@@ -963,7 +972,7 @@ cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     for i in range(count):
         found = waits[i]
         if found is not None:
-            pass_waits[i] = tuple([_new_wait(q, values[<Py_ssize_t> jm[0]], _stage_names(<u64> jm[1]))
+            pass_waits[i] = tuple([_wait(q, values[<Py_ssize_t> jm[0]], _stage_names(<u64> jm[1]))
                                    for q, jm in sorted(found.items())])
     return SyncResult(_bars_by_pass(sink), _rels_by_pass(sink), pass_waits, signals, values, final, initial)
 

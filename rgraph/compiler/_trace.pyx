@@ -364,18 +364,16 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                         r.cur.append((oi, j))
                         if not r.mixed and layout is not r.lay0 and layout != r.lay0:
                             r.mixed = True
-            if known != NULL:
-                cs = <tuple> cur.cells
-            else:
-                cs = access_field(accs[j], 9, "cells")
             if r.single:  # most resources: the one cell's uses without a lookup by cell
                 cells = r.cells
-                if not cells:
+                if not cells:  # (the cells tuple is read only here: it is cold)
+                    cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
                     cells.append((cs[0], [(oi, s, w, queue, pos)]))
                     pos += 1
                     continue
                 pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
                 continue
+            cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
             for c in cs:
                 found = timeline.get(c)
                 if found is None:

@@ -271,12 +271,8 @@ def plain(spec, list passes, frozenset rw, culled_class):
                 acc = &t.accs[k]
                 acc.res = res
                 acc.write = access_field(a, 2, "write")
-                cells = access_field(a, 9, "cells")
-                acc.cells = <PyObject *> cells
-                if type(a) is not ACCESS_SPEC:  # (an AccessSpec's stays in its slot)
-                    held.append(cells)
                 fl = t.flags[res]
-                if fl & _SINGLE:
+                if fl & _SINGLE:  # (its cells are not read: a cold tuple)
                     if not acc.write:
                         continue
                     st = t.state[t.base[res]]
@@ -287,6 +283,10 @@ def plain(spec, list passes, frozenset rw, culled_class):
                     elif not live and (st & _WANTED):
                         live = True
                     continue
+                cells = access_field(a, 9, "cells")
+                acc.cells = <PyObject *> cells
+                if type(a) is not ACCESS_SPEC:  # (an AccessSpec's stays in its slot)
+                    held.append(cells)
                 for c in <tuple> cells:  # checked here once: the second loop trusts them
                     slot = _cell(&t, res, name, c)
                     if slot < 0:

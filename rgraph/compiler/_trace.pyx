@@ -25,74 +25,124 @@ cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "co
 cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared, never replaced)
 
 
-# ---- each access's scope and subresource, by the access's identity ------------------------
-# An ``AccessSpec`` is frozen: its scope (``trace._SCOPES`` by (usage, kind, stages, code,
-# refit)) and its subresource (by (mips, layers)) depend only on it, its pass's kind and its
-# resource's format code. Those lookups hash nested tuples at every access of every compile;
-# this table finds them by pointers instead (each object kept alive while listed, so no
-# pointer is reused). The values are the ones the lookups give (equal ones, where those
-# tables were cleared since): the walk's results do not change.
+# ---- each pass's accesses, by the pass's identity --------------------------------------------
+# A ``PassSpec`` is frozen, and so are its ``AccessSpec``s: its queue, kind and accesses, and
+# each access's fields, scope (``trace._SCOPES`` by (usage, kind, stages, code, refit)) and
+# subresource (by (mips, layers)) depend only on it and on its resource's format code. The
+# walk meets the same passes at every compile of a graph: this table finds them by the pass's
+# pointer, one probe per pass, with each access's fields read once, at the pass's first walk,
+# into a C array (``_Acc``); later walks read those instead of the cold ``AccessSpec``s and
+# look up no scope. Each object is kept alive while listed (``_table_keep``), so no pointer
+# is reused; a scope is used only where its resource's format code is the one it was found
+# for (else found again). The values are the ones the lookups give (equal ones, where those
+# tables were cleared since): the walk's results do not change. The table is emptied at a
+# walk's start once half full, and only when no other walk (another thread's) is under way:
+# while one is, what the table points at stays.
+
+from libc.stdlib cimport malloc, free
+from cpython.exc cimport PyErr_Clear, PyErr_Occurred
+from cpython.long cimport PyLong_AsLong
 
 cdef enum:
-    _ACCESS_CAP = 8192  # table slots (power of two); at most half used, then emptied at a walk's start
+    _TABLE_CAP = 4096  # table slots (power of two): at most half used
+    _MAX_CACHED = 64  # passes of more accesses are not listed
 
-cdef struct AccessSlot:
+cdef struct _Acc:
     PyObject *access
-    PyObject *kind
-    long code
-    PyObject *scope  # tuple: trace._SCOPES' value
+    PyObject *name
+    PyObject *usage
+    PyObject *write
+    PyObject *cells  # tuple
+    PyObject *mips
+    PyObject *layers
+    PyObject *scope  # tuple: trace._SCOPES' value, for ``code``
     PyObject *sub  # pm.Subresource or None
+    long code
+    bint w  # ``write``'s truth
+    bint ranges  # mips and layers are pairs of ints, (mlo, mhi) and (llo, lhi)
+    long mlo, mhi, llo, lhi
 
-cdef AccessSlot _accesses[_ACCESS_CAP]
-cdef Py_ssize_t _access_count = 0
-cdef list _access_keep = []  # what the table points at
+cdef struct PassSlot:
+    PyObject *pass_
+    PyObject *queue
+    PyObject *kind
+    PyObject *accesses  # tuple
+    Py_ssize_t n
+    _Acc *accs
+
+cdef PassSlot _passes[_TABLE_CAP]
+cdef Py_ssize_t _pass_count = 0
+cdef Py_ssize_t _walking = 0  # walks under way (threads)
+cdef list _table_keep = []  # what the table points at
 
 
-cdef inline size_t _access_home(PyObject *a, PyObject *kind, long code):
-    return ((<size_t> a >> 4) ^ ((<size_t> kind >> 4) * 31) ^ (<size_t> code * 0x9E37)) & (_ACCESS_CAP - 1)
-
-
-cdef inline AccessSlot *_access_find(object a, object kind, long code):
-    """The table's slot of (``a``, ``kind``, ``code``), or NULL."""
-    cdef size_t h = _access_home(<PyObject *> a, <PyObject *> kind, code)
-    while _accesses[h].access != NULL:
-        if (_accesses[h].access == <PyObject *> a and _accesses[h].kind == <PyObject *> kind
-                and _accesses[h].code == code):
-            return &_accesses[h]
-        h = (h + 1) & (_ACCESS_CAP - 1)
+cdef inline PassSlot *_pass_find(object p):
+    """The table's slot of pass ``p``, or NULL."""
+    cdef size_t h = (<size_t> <PyObject *> p >> 4) & (_TABLE_CAP - 1)
+    while _passes[h].pass_ != NULL:
+        if _passes[h].pass_ == <PyObject *> p:
+            return &_passes[h]
+        h = (h + 1) & (_TABLE_CAP - 1)
     return NULL
 
 
-cdef inline void _access_add(object a, object kind, long code, tuple scope, object sub):
-    """Remember ``a``'s scope and subresource (not once the table is half full)."""
-    global _access_count
-    if _access_count >= _ACCESS_CAP // 2:
+cdef void _pass_add(object p, object queue, object kind, object accesses, Py_ssize_t n, _Acc *accs):
+    """List pass ``p`` with a copy of its accesses' ``accs`` (not once the table is half full,
+    nor where it is listed already: another thread's walk may have listed it meanwhile)."""
+    global _pass_count
+    cdef Py_ssize_t k
+    if _pass_count >= _TABLE_CAP // 2 or _pass_find(p) != NULL:
         return
-    cdef size_t h = _access_home(<PyObject *> a, <PyObject *> kind, code)
-    while _accesses[h].access != NULL:
-        h = (h + 1) & (_ACCESS_CAP - 1)
-    _access_keep.append(a)
-    _access_keep.append(kind)
-    _access_keep.append(scope)
-    _access_keep.append(sub)
-    _accesses[h].access = <PyObject *> a
-    _accesses[h].kind = <PyObject *> kind
-    _accesses[h].code = code
-    _accesses[h].scope = <PyObject *> scope
-    _accesses[h].sub = <PyObject *> sub
-    _access_count += 1
+    cdef _Acc *copy = <_Acc *> malloc(n * sizeof(_Acc) + 1)
+    if copy == NULL:
+        return
+    cdef size_t h = (<size_t> <PyObject *> p >> 4) & (_TABLE_CAP - 1)
+    while _passes[h].pass_ != NULL:
+        h = (h + 1) & (_TABLE_CAP - 1)
+    _table_keep.append(p)  # holds its queue, kind, accesses and their fields
+    for k in range(n):
+        copy[k] = accs[k]
+        _table_keep.append(<object> accs[k].scope)
+        _table_keep.append(<object> accs[k].sub)
+    _passes[h].pass_ = <PyObject *> p
+    _passes[h].queue = <PyObject *> queue
+    _passes[h].kind = <PyObject *> kind
+    _passes[h].accesses = <PyObject *> accesses
+    _passes[h].n = n
+    _passes[h].accs = copy
+    _pass_count += 1
 
 
-cdef void _access_reset():
-    global _access_count
-    memset(_accesses, 0, sizeof(_accesses))
-    _access_count = 0
-    _access_keep.clear()
+cdef void _table_reset():
+    global _pass_count
+    cdef Py_ssize_t h
+    for h in range(_TABLE_CAP):
+        if _passes[h].pass_ != NULL:
+            free(_passes[h].accs)
+    memset(_passes, 0, sizeof(_passes))
+    _pass_count = 0
+    _table_keep.clear()
 
 
 def reset_access_table():
     """Empty the table (tests: a walk that fills it afresh gives the same results)."""
-    _access_reset()
+    if _walking == 0:
+        _table_reset()
+
+
+cdef inline bint _pair(object t, long *lo, long *hi):
+    """Whether ``t`` is a pair of ints (within a C long): then ``lo``, ``hi``."""
+    if type(t) is not tuple or len(<tuple> t) != 2:
+        return False
+    a, b = (<tuple> t)[0], (<tuple> t)[1]
+    if type(a) is not int or type(b) is not int:
+        return False
+    lo[0] = PyLong_AsLong(a)
+    hi[0] = PyLong_AsLong(b)
+    if (lo[0] == -1 or hi[0] == -1) and PyErr_Occurred():
+        PyErr_Clear()
+        return False
+    return True
 
 
 cdef class _Res:
@@ -112,6 +162,9 @@ cdef class _Res:
     cdef bint mixed  # another layout among them
     cdef bint single
     cdef object mips, layers  # read-group candidates: (0, mips), (0, layers)
+    cdef bint cranges  # and those as C longs: (0, cm), (0, cl)
+    cdef long cm, cl
+    cdef object last_usage  # the usage added last to ``usages``
 
 
 cdef inline void _close(_Res r):
@@ -127,26 +180,50 @@ cdef inline void _close(_Res r):
         r.mixed = False
 
 
+from rgraph.spec.specialize import ResourceSpec
+
+cdef object RESOURCE_SPEC = ResourceSpec
+#: Field positions: name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6 (every field
+#: named: only read, never built here).
+cdef Slots RES = Slots(ResourceSpec, tuple(f.name for f in _dataclasses.fields(ResourceSpec)))
+if tuple(f.name for f in _dataclasses.fields(ResourceSpec))[:7] != (
+        "name", "kind", "lifetime", "format", "extent", "layers", "mips"):
+    raise TypeError("ResourceSpec: fields name, kind, lifetime, format, extent, layers, mips expected first")
+
+
+cdef inline object res_field(object r, Py_ssize_t k, str name):
+    """Field ``k`` (named ``name``) of resource ``r``."""
+    if type(r) is RESOURCE_SPEC:
+        return get(r, RES, k)
+    return getattr(r, name)
+
+
 cdef _Res _start(res, Py_ssize_t i, usage):
     """``trace._start``: a resource's trace at its first use."""
     cdef _Res r = _Res.__new__(_Res)
-    cdef bint image = res.kind == "image", depth = False, stencil = False
-    fmt = res.format
+    cdef bint image = res_field(res, 1, "kind") == "image", depth = False, stencil = False
+    cdef long lo
+    fmt = res_field(res, 3, "format")
     if fmt is not None:
         depth, stencil = bool(fmt.has_depth), bool(fmt.has_stencil)
     r.usages = {usage}
+    r.last_usage = usage
     r.first = r.last = i
     r.cells = []
     r.icode = image + 2 * depth + 4 * stencil
     r.code = r.icode
-    if image and res.lifetime == "transient" and fmt is not None and not depth and not stencil:
+    mips = layers = None  # (read for images only, as trace._start does)
+    if image:
+        mips, layers = res_field(res, 6, "mips"), res_field(res, 5, "layers")
+    if image and res_field(res, 2, "lifetime") == "transient" and fmt is not None and not depth and not stencil:
         r.group = []
         r.candidate = True
-        r.mips, r.layers = (0, res.mips), (0, res.layers)
+        r.mips, r.layers = (0, mips), (0, layers)
+        r.cranges = _pair(r.mips, &lo, &r.cm) and _pair(r.layers, &lo, &r.cl)
     else:
         r.group = None
         r.candidate = False
-    r.single = not image or res.mips * res.layers == 1
+    r.single = not image or mips * layers == 1
     return r
 
 
@@ -179,47 +256,81 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
     filler (``trace._scope``). With a list ``moved``: no read-group candidates in the traces
     (``group`` None); ``moved`` gets ``read_layouts.to_general`` of them instead, found during
     the walk (no tuple per candidate access)."""
+    global _walking
+    if _pass_count >= _TABLE_CAP // 2 and _walking == 0:
+        _table_reset()
+    _walking += 1
+    try:
+        return _walk(passes, resources, scopes, scope_of, moved)
+    finally:
+        _walking -= 1
+
+
+cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
     cdef bint keep_groups = moved is None
     cdef list plan_accesses = [], uses, cells
     cdef tuple values, accs
     cdef dict info = {}, timeline = {}, waits = {}
-    cdef Py_ssize_t i = -1, j, pos
-    cdef bint raytrace, exact
-    cdef AccessSlot *slot
+    cdef list pending = []  # the scopes and subresources of ``fresh``
+    cdef Py_ssize_t i = -1, j, n, pos
+    cdef bint raytrace, whole, listing
+    cdef PassSlot *slot
+    cdef _Acc *known  # the listed pass's accesses
+    cdef _Acc fresh[_MAX_CACHED]  # an unlisted pass's, to list it
+    cdef _Acc cur
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value
-    if _access_count >= _ACCESS_CAP // 2:
-        _access_reset()
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, a
     for p in passes:
         i += 1
         oi = i
-        queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
+        slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
+        if slot != NULL:
+            queue, kind, accs = <object> slot.queue, <object> slot.kind, <tuple> slot.accesses
+            known = slot.accs
+            listing = False
+        else:
+            queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
+            accs = <tuple> pass_field(p, 7, "accesses")
+            known = NULL
+            listing = type(p) is PASS_SPEC and len(accs) <= _MAX_CACHED
+            if pending:
+                pending.clear()
         raytrace = kind == "raytrace"
-        accs = <tuple> pass_field(p, 7, "accesses")
-        values = PyTuple_New(len(accs))  # the plan's tuple (emit keeps it)
+        n = len(accs)
+        values = PyTuple_New(n)  # the plan's tuple (emit keeps it)
         pos = 0
-        j = -1
-        for a in accs:
-            j += 1
-            exact = type(a) is ACCESS_SPEC  # frozen: its scope and subresource are in the table
-            # (the other fields are read where needed: each read touches its object)
-            name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
+        for j in range(n):
+            if known != NULL:
+                cur = known[j]
+                name, usage, w = <object> cur.name, <object> cur.usage, <object> cur.write
+            else:
+                a = accs[j]
+                if listing and type(a) is not ACCESS_SPEC:  # only AccessSpecs are frozen
+                    listing = False
+                name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
+                cur.access = <PyObject *> a
+                cur.name, cur.usage, cur.write = <PyObject *> name, <PyObject *> usage, <PyObject *> w
+                cur.w = w
+                cur.scope = NULL
             found = info.get(name)
             if found is None:
                 r = _start(resources[name], i, usage)
                 info[name] = r
             else:
                 r = <_Res> found
-                r.usages.add(usage)
+                if usage is not r.last_usage:
+                    r.usages.add(usage)
+                    r.last_usage = usage
                 r.last = i
             if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 r.usages.add("trace_indirect")
-            slot = _access_find(a, kind, r.icode) if exact else NULL
-            if slot != NULL:
-                scope = <tuple> slot.scope
-                sub = <object> slot.sub
+                r.last_usage = None
+            if cur.scope != NULL and cur.code == r.icode:  # listed, for this format code
+                scope = <tuple> cur.scope
+                sub = <object> cur.sub
             else:
+                a = accs[j]
                 key = (usage, kind, access_field(a, 5, "stages"), r.code, access_field(a, 8, "refit"))
                 found = scopes.get(key)
                 scope = <tuple> (scope_of(key) if found is None else found)
@@ -230,8 +341,15 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
                     sub = SUBRESOURCES.get((mips, layers))
                     if sub is None:
                         sub = subresource(mips, layers)
-                if exact:
-                    _access_add(a, kind, r.icode, scope, sub)
+                if listing:
+                    cells = None
+                    c = access_field(a, 9, "cells")
+                    cur.cells, cur.mips, cur.layers = <PyObject *> c, <PyObject *> mips, <PyObject *> layers
+                    cur.ranges = _pair(mips, &cur.mlo, &cur.mhi) and _pair(layers, &cur.llo, &cur.lhi)
+                    cur.scope, cur.sub, cur.code = <PyObject *> scope, <PyObject *> sub, r.icode
+                    fresh[j] = cur
+                    pending.append(scope)  # (the caches may drop them before the pass is listed)
+                    pending.append(sub)
             s = scope[0]
             layout = scope[3]
             value = new_slots(ACCESS)
@@ -245,13 +363,19 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
             Py_INCREF(value)
             PyTuple_SET_ITEM(values, j, value)
             if r.candidate:
-                if access_field(a, 3, "mips") != r.mips or access_field(a, 4, "layers") != r.layers:
-                    # not the whole image: never unified
+                if known != NULL and cur.ranges and r.cranges:
+                    whole = cur.mlo == 0 and cur.mhi == r.cm and cur.llo == 0 and cur.lhi == r.cl
+                elif known != NULL:
+                    whole = not (<object> cur.mips != r.mips or <object> cur.layers != r.layers)
+                else:
+                    a = accs[j]
+                    whole = not (access_field(a, 3, "mips") != r.mips or access_field(a, 4, "layers") != r.layers)
+                if not whole:  # not the whole image: never unified
                     r.group = None
                     r.candidate = False
                 elif keep_groups:
                     r.group.append((oi, j, w, usage, layout))
-                elif w:
+                elif cur.w:
                     _close(r)
                 elif usage in GENERAL_READS:
                     if r.cur is None:
@@ -263,13 +387,14 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
                             r.mixed = True
             if r.single:  # most resources: the one cell's uses without a lookup by cell
                 cells = r.cells
-                if not cells:
-                    cells.append(((<tuple> access_field(a, 9, "cells"))[0], [(oi, s, w, queue, pos)]))
+                if not cells:  # (the cells tuple is read only here: it is cold)
+                    cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
+                    cells.append((cs[0], [(oi, s, w, queue, pos)]))
                     pos += 1
                     continue
                 pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
                 continue
-            cs = access_field(a, 9, "cells")
+            cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
             for c in cs:
                 found = timeline.get(c)
                 if found is None:
@@ -279,6 +404,8 @@ def walk(passes, resources, dict scopes, scope_of, list moved=None):
                     pos += 1
                     continue
                 pos += _add_use(<list> found, i, oi, s, w, queue, pos, waits)
+        if listing:
+            _pass_add(p, queue, kind, accs, n, fresh)
         plan_accesses.append(values)
     traced = {}
     for name, found in info.items():
@@ -305,24 +432,32 @@ from dataclasses import replace as _replace
 
 
 cdef list _row(p, dict info, dict scopes, scope_of):
-    """``trace._row``: the scope of each access of ``p`` (from the access table where listed)."""
+    """``trace._row``: the scope of each access of ``p`` (from the pass table where listed;
+    counted as a walk meanwhile, so no other thread empties the table)."""
+    global _walking
     cdef list out = []
-    cdef AccessSlot *slot
+    cdef PassSlot *slot
+    cdef Py_ssize_t j = -1
     cdef long code
-    kind = pass_field(p, 2, "kind")
-    for a in <tuple> pass_field(p, 7, "accesses"):
-        code_obj = info[access_field(a, 0, "resource")].code
-        slot = NULL
-        if type(a) is ACCESS_SPEC:
-            code = code_obj
-            slot = _access_find(a, kind, code)
-        if slot != NULL:
-            out.append((<tuple> slot.scope)[0])
-            continue
-        key = (access_field(a, 1, "usage"), kind, access_field(a, 5, "stages"), code_obj, access_field(a, 8, "refit"))
-        found = scopes.get(key)
-        out.append((<tuple> (scope_of(key) if found is None else found))[0])
-    return out
+    _walking += 1
+    try:
+        slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
+        kind = pass_field(p, 2, "kind")
+        for a in <tuple> pass_field(p, 7, "accesses"):
+            j += 1
+            code_obj = info[access_field(a, 0, "resource")].code
+            if slot != NULL:
+                code = code_obj
+                if slot.accs[j].code == code:
+                    out.append((<tuple> slot.accs[j].scope)[0])
+                    continue
+            key = (access_field(a, 1, "usage"), kind, access_field(a, 5, "stages"), code_obj,
+                   access_field(a, 8, "refit"))
+            found = scopes.get(key)
+            out.append((<tuple> (scope_of(key) if found is None else found))[0])
+        return out
+    finally:
+        _walking -= 1
 
 
 def patch(passes, list plan_accesses, dict info, dict timeline, list moved, dict scopes, scope_of):

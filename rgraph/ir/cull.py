@@ -54,6 +54,12 @@ class Culling:
 
 
 def cull(spec: Spec) -> Culling:
+    if not spec.removed:  # the common case in one walk, unless a read is optional
+        found = _plain(spec, spec.passes)
+        if found is not None:
+            final, unreached = found
+            check_empty(spec, final)
+            return Culling(final, unreached, [])
     removed_reason = dict(spec.removed)
     culled = [Culled(name, reason) for name, reason in spec.removed]
     kept, dropped, cascade = _drop_unproduced_reads(spec, removed_reason)
@@ -74,6 +80,19 @@ def _alive(spec: Spec, kept: list[PassSpec]) -> set[str]:
     if NATIVE is None:
         return _alive_python(spec, kept)
     return NATIVE.alive(spec, kept, READ_WRITE_USAGES)
+
+
+def _plain(spec: Spec, passes: list[PassSpec]) -> tuple[list[PassSpec], list[Culled]] | None:
+    """``_split(passes, _alive(spec, passes))`` where no access of ``passes`` is optional (so,
+    with no pass removed by the scene, ``_drop_unproduced_reads`` keeps ``passes`` as they are),
+    else None. Compiled where built (``NATIVE.plain``: one backwards walk that also looks for
+    an optional access, the cells of each resource numbered in C arrays instead of sets; None
+    also where a resource or a cell does not fit those, and the general path runs)."""
+    if NATIVE is not None:
+        return NATIVE.plain(spec, passes, READ_WRITE_USAGES, Culled)
+    if _has_optional_python(passes):
+        return None
+    return _split(passes, _alive_python(spec, passes))
 
 
 def _split(kept: list[PassSpec], alive: set[str]) -> tuple[list[PassSpec], list[Culled]]:

@@ -203,6 +203,61 @@ def test_the_optional_scan_agrees(tmp_path: Path) -> None:
         assert cull._has_optional_python(ps) is expected
 
 
+#: Mips and layers: cells of several-cell resources numbered in ``plain``'s tables.
+CELLS_GRAPH = """rgraph: 1
+name: cells
+resources:
+  out: {kind: image, format: r8g8b8a8_unorm, size: [16, 16], mips: 2, layers: 3}
+  tmp: {kind: image, format: r8g8b8a8_unorm, size: [16, 16], mips: 3, layers: 2}
+  hist: {kind: image, format: r8g8b8a8_unorm, size: [16, 16], mips: 2, lifetime: persistent}
+  dead: {kind: buffer, bytes: 256}
+  buf: {kind: buffer, bytes: 256}
+passes:
+  both_mips: {kind: compute, writes: {out: storage_write}}
+  feed: {kind: compute, writes: {tmp: storage_write}}
+  feed1: {kind: compute, writes: {"tmp[mip=1:3]": storage_write}}
+  unused: {kind: compute, writes: {dead: storage_write}}
+  mip0: {kind: compute, reads: {"tmp[mip=0:1]": storage_read}, writes: {"out[mip=0:1]": storage_write}}
+  mip0_again: {kind: compute, reads: {"tmp[mip=2:3]": storage_read}, writes: {"out[mip=0:1]": storage_write}}
+  layer: {kind: compute, writes: {"out[mip=1:2, layer=1:2]": storage_write, buf: storage_write}}
+  rw: {kind: compute, reads: {buf: storage_read}, writes: {"hist[mip=1:2]": storage_rw}}
+outputs: [out]
+"""
+
+
+def test_the_compiled_plain_cull_agrees(tmp_path: Path) -> None:
+    """``cull._plain`` compiled (one walk over numbered cells, None at an optional access) gives
+    the Python one's kept and culled passes: on random graphs, a graph of mips and layers, and
+    None on graphs with an optional read (first or last)."""
+    from dataclasses import replace
+
+    from rgraph.ir.graph import READ_WRITE_USAGES
+
+    specs = []
+    for seed, passes in ((3, 60), (9, 150), (1000, 1000), (17, 5)):
+        path = tmp_path / f"g{seed}.yaml"
+        path.write_text(to_yaml(random_graph(seed=seed, passes=passes)))
+        specs.append(frontend(path, size=(16, 16)).spec)
+    path = tmp_path / "cells.yaml"
+    path.write_text(CELLS_GRAPH)
+    specs.append(frontend(path, size=(16, 16)).spec)
+    for spec in specs:
+        native = cull.NATIVE.plain(spec, spec.passes, READ_WRITE_USAGES, cull.Culled)
+        assert native is not None
+        assert native == cull._split(spec.passes, cull._alive_python(spec, spec.passes))
+        first, last = spec.passes[0], spec.passes[-1]
+        with_last = [*spec.passes[:-1], replace(last, accesses=(*last.accesses[:-1],
+                                                               replace(last.accesses[-1], optional=True)))]
+        with_first = [replace(first, accesses=(replace(first.accesses[0], optional=True), *first.accesses[1:])),
+                      *spec.passes[1:]]
+        for ps in (with_last, with_first):
+            assert cull.NATIVE.plain(spec, ps, READ_WRITE_USAGES, cull.Culled) is None
+    # ``mip0``'s write of ``out`` mip 0 is overwritten, so ``feed``'s ``tmp`` (its mip 0) is not
+    # needed; ``feed1``'s mip 2 is (``mip0_again``); ``rw`` writes a persistent image and reads
+    # ``buf`` from ``layer``
+    assert [c.pass_name for c in cull.cull(specs[-1]).culled] == ["feed", "unused", "mip0"]
+
+
 @pytest.mark.parametrize("seed,passes", [(1, 40), (9, 150), (1000, 1000)])
 def test_the_compiled_walk_groups_reads_as_read_layouts(tmp_path: Path, seed: int, passes: int) -> None:
     """``walk(..., moved=[])`` finds ``read_layouts.to_general``'s reads during the walk (no read

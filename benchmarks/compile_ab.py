@@ -9,6 +9,8 @@ worker in turn for one whole compile (``compile_plan``) and one compile phase by
 ``compile_scaling.py --phases`` does). Printed: the minimum CPU ms of each over the rounds.
 On a shared machine a load that comes and goes then hits every checkout alike, where
 whole runs of ``compile_scaling.py`` one after the other can each meet a different load.
+``--fresh``: each compile gets a freshly specialized spec (new objects: memo tables keyed by
+spec objects start cold), the way a graph that changed is compiled.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve()
 
 
-def worker(passes: int) -> None:
+def worker(passes: int, fresh: bool) -> None:
     """Answer 'whole' and 'phases' lines on stdin with one compile's CPU ms."""
     import gc
     import tempfile
@@ -34,10 +36,10 @@ def worker(passes: int) -> None:
     from rgraph.compiler.pipeline import DEFAULT_PROFILE, _default_provider, compile_plan, frontend
     from rgraph.random_graph import random_graph, to_yaml
 
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "g.yaml"
-        path.write_text(to_yaml(random_graph(seed=passes, passes=passes)))
-        spec = frontend(path, size=(16, 16)).spec
+    tmp = tempfile.TemporaryDirectory()
+    path = Path(tmp.name) / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=passes, passes=passes)))
+    spec = frontend(path, size=(16, 16)).spec
     search, spent = rgraph.memory.place, [0.0]
 
     def timed_search(*args, **kwargs):
@@ -50,6 +52,8 @@ def worker(passes: int) -> None:
     compile_plan(spec)
     print("ready", flush=True)
     for line in sys.stdin:
+        if fresh:
+            spec = frontend(path, size=(16, 16)).spec
         if line.strip() == "whole":
             start = time.process_time()
             compile_plan(spec)
@@ -70,6 +74,7 @@ def worker(passes: int) -> None:
                 gc.enable()
             print(" ".join([*out, f"placement_search={spent[0] * 1e3:.4f}"]), flush=True)
         else:
+            tmp.cleanup()
             return
 
 
@@ -78,15 +83,16 @@ def main() -> None:
     parser.add_argument("checkouts", nargs="*", type=Path)
     parser.add_argument("--passes", type=int, default=1000)
     parser.add_argument("--rounds", type=int, default=100)
+    parser.add_argument("--fresh", action="store_true", help="a freshly specialized spec for every compile")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
-        worker(args.passes)
+        worker(args.passes, args.fresh)
         return
     workers = []
     for checkout in args.checkouts:
         proc = subprocess.Popen([str(checkout / ".venv" / "bin" / "python"), str(HERE), "--worker", "--passes",
-                                 str(args.passes)], cwd=checkout, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 str(args.passes), *(["--fresh"] if args.fresh else [])], cwd=checkout, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                 text=True)
         assert proc.stdin is not None and proc.stdout is not None
         if proc.stdout.readline().strip() != "ready":
@@ -107,7 +113,8 @@ def main() -> None:
         proc.stdin.close()
         proc.wait()
     names = list(dict.fromkeys(name for b in best for name in b if name != "whole")) + ["whole"]
-    print(f"min cpu ms over {args.rounds} rounds, {args.passes}-pass random graph")
+    print(f"min cpu ms over {args.rounds} rounds, {args.passes}-pass random graph"
+          + (", a fresh spec each compile" if args.fresh else ""))
     print(f"{'':18s}" + "".join(f"{str(c):>28s}" for c in args.checkouts))
     for name in names:
         print(f"{name:18s}" + "".join(f"{b[name]:28.2f}" if name in b else f"{'-':>28s}" for b in best))

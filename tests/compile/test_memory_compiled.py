@@ -128,3 +128,26 @@ def test_compiled_culled_only_finds_names_by_value_too(tmp_path: Path) -> None:
         got = memory.NATIVE.culled_only(*args)
         assert got[0] == want[0] and list(got[0]) == list(want[0])
         assert [p.name for p in got[1]] == [p.name for p in want[1]]
+
+
+@pytest.mark.parametrize("seed", [3, 11, 1000])
+def test_compiled_cross_queue_conflicts_match_python(tmp_path: Path, seed: int) -> None:
+    """``_queue_order.cross_queue_conflicts`` against the Python code: the same pairs, the
+    same keys in the same order, each set filled in the same order."""
+    from rgraph.compiler import queue_order
+
+    if queue_order.NATIVE is None:
+        pytest.skip("compiled accelerators not built")
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=400)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    candidates = [n for n in c.memory if spec.resources[n].lifetime == "transient"]
+    for names in (candidates, candidates[::-1]):
+        want = queue_order.cross_queue_conflicts_python(c.passes, c.trace, names)
+        got = queue_order.NATIVE.cross_queue_conflicts(c.passes, c.trace, names)
+        assert want, "the graph should have cross-queue pairs"
+        assert got == want and list(got) == list(want)
+        assert all(list(got[k]) == list(want[k]) for k in want)
+    one_queue = [p for p in c.passes if p.queue == c.passes[0].queue]
+    assert queue_order.NATIVE.cross_queue_conflicts(one_queue, c.trace, candidates) == {}

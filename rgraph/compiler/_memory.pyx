@@ -7,7 +7,7 @@ for the spans of one heap's resources, and the results stored slot by slot
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
 from cpython.dict cimport PyDict_Next
-from libc.stdlib cimport calloc, free, malloc
+from libc.stdlib cimport calloc, free, malloc, qsort
 
 from rgraph.compiler.memory import Requirement, ResourceMemory
 from rgraph.errors import RGraphError
@@ -385,40 +385,79 @@ def measure(resources, traced, outputs, provider, culled, passes, empty, dict sa
     return out, culled_bytes, only_by_pass
 
 
+cdef struct Span:
+    i64 first, last, lo, hi  # first and last pass, first and end byte
+    i64 rank  # the name's rank in name order among the heap's resources
+    Py_ssize_t at  # index in ``names``
+
+
+cdef int by_first(const void *a, const void *b) noexcept nogil:
+    cdef const Span *x = <const Span *> a
+    cdef const Span *y = <const Span *> b
+    if x.first != y.first:
+        return -1 if x.first < y.first else 1
+    return (x.rank > y.rank) - (x.rank < y.rank)
+
+
+cdef int by_last(const void *a, const void *b) noexcept nogil:
+    cdef const Span *x = <const Span *> a
+    cdef const Span *y = <const Span *> b
+    if x.last != y.last:
+        return -1 if x.last < y.last else 1
+    return (x.rank > y.rank) - (x.rank < y.rank)
+
+
 cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
-    """``alias_sources_python``'s loop over one heap's resources ``names`` (at least two)."""
-    cdef Py_ssize_t n = len(names), k, t, m, v, r_k
-    cdef dict span = {}, pos = {}
-    cdef i64 *first = <i64 *> malloc(4 * n * sizeof(i64))
+    """``alias_sources_python``'s loop over one heap's resources ``names`` (at least two): the
+    spans in C, sorted by (first pass, name) and (last pass, name) with each name's rank in
+    name order (its place in ``names`` where those are sorted already, as the compiler's
+    placements list them), the earlier occupants kept by their place in the by-last order."""
+    cdef Py_ssize_t n = len(names), k, t, m, v, a, nkeep
+    cdef Span *spans = <Span *> malloc(2 * n * sizeof(Span))
+    cdef Span *ordered = spans + n
     cdef i64 *vis = <i64 *> malloc(3 * n * sizeof(i64))
-    cdef i64 *last = first + n
-    cdef i64 *lo = first + 2 * n
-    cdef i64 *hi = first + 3 * n
+    cdef i64 *last = <i64 *> malloc(n * sizeof(i64))
+    cdef Py_ssize_t *keep = <Py_ssize_t *> malloc(n * sizeof(Py_ssize_t))
     cdef i64 r_first, r_lo, r_hi, p_first, p_last, p_lo, p_hi, both_lo, both_hi, stop
-    cdef bint covered
-    cdef list keep
-    if first == NULL or vis == NULL:
-        free(first)
+    cdef bint covered, in_order = True
+    cdef list kept
+    cdef dict rank_of
+    if spans == NULL or vis == NULL or last == NULL or keep == NULL:
+        free(spans)
         free(vis)
+        free(last)
+        free(keep)
         raise MemoryError()
     try:
-        for name in names:
+        for k in range(1, n):
+            if not names[k - 1] < names[k]:
+                in_order = False
+                break
+        if not in_order:
+            rank_of = {name: t for t, name in enumerate(sorted(names))}
+        for k in range(n):
+            name = names[k]
             mem = memory[name]
+            if type(mem) is ResourceMemory:
+                first, lst, size = get(mem, MEMORY, 5), get(mem, MEMORY, 6), get(mem, MEMORY, 0)
+            else:
+                first, lst, size = mem.first, mem.last, mem.bytes
             off = offsets[name][1]
-            span[name] = (mem.first, mem.last, off, off + mem.bytes)
-        ordered = sorted(names, key=lambda x: (span[x][0], x))
-        by_last = sorted(names, key=lambda x: (span[x][1], x))
-        for k in range(n):  # the spans in by_last's order
-            f, l, a, b = span[by_last[k]]
-            first[k], last[k], lo[k], hi[k] = f, l, a, b
-        for r in ordered:
-            f, _, a, b = span[r]
-            r_first, r_lo, r_hi = f, a, b
+            spans[k].first, spans[k].last, spans[k].lo, spans[k].hi = first, lst, off, off + size
+            spans[k].rank = k if in_order else rank_of[name]
+            spans[k].at = k
+            ordered[k] = spans[k]
+        qsort(ordered, n, sizeof(Span), by_first)
+        qsort(spans, n, sizeof(Span), by_last)  # by_last's order from here
+        for k in range(n):
+            last[k] = spans[k].last
+        for t in range(n):
+            r_first, r_lo, r_hi = ordered[t].first, ordered[t].lo, ordered[t].hi
             m = 0
+            nkeep = 0
             stop = -1
-            keep = []
             for k in range(_bisect_left(last, n, r_first) - 1, -1, -1):
-                p_first, p_last, p_lo, p_hi = first[k], last[k], lo[k], hi[k]
+                p_first, p_last, p_lo, p_hi = spans[k].first, spans[k].last, spans[k].lo, spans[k].hi
                 if p_last < stop:
                     break
                 if not (r_lo < p_hi and p_lo < r_hi):
@@ -431,17 +470,29 @@ cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
                         covered = True
                         break
                 if not covered:
-                    keep.append(by_last[k])
+                    keep[nkeep] = k
+                    nkeep += 1
                 vis[3 * m], vis[3 * m + 1], vis[3 * m + 2] = p_first, p_lo, p_hi
                 m += 1
                 if p_lo <= r_lo and r_hi <= p_hi:
                     if p_first > stop:
                         stop = p_first
-            if keep:
-                out[r] = sorted(keep, key=lambda x: (span[x][0], x))
+            if nkeep:
+                for a in range(1, nkeep):  # insertion sort by (first pass, name): a few
+                    k = keep[a]
+                    v = a
+                    while v > 0 and (spans[keep[v - 1]].first > spans[k].first or (
+                            spans[keep[v - 1]].first == spans[k].first and spans[keep[v - 1]].rank > spans[k].rank)):
+                        keep[v] = keep[v - 1]
+                        v -= 1
+                    keep[v] = k
+                kept = [names[spans[keep[a]].at] for a in range(nkeep)]
+                out[names[ordered[t].at]] = kept
     finally:
-        free(first)
+        free(spans)
         free(vis)
+        free(last)
+        free(keep)
     return 0
 
 

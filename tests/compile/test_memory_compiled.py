@@ -151,3 +151,25 @@ def test_compiled_cross_queue_conflicts_match_python(tmp_path: Path, seed: int) 
         assert all(list(got[k]) == list(want[k]) for k in want)
     one_queue = [p for p in c.passes if p.queue == c.passes[0].queue]
     assert queue_order.NATIVE.cross_queue_conflicts(one_queue, c.trace, candidates) == {}
+
+
+@pytest.mark.parametrize("seed", [2, 1000])
+def test_compiled_alias_sources_match_python(tmp_path: Path, seed: int) -> None:
+    """``_memory.alias_sources`` against ``alias_sources_python``: the same sources in the
+    same order, with a heap's names in name order (as placements list them) and shuffled."""
+    import random
+
+    from rgraph.memory.model import Placement
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=400)))
+    c = compilation(frontend(path, size=(16, 16)).spec)
+    placement = c.placement
+    items = list(placement.offsets.items())
+    random.Random(seed).shuffle(items)
+    for offsets in (placement.offsets, dict(items)):
+        p = Placement(offsets, placement.heaps, placement.stats)
+        want = memory.alias_sources_python(p, c.memory)
+        got = memory.NATIVE.alias_sources(p, c.memory)
+        assert want, "the graph should alias"
+        assert got == want and list(got) == list(want)

@@ -550,6 +550,32 @@ def split(resources, memory, outputs):
     return aliasable, rest
 
 
+def split_transients(resources, memory, outputs):
+    """``phases.place``'s candidates and ``split(resources, memory, outputs)`` in one pass
+    where ``memory`` is in name order (the measure phase's is): ``(transients, aliasable,
+    rest)``, ``transients`` the names of ``memory`` whose resource is transient, in
+    ``memory``'s order (outputs included)."""
+    cdef set kept = set(outputs)
+    cdef list names = list(memory), ordered = sorted(names), transients = [], aliasable, rest
+    cdef Py_ssize_t k, n = len(names)
+    if ordered != names:  # another order: the two lists apart
+        for name in names:
+            if resources[name].lifetime == "transient":
+                transients.append(name)
+        aliasable, rest = split(resources, memory, outputs)
+        return transients, aliasable, rest
+    aliasable, rest = [], []
+    for k in range(n):
+        name = names[k]
+        if resources[name].lifetime == "transient":
+            transients.append(name)
+            if name not in kept:
+                aliasable.append(name)
+                continue
+        rest.append(name)
+    return transients, aliasable, rest
+
+
 def dedicated(list rest, memory, list heaps, dict offsets, heap):
     """``place_resources``' loop giving each of ``rest`` its own heap (``heap``: the ``Heap``
     builder), appended to ``heaps`` and written to ``offsets``; returns their bytes."""

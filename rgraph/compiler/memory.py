@@ -163,9 +163,11 @@ def place_resources(
     policy: str,
     outputs: Sequence[str],
     conflicts: Mapping[str, set[str]] | None = None,
+    split: tuple[list[str], list[str]] | None = None,
 ) -> Placement:
     """Place transients with ``policy``; give every other resource its own heap.
-    ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
+    ``conflicts``: transients that may not alias although apart in time (queue_order.py).
+    ``split`` (compiled path only): ``NATIVE.split(resources, memory, outputs)``, made already."""
     if NATIVE is None:
         kept = set(outputs)
         aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
@@ -173,7 +175,7 @@ def place_resources(
             Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
         ]
     else:  # the same names, and the same blocks built in C with their aligned sizes
-        aliasable, rest = NATIVE.split(resources, memory, outputs)
+        aliasable, rest = NATIVE.split(resources, memory, outputs) if split is None else split
         blocks = NATIVE.blocks(aliasable, memory)
     from rgraph.memory import place
 

@@ -179,10 +179,15 @@ def place(c: Compilation) -> Compilation:
     """Heaps and offsets: transients by the allocator policy (may alias), others dedicated."""
     try:
         resources = c.spec.resources
-        aliasable = [n for n in c.memory if resources[n].lifetime == "transient"]
         assert c.trace is not None
+        if memory.NATIVE is None:
+            aliasable = [n for n in c.memory if resources[n].lifetime == "transient"]
+            split = None
+        else:  # the same list, and place_resources' split, in one pass
+            aliasable, kept_apart, rest = memory.NATIVE.split_transients(resources, c.memory, c.spec.outputs)
+            split = (kept_apart, rest)
         conflicts = cross_queue_conflicts(c.passes, c.trace, aliasable)
-        placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs, conflicts)
+        placement = memory.place_resources(resources, c.memory, c.policy, c.spec.outputs, conflicts, split)
     except ValueError as exc:
         raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
     return replace(c, placement=placement, aliases=memory.alias_sources(placement, c.memory))

@@ -323,6 +323,7 @@ def conflict_matrix(start, end, names, conflicts):
     import numpy as np
 
     cdef Py_ssize_t n = len(start), i, j, k, count = 0, room = 64
+    cdef i64 si, ei
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef Py_ssize_t *pairs = <Py_ssize_t *> malloc(2 * room * sizeof(Py_ssize_t))
@@ -366,9 +367,11 @@ def conflict_matrix(start, end, names, conflicts):
             m = matrix
             adj = &m[0, 0]
             with nogil:
-                for i in range(n):
+                for i in range(n):  # (bitwise, not short-circuit: no branch to mispredict)
+                    si, ei = s[i], e[i]
                     for j in range(n):
-                        adj[i * n + j] = s[i] <= e[j] and e[i] >= s[j] and i != j
+                        adj[i * n + j] = (si <= e[j]) & (ei >= s[j])
+                    adj[i * n + i] = 0
                 for k in range(count):
                     if not adj[pairs[2 * k] * n + pairs[2 * k + 1]]:
                         separable = False

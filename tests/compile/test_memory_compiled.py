@@ -77,6 +77,11 @@ def test_place_resources_compiled_loops_match_python(seed: int, monkeypatch: pyt
     aliasable, rest = memory.NATIVE.split(resources, mem, outputs)
     assert aliasable == [n for n in sorted(mem) if resources[n].lifetime == "transient" and n not in outputs]
     assert rest == sorted(set(mem) - set(aliasable))
+    transients = [n for n in mem if resources[n].lifetime == "transient"]
+    for order in (mem, dict(sorted(mem.items()))):  # names out of order, then in name order
+        want = [n for n in order if resources[n].lifetime == "transient"]
+        assert memory.NATIVE.split_transients(resources, order, outputs) == (want, aliasable, rest)
+    assert sorted(transients) == sorted(set(aliasable) | (set(transients) & set(outputs)))
     native = memory.place_resources(resources, mem, "aliased", outputs)
     monkeypatch.setattr(memory, "NATIVE", None)
     python = memory.place_resources(resources, mem, "aliased", outputs)

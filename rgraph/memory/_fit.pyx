@@ -16,6 +16,31 @@ one instance's arrays, made once per ``Instance`` (``greedy.native_flat``)."""
 
 from libc.stdlib cimport calloc, free, malloc, qsort, realloc
 from libc.string cimport memmove
+from cpython.object cimport PyObject
+
+cdef extern from "Python.h":
+    PyObject *PyDict_GetItemWithError(object d, object key) except? NULL
+    object PyObject_GenericGetDict(object o, void *context)
+
+from rgraph.memory.model import Block
+
+
+cdef inline object block_dict(b):
+    """The ``__dict__`` of ``b`` where it is exactly a ``Block`` (its fields are read from it
+    directly: ``Block`` has no data descriptor, so that is what ``getattr`` finds), else None."""
+    if type(b) is Block:
+        return PyObject_GenericGetDict(b, NULL)
+    return None
+
+
+cdef inline object field(b, d, str key):
+    """``getattr(b, key)``, read from ``d`` (``block_dict(b)``) where it holds ``key``."""
+    cdef PyObject *v
+    if d is not None:
+        v = PyDict_GetItemWithError(d, key)
+        if v != NULL:
+            return <object> v
+    return getattr(b, key)
 
 ctypedef long long i64
 
@@ -435,11 +460,12 @@ def class_arrays(list blocks):
             raise MemoryError()
         for i in range(n):
             b = blocks[i]
-            x, y, w = b.start, b.end, b.aligned_size
+            d = block_dict(b)
+            x, y, w = field(b, d, "start"), field(b, d, "end"), field(b, d, "aligned_size")
             start.append(x)
             end.append(y)
             size.append(w)
-            align.append(b.alignment)
+            align.append(field(b, d, "alignment"))
             s[i], e[i], z[i] = x, y, w  # OverflowError past 64 bits
             if not (-LIMIT < s[i] < LIMIT and -LIMIT < e[i] < LIMIT and 0 <= z[i] < LIMIT):
                 raise OverflowError("times and sizes must be within 2**62")
@@ -498,12 +524,13 @@ def class_groups(list blocks):
             raise MemoryError()
         for i in range(n):
             b = blocks[i]
-            name = b.name
+            d = block_dict(b)
+            name = field(b, d, "name")
             if name in seen:
                 return None
             seen.add(name)
-            x, y = b.start, b.end
-            if x > y or b.size < 0 or b.alignment < 1:
+            x, y = field(b, d, "start"), field(b, d, "end")
+            if x > y or field(b, d, "size") < 0 or field(b, d, "alignment") < 1:
                 return None
             try:
                 s[i], e[i] = x, y
@@ -511,7 +538,7 @@ def class_groups(list blocks):
                 return None
             if not (-LIMIT < s[i] < LIMIT and -LIMIT < e[i] < LIMIT):
                 return None
-            cls = b.memory_class
+            cls = field(b, d, "memory_class")
             members = groups.get(cls)
             if members is None:
                 members = groups[cls] = []
@@ -527,10 +554,11 @@ def class_groups(list blocks):
                 i = where[k]
                 ss[k], es[k] = s[i], e[i]
                 b = members[k]
-                a = b.alignment
+                d = block_dict(b)
+                a = field(b, d, "alignment")
                 if top is None or a > top:
                     top = a
-                bytes_ += b.aligned_size
+                bytes_ += field(b, d, "aligned_size")
             qsort(ss, g, sizeof(i64), by_i64)
             qsort(es, g, sizeof(i64), by_i64)
             pairs = 0

@@ -7,7 +7,7 @@ for the spans of one heap's resources, and the results stored slot by slot
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
 from cpython.dict cimport PyDict_Next
-from libc.stdlib cimport calloc, free, malloc, qsort
+from libc.stdlib cimport calloc, free, malloc
 
 from rgraph.compiler.memory import Requirement, ResourceMemory
 from rgraph.errors import RGraphError
@@ -17,6 +17,7 @@ from rgraph.memory_requirements import ProfileMemoryRequirements
 include "../plan/_slots.pxi"
 
 include "_bisect.pxi"
+include "../memory/_sort.pxi"
 
 cdef Slots REQUIREMENT = Slots(Requirement, ("bytes", "alignment", "memory_type_bits", "tiling"))
 cdef Slots MEMORY = Slots(ResourceMemory, ("bytes", "alignment", "memory_type_bits", "memory_class", "usages",
@@ -391,30 +392,17 @@ cdef struct Span:
     Py_ssize_t at  # index in ``names``
 
 
-cdef int by_first(const void *a, const void *b) noexcept nogil:
-    cdef const Span *x = <const Span *> a
-    cdef const Span *y = <const Span *> b
-    if x.first != y.first:
-        return -1 if x.first < y.first else 1
-    return (x.rank > y.rank) - (x.rank < y.rank)
-
-
-cdef int by_last(const void *a, const void *b) noexcept nogil:
-    cdef const Span *x = <const Span *> a
-    cdef const Span *y = <const Span *> b
-    if x.last != y.last:
-        return -1 if x.last < y.last else 1
-    return (x.rank > y.rank) - (x.rank < y.rank)
-
-
 cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
     """``alias_sources_python``'s loop over one heap's resources ``names`` (at least two): the
     spans in C, sorted by (first pass, name) and (last pass, name) with each name's rank in
     name order (its place in ``names`` where those are sorted already, as the compiler's
     placements list them), the earlier occupants kept by their place in the by-last order."""
     cdef Py_ssize_t n = len(names), k, t, m, v, a, nkeep
-    cdef Span *spans = <Span *> malloc(2 * n * sizeof(Span))
+    cdef Span *spans = <Span *> malloc(3 * n * sizeof(Span))
     cdef Span *ordered = spans + n
+    cdef Span *given = spans + 2 * n  # in names' order
+    cdef Triple *keys = <Triple *> malloc(2 * n * sizeof(Triple))
+    cdef Triple *sorted_keys
     cdef i64 *vis = <i64 *> malloc(3 * n * sizeof(i64))
     cdef i64 *last = <i64 *> malloc(n * sizeof(i64))
     cdef Py_ssize_t *keep = <Py_ssize_t *> malloc(n * sizeof(Py_ssize_t))
@@ -422,8 +410,9 @@ cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
     cdef bint covered, in_order = True
     cdef list kept
     cdef dict rank_of
-    if spans == NULL or vis == NULL or last == NULL or keep == NULL:
+    if spans == NULL or vis == NULL or last == NULL or keep == NULL or keys == NULL:
         free(spans)
+        free(keys)
         free(vis)
         free(last)
         free(keep)
@@ -443,12 +432,19 @@ cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
             else:
                 first, lst, size = mem.first, mem.last, mem.bytes
             off = offsets[name][1]
-            spans[k].first, spans[k].last, spans[k].lo, spans[k].hi = first, lst, off, off + size
-            spans[k].rank = k if in_order else rank_of[name]
-            spans[k].at = k
-            ordered[k] = spans[k]
-        qsort(ordered, n, sizeof(Span), by_first)
-        qsort(spans, n, sizeof(Span), by_last)  # by_last's order from here
+            given[k].first, given[k].last, given[k].lo, given[k].hi = first, lst, off, off + size
+            given[k].rank = k if in_order else rank_of[name]
+            given[k].at = k
+        for k in range(n):  # (first pass, name rank): ordered
+            keys[k].a, keys[k].b, keys[k].c = given[k].first, given[k].rank, k
+        sorted_keys = sort_triples(keys, keys + n, n)
+        for k in range(n):
+            ordered[k] = given[sorted_keys[k].c]
+        for k in range(n):  # (last pass, name rank): spans
+            keys[k].a, keys[k].b, keys[k].c = given[k].last, given[k].rank, k
+        sorted_keys = sort_triples(keys, keys + n, n)
+        for k in range(n):
+            spans[k] = given[sorted_keys[k].c]
         for k in range(n):
             last[k] = spans[k].last
         for t in range(n):
@@ -490,6 +486,7 @@ cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
                 out[names[ordered[t].at]] = kept
     finally:
         free(spans)
+        free(keys)
         free(vis)
         free(last)
         free(keep)

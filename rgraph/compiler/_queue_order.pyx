@@ -8,9 +8,10 @@ made here too (tests/compile/test_native_phases.py compares the plans of both,
 tests/compile/test_memory_compiled.py the pairs)."""
 
 from cpython.ref cimport PyObject
-from libc.stdlib cimport free, malloc, qsort, realloc
+from libc.stdlib cimport free, malloc, realloc
 
 include "_bisect.pxi"
+include "../memory/_sort.pxi"
 include "../plan/_slots.pxi"
 
 #: Queues past this many: the Python code runs (the C arrays hold a few per candidate).
@@ -48,16 +49,6 @@ cdef struct Row:
     i64 q  # the queue's place in ``by_queue``'s order
     i64 j  # the last use of a cell of the resource on that queue
     i64 k  # the resource's rank in name order
-
-
-cdef int by_row(const void *a, const void *b) noexcept nogil:
-    cdef const Row *x = <const Row *> a
-    cdef const Row *y = <const Row *> b
-    if x.q != y.q:
-        return -1 if x.q < y.q else 1
-    if x.j != y.j:
-        return -1 if x.j < y.j else 1
-    return (x.k > y.k) - (x.k < y.k)
 
 
 cdef Py_ssize_t _queue(list qs, q) except -1:
@@ -134,6 +125,7 @@ cdef object _conflicts(trace, candidates):
     cdef Py_ssize_t *estart = NULL
     cdef i64 *entry_q = NULL
     cdef Row *rows = NULL
+    cdef Row *spare = NULL
     cdef i64 *keys = NULL
     cdef void *grown
     for k in range(n):
@@ -211,7 +203,13 @@ cdef object _conflicts(trace, candidates):
                 rows[nrows].q, rows[nrows].j, rows[nrows].k = row_of[qi], permax[i], k
                 nrows += 1
         nq = len(row_queues)
-        qsort(rows, nrows, sizeof(Row), by_row)
+        spare = <Row *> malloc(max(nrows, 1) * sizeof(Row))
+        if spare == NULL:
+            raise MemoryError()
+        if <Row *> sort_triples(<Triple *> rows, <Triple *> spare, nrows) == spare:  # by (q, j, k)
+            grown = rows
+            rows = spare
+            spare = <Row *> grown
         keys = <i64 *> malloc(max(nrows, 1) * sizeof(i64))
         if keys == NULL:
             raise MemoryError()
@@ -254,5 +252,6 @@ cdef object _conflicts(trace, candidates):
         free(estart)
         free(entry_q)
         free(rows)
+        free(spare)
         free(keys)
     return out

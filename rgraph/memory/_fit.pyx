@@ -16,6 +16,8 @@ one instance's arrays, made once per ``Instance`` (``greedy.native_flat``)."""
 
 from libc.stdlib cimport calloc, free, malloc, qsort, realloc
 from libc.string cimport memmove
+
+include "_sort.pxi"
 from cpython.object cimport PyObject
 
 cdef extern from "Python.h":
@@ -449,14 +451,15 @@ def class_arrays(list blocks):
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *z = <i64 *> malloc(max(n, 1) * sizeof(i64))
-    cdef i64 *coords = <i64 *> malloc(max(2 * n, 1) * sizeof(i64))
+    cdef i64 *coords_buf = <i64 *> malloc(2 * max(2 * n, 1) * sizeof(i64))  # the coordinates and a spare
+    cdef i64 *coords = coords_buf
     cdef i64 *diff = NULL
     cdef i64 total = 0, run = 0
     cdef Py_ssize_t *lo = <Py_ssize_t *> malloc(max(n, 1) * sizeof(Py_ssize_t))
     cdef Py_ssize_t *hi = <Py_ssize_t *> malloc(max(n, 1) * sizeof(Py_ssize_t))
     cdef list start = [], end = [], size = [], align = [], sec_lo = [], sec_hi = [], totals = []
     try:
-        if not (s and e and z and coords and lo and hi):
+        if not (s and e and z and coords_buf and lo and hi):
             raise MemoryError()
         for i in range(n):
             b = blocks[i]
@@ -474,7 +477,7 @@ def class_arrays(list blocks):
                 raise OverflowError("sizes sum past 2**62")
             coords[2 * i], coords[2 * i + 1] = s[i], e[i] + 1
         if n:
-            qsort(coords, 2 * n, sizeof(i64), by_i64)
+            coords = sort_i64(coords_buf, coords_buf + max(2 * n, 1), 2 * n)
             m = 1
             for i in range(1, 2 * n):
                 if coords[i] != coords[m - 1]:
@@ -499,7 +502,7 @@ def class_arrays(list blocks):
         free(s)
         free(e)
         free(z)
-        free(coords)
+        free(coords_buf)
         free(diff)
         free(lo)
         free(hi)
@@ -513,14 +516,16 @@ def class_groups(list blocks):
     cdef Py_ssize_t n = len(blocks), i, k, g
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
-    cdef i64 *ss = <i64 *> malloc(max(n, 1) * sizeof(i64))
-    cdef i64 *es = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *ss_buf = <i64 *> malloc(2 * max(n, 1) * sizeof(i64))  # starts and a spare
+    cdef i64 *es_buf = <i64 *> malloc(2 * max(n, 1) * sizeof(i64))
+    cdef i64 *ss = ss_buf
+    cdef i64 *es = es_buf
     cdef i64 pairs
     cdef set seen = set()
     cdef dict groups = {}, at = {}, out = {}
     cdef list members, where
     try:
-        if not (s and e and ss and es):
+        if not (s and e and ss_buf and es_buf):
             raise MemoryError()
         for i in range(n):
             b = blocks[i]
@@ -552,15 +557,15 @@ def class_groups(list blocks):
             bytes_ = 0
             for k in range(g):
                 i = where[k]
-                ss[k], es[k] = s[i], e[i]
+                ss_buf[k], es_buf[k] = s[i], e[i]
                 b = members[k]
                 d = block_dict(b)
                 a = field(b, d, "alignment")
                 if top is None or a > top:
                     top = a
                 bytes_ += field(b, d, "aligned_size")
-            qsort(ss, g, sizeof(i64), by_i64)
-            qsort(es, g, sizeof(i64), by_i64)
+            ss = sort_i64(ss_buf, ss_buf + max(n, 1), g)
+            es = sort_i64(es_buf, es_buf + max(n, 1), g)
             pairs = 0
             for k in range(g):  # j overlaps i: start_j <= end_i, less those with end_j < start_i
                 i = where[k]
@@ -570,8 +575,8 @@ def class_groups(list blocks):
     finally:
         free(s)
         free(e)
-        free(ss)
-        free(es)
+        free(ss_buf)
+        free(es_buf)
 
 
 cdef struct Key:

@@ -7,6 +7,7 @@ for the spans of one heap's resources, and the results stored slot by slot
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
 from cpython.dict cimport PyDict_Next
+from cpython.object cimport newfunc
 from libc.stdlib cimport calloc, free, malloc
 
 from rgraph.compiler.memory import Requirement, ResourceMemory
@@ -519,14 +520,22 @@ def blocks(list names, memory):
     the alignment is below 1: ``check_blocks`` reports that)."""
     cdef list out = []
     cdef dict d
+    cdef tuple no_args = ()
+    cdef newfunc tp_new = (<PyTypeObject *> Block).tp_new  # object.__new__'s: Block defines none
+    if Block.__new__ is not object.__new__:
+        tp_new = NULL
     new = Block.__new__
     for n in names:
         m = memory[n]
-        b = new(Block)
+        b = tp_new(Block, <PyObject *> no_args, NULL) if tp_new != NULL else new(Block)
         d = b.__dict__
-        size, alignment = m.bytes, m.alignment
-        d["name"], d["start"], d["end"], d["size"] = n, m.first, m.last, size
-        d["alignment"], d["memory_class"] = alignment, m.memory_class
+        if type(m) is ResourceMemory:  # its slots read directly
+            size, alignment, first, last, cls = get(m, MEMORY, 0), get(m, MEMORY, 1), get(m, MEMORY, 5), \
+                get(m, MEMORY, 6), get(m, MEMORY, 3)
+        else:
+            size, alignment, first, last, cls = m.bytes, m.alignment, m.first, m.last, m.memory_class
+        d["name"], d["start"], d["end"], d["size"] = n, first, last, size
+        d["alignment"], d["memory_class"] = alignment, cls
         if type(size) is int and type(alignment) is int and alignment >= 1:
             rem = size % alignment
             d["aligned_size"] = size if rem == 0 else size + alignment - rem

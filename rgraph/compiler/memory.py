@@ -58,7 +58,9 @@ _requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  
 _heap = builder(Heap)  # one per resource placed apart
 
 #: The compiled mirror of :func:`requirements_python`, :func:`resource_memory_python`,
-#: :func:`alias_sources_python`, ``phases._culled_only_python`` and ``place_resources``' loops
+#: :func:`alias_sources_python`, ``phases._culled_only_python``, the whole measure phase
+#: (``phases._measure_python``: ``measure``), ``phases.place``'s candidates with
+#: ``place_resources``' split (``split_transients``) and ``place_resources``' loops
 #: (``rgraph/compiler/_memory.pyx``), None where it is not built or ``RGRAPH_NATIVE=0``.
 NATIVE = load("rgraph.compiler._memory")
 

@@ -6,7 +6,9 @@ for the spans of one heap's resources, and the results stored slot by slot
 (``rgraph/plan/_slots.pxi``). Any change to the Python code must be made here too
 (tests/compile/test_native_phases.py compares the plans of both)."""
 
-from libc.stdlib cimport free, malloc
+from cpython.dict cimport PyDict_Next
+from cpython.object cimport newfunc
+from libc.stdlib cimport calloc, free, malloc
 
 from rgraph.compiler.memory import Requirement, ResourceMemory
 from rgraph.errors import RGraphError
@@ -16,10 +18,32 @@ from rgraph.memory_requirements import ProfileMemoryRequirements
 include "../plan/_slots.pxi"
 
 include "_bisect.pxi"
+include "../memory/_sort.pxi"
 
 cdef Slots REQUIREMENT = Slots(Requirement, ("bytes", "alignment", "memory_type_bits", "tiling"))
 cdef Slots MEMORY = Slots(ResourceMemory, ("bytes", "alignment", "memory_type_bits", "memory_class", "usages",
                                            "first", "last"))
+
+# The slots of the values ``measure`` reads (set on first use: their modules import later
+# than this one); each read checks the exact type first, else falls back to ``getattr``.
+cdef Slots TRACE = None, ACCESS = None, PASS = None, CULLED = None
+cdef object TRACE_T = None, ACCESS_T = None, PASS_T = None, CULLED_T = None
+
+
+cdef int _layouts() except -1:
+    global TRACE, ACCESS, PASS, CULLED, TRACE_T, ACCESS_T, PASS_T, CULLED_T
+    from rgraph.compiler.trace import ResourceTrace
+    from rgraph.ir.cull import Culled
+    from rgraph.spec.specialize import AccessSpec, PassSpec
+
+    TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group"))
+    ACCESS = Slots(AccessSpec, ("resource", "usage", "write", "mips", "layers", "stages", "optional", "loc",
+                                "refit", "cells"))
+    PASS = Slots(PassSpec, ("name", "order", "kind", "queue", "impl", "requires", "side_effects", "accesses",
+                            "params", "loc", "requires_any"))
+    CULLED = Slots(Culled, ("pass_name", "reason"))
+    TRACE_T, ACCESS_T, PASS_T, CULLED_T = ResourceTrace, AccessSpec, PassSpec, Culled
+    return 0
 
 
 def requirements(resources, used, outputs, provider, dict same_buffer_flag):
@@ -100,63 +124,337 @@ def resource_memory(reqs, used, spans):
 
 def culled_only(passes, culled, traced):
     """``_culled_only_python(spec, culled, traced)`` for ``passes``: ``spec.passes``."""
-    cdef dict by_name = {}, only_by_pass = {}
+    if TRACE is None:
+        _layouts()
+    return _culled_only(passes, culled, traced)
+
+
+cdef struct PtrMap:
+    # Open addressing on object addresses (no reference held, no hash read from the object):
+    # a slot is free while its key is NULL.
+    size_t mask
+    void **keys
+    void **values
+
+
+cdef int ptr_map_init(PtrMap *m, Py_ssize_t count) except -1:
+    cdef size_t size = 16
+    while size < 2 * <size_t> count:
+        size *= 2
+    m.mask = size - 1
+    m.keys = <void **> calloc(2 * size, sizeof(void *))
+    if m.keys == NULL:
+        raise MemoryError()
+    m.values = m.keys + size
+    return 0
+
+
+cdef inline size_t ptr_slot(const PtrMap *m, void *key) noexcept nogil:
+    cdef size_t h = (<size_t> key >> 4) * <size_t> 0x9E3779B97F4A7C15ULL
+    h = (h >> 32) & m.mask
+    while m.keys[h] != NULL and m.keys[h] != key:
+        h = (h + 1) & m.mask
+    return h
+
+
+cdef inline void ptr_put(PtrMap *m, void *key, void *value) noexcept nogil:
+    cdef size_t h = ptr_slot(m, key)
+    m.keys[h] = key
+    m.values[h] = value
+
+
+cdef inline void *ptr_get(const PtrMap *m, void *key) noexcept nogil:
+    """The value stored for ``key``, NULL where none is."""
+    cdef size_t h = ptr_slot(m, key)
+    return m.values[h] if m.keys[h] != NULL else NULL
+
+
+cdef inline void *slot_ptr(object o, Slots layout, Py_ssize_t k) noexcept:
+    """Field ``k`` of ``o`` (exactly ``layout.cls``) as a borrowed pointer, NULL where unset."""
+    return (<void **> ((<char *> <PyObject *> o) + layout.off[k]))[0]
+
+
+cdef tuple _culled_only(passes, culled, traced):
+    """``_culled_only_python``. Where every pass is a ``PassSpec`` (and the trace a dict), the
+    passes are found by the address of their name and the traced resources by the address of
+    theirs (a culled pass's name is its ``PassSpec``'s own string, an access's resource the
+    trace's key): the strings are not read (on a 1,000-pass graph they were most of its
+    time, each a cache miss); a name or resource not found by address is looked up by value."""
+    cdef dict by_name = None, only_by_pass = {}
     cdef list used_by = []
     cdef set only
+    cdef PtrMap names, seen
+    cdef bint fast = type(passes) is list and type(traced) is dict
+    cdef Py_ssize_t pos = 0
+    cdef PyObject *key
+    cdef PyObject *value
+    cdef void *found
     if not culled:
         return {}, []
-    for p in passes:
-        by_name[p.name] = p
-    for x in culled:
-        p = by_name[x.pass_name]
-        only = None
-        for a in p.accesses:
-            name = a.resource
-            if name not in traced:
-                if only is None:
-                    only = {name}
+    if fast:
+        for p in <list> passes:
+            if type(p) is not PASS_T:
+                fast = False
+                break
+    names.keys = seen.keys = names.values = seen.values = NULL
+    names.mask = seen.mask = 0
+    try:
+        if fast:
+            ptr_map_init(&names, len(<list> passes))
+            for p in <list> passes:
+                found = slot_ptr(p, PASS, 0)
+                if found != NULL:
+                    ptr_put(&names, found, <void *> p)
+            ptr_map_init(&seen, len(<dict> traced))
+            while PyDict_Next(<dict> traced, &pos, &key, &value):
+                ptr_put(&seen, <void *> key, <void *> key)
+        for x in culled:
+            pass_name = get(x, CULLED, 0) if type(x) is CULLED_T else x.pass_name
+            found = ptr_get(&names, <void *> pass_name) if fast else NULL
+            if found != NULL:
+                p = <object> found
+            else:
+                if by_name is None:
+                    by_name = {}
+                    for q in passes:
+                        by_name[get(q, PASS, 0) if type(q) is PASS_T else q.name] = q
+                p = by_name[pass_name]
+            only = None
+            for a in (get(p, PASS, 7) if type(p) is PASS_T else p.accesses):
+                if type(a) is ACCESS_T:
+                    if fast and ptr_get(&seen, slot_ptr(a, ACCESS, 0)) != NULL:
+                        continue  # traced (found by address)
+                    name = get(a, ACCESS, 0)
                 else:
-                    only.add(name)
-        if only is not None:
-            only_by_pass[p.name] = tuple(sorted(only))
-            used_by.append(p)
+                    name = a.resource
+                if name not in traced:
+                    if only is None:
+                        only = {name}
+                    else:
+                        only.add(name)
+            if only is not None:
+                only_by_pass[get(p, PASS, 0) if type(p) is PASS_T else p.name] = tuple(sorted(only))
+                used_by.append(p)
+    finally:
+        free(names.keys)
+        free(seen.keys)
     return only_by_pass, used_by
 
 
+cdef dict _usages_by_resource(list passes):
+    """``memory.usages_by_resource(passes)``."""
+    cdef dict used = {}
+    cdef set found
+    cdef bint raytrace
+    for p in passes:
+        if type(p) is PASS_T:
+            raytrace = get(p, PASS, 2) == "raytrace"
+            accesses = get(p, PASS, 7)
+        else:
+            raytrace = p.kind == "raytrace"
+            accesses = p.accesses
+        for a in accesses:
+            if type(a) is ACCESS_T:
+                name, usage = get(a, ACCESS, 0), get(a, ACCESS, 1)
+            else:
+                name, usage = a.resource, a.usage
+            got = used.get(name)
+            if got is None:
+                found = {usage}
+                used[name] = found
+            else:
+                found = <set> got
+                found.add(usage)
+            if raytrace and usage == "indirect":
+                found.add("trace_indirect")
+    return used
+
+
+def measure(resources, traced, outputs, provider, culled, passes, empty, dict same_buffer_flag):
+    """``phases._measure_python``'s ``(memory, culled_bytes, culled_only)``: the
+    requirements of the used resources (``requirements_python`` of their usages), their
+    ``resource_memory_python`` values, and the culled-only resources' bytes, in one pass
+    over the used resources: each usage set sorted once (twice where ``transfer_src`` joins
+    it), no ``Requirement`` made for them, the trace read from its slots."""
+    cdef dict out = {}, memo = None, buffer_memo = None, flags_memo = {}
+    cdef dict culled_bytes = {}, only_by_pass
+    cdef set kept = set(outputs), usage_set
+    cdef list names, usages, founds = [], tuples = [], firsts = [], lasts = []
+    cdef list culled_passes
+    cdef Py_ssize_t k, n
+    cdef int many_optimal = 0, many_linear = 0  # several memoryTypeBits within the tiling
+    cdef bint image
+    cdef tuple key_usages, utuple, flags_pair, found
+    if TRACE is None:
+        _layouts()
+    if type(provider) is ProfileMemoryRequirements:  # its memos read here: no call per resource once filled
+        memo = provider.__dict__.get("_image_memo")
+        buffer_memo = provider.__dict__.get("_buffer_memo")
+    names = sorted(traced)
+    n = len(names)
+    cdef char *tilings = <char *> malloc(max(n, 1))
+    if tilings == NULL:
+        raise MemoryError()
+    bits_optimal = bits_linear = None
+    try:
+        for k in range(n):
+            name = names[k]
+            rt = traced[name]
+            if type(rt) is TRACE_T:
+                usage_set = get(rt, TRACE, 0)
+                firsts.append(get(rt, TRACE, 1))
+                lasts.append(get(rt, TRACE, 2))
+            else:
+                usage_set = rt.usages
+                firsts.append(rt.first)
+                lasts.append(rt.last)
+            res = resources[name]
+            usages = sorted(usage_set)
+            utuple = tuple(usages)
+            tuples.append(utuple)
+            if name in kept or res.lifetime == "output":
+                usages = sorted(usage_set | {"transfer_src"})
+                key_usages = tuple(usages)
+            else:
+                key_usages = utuple
+            try:
+                image = res.kind == "image"  # ``res.is_image``
+                if image:
+                    fmt = res.format
+                    assert fmt is not None
+                    got = None
+                    if memo is not None:  # ``ProfileMemoryRequirements.image``'s key
+                        got = memo.get((fmt.vk_name, tuple(res.extent), res.mips, res.layers, res.samples,
+                                        key_usages))
+                    if got is None:
+                        got = provider.image(fmt.vk_name, res.extent, res.mips, res.layers, res.samples, usages)
+                else:
+                    flags_pair = flags_memo.get(key_usages)
+                    if flags_pair is None:
+                        flags = sorted({same_buffer_flag.get(u, u) for u in usages})
+                        flags_pair = (flags, tuple(flags))
+                        flags_memo[key_usages] = flags_pair
+                    got = None
+                    if buffer_memo is not None:  # ``ProfileMemoryRequirements.buffer``'s key
+                        got = buffer_memo.get((res.bytes, flags_pair[1]))
+                    if got is None:
+                        got = provider.buffer(res.bytes, list(flags_pair[0]))
+                if type(got) is tuple and len(<tuple> got) == 3:
+                    found = <tuple> got
+                    bits = found[2]
+                else:
+                    size, align, bits = got
+                    found = (size, align, bits)
+            except RGraphError as err:
+                raise RGraphError.at(res.loc, f"resource '{name}': {err.first.message}") from None
+            founds.append(found)
+            if image:
+                tilings[k] = 1
+                if bits_optimal is None:
+                    bits_optimal = bits
+                elif not many_optimal and bits != bits_optimal:
+                    many_optimal = 1
+            else:
+                tilings[k] = 0
+                if bits_linear is None:
+                    bits_linear = bits
+                elif not many_linear and bits != bits_linear:
+                    many_linear = 1
+        for k in range(n):
+            found = <tuple> founds[k]
+            bits = found[2]
+            if tilings[k]:
+                cls = f"device_local_optimal_types_{bits:x}" if many_optimal else "device_local_optimal"
+            else:
+                cls = f"device_local_linear_types_{bits:x}" if many_linear else "device_local_linear"
+            value = new_slots(MEMORY)
+            put(value, MEMORY, 0, found[0])
+            put(value, MEMORY, 1, found[1])
+            put(value, MEMORY, 2, bits)
+            put(value, MEMORY, 3, cls)
+            put(value, MEMORY, 4, tuples[k])
+            put(value, MEMORY, 5, firsts[k])
+            put(value, MEMORY, 6, lasts[k])
+            out[names[k]] = value
+    finally:
+        free(tilings)
+    only_by_pass, culled_passes = _culled_only(passes, culled, traced)
+    if culled_passes:
+        culled_used = {r: u for r, u in _usages_by_resource(culled_passes).items() if r not in traced}
+        if culled_used:
+            for r, q in requirements(resources, culled_used, outputs, provider, same_buffer_flag).items():
+                culled_bytes[r] = 0 if r in empty else (<object> q).bytes
+    return out, culled_bytes, only_by_pass
+
+
+cdef struct Span:
+    i64 first, last, lo, hi  # first and last pass, first and end byte
+    i64 rank  # the name's rank in name order among the heap's resources
+    Py_ssize_t at  # index in ``names``
+
+
 cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
-    """``alias_sources_python``'s loop over one heap's resources ``names`` (at least two)."""
-    cdef Py_ssize_t n = len(names), k, t, m, v, r_k
-    cdef dict span = {}, pos = {}
-    cdef i64 *first = <i64 *> malloc(4 * n * sizeof(i64))
+    """``alias_sources_python``'s loop over one heap's resources ``names`` (at least two): the
+    spans in C, sorted by (first pass, name) and (last pass, name) with each name's rank in
+    name order (its place in ``names`` where those are sorted already, as the compiler's
+    placements list them), the earlier occupants kept by their place in the by-last order."""
+    cdef Py_ssize_t n = len(names), k, t, m, v, a, nkeep
+    cdef Span *spans = <Span *> malloc(3 * n * sizeof(Span))
+    cdef Span *ordered = spans + n
+    cdef Span *given = spans + 2 * n  # in names' order
+    cdef Triple *keys = <Triple *> malloc(2 * n * sizeof(Triple))
+    cdef Triple *sorted_keys
     cdef i64 *vis = <i64 *> malloc(3 * n * sizeof(i64))
-    cdef i64 *last = first + n
-    cdef i64 *lo = first + 2 * n
-    cdef i64 *hi = first + 3 * n
+    cdef i64 *last = <i64 *> malloc(n * sizeof(i64))
+    cdef Py_ssize_t *keep = <Py_ssize_t *> malloc(n * sizeof(Py_ssize_t))
     cdef i64 r_first, r_lo, r_hi, p_first, p_last, p_lo, p_hi, both_lo, both_hi, stop
-    cdef bint covered
-    cdef list keep
-    if first == NULL or vis == NULL:
-        free(first)
+    cdef bint covered, in_order = True
+    cdef list kept
+    cdef dict rank_of
+    if spans == NULL or vis == NULL or last == NULL or keep == NULL or keys == NULL:
+        free(spans)
+        free(keys)
         free(vis)
+        free(last)
+        free(keep)
         raise MemoryError()
     try:
-        for name in names:
+        for k in range(1, n):
+            if not names[k - 1] < names[k]:
+                in_order = False
+                break
+        if not in_order:
+            rank_of = {name: t for t, name in enumerate(sorted(names))}
+        for k in range(n):
+            name = names[k]
             mem = memory[name]
+            if type(mem) is ResourceMemory:
+                first, lst, size = get(mem, MEMORY, 5), get(mem, MEMORY, 6), get(mem, MEMORY, 0)
+            else:
+                first, lst, size = mem.first, mem.last, mem.bytes
             off = offsets[name][1]
-            span[name] = (mem.first, mem.last, off, off + mem.bytes)
-        ordered = sorted(names, key=lambda x: (span[x][0], x))
-        by_last = sorted(names, key=lambda x: (span[x][1], x))
-        for k in range(n):  # the spans in by_last's order
-            f, l, a, b = span[by_last[k]]
-            first[k], last[k], lo[k], hi[k] = f, l, a, b
-        for r in ordered:
-            f, _, a, b = span[r]
-            r_first, r_lo, r_hi = f, a, b
+            given[k].first, given[k].last, given[k].lo, given[k].hi = first, lst, off, off + size
+            given[k].rank = k if in_order else rank_of[name]
+            given[k].at = k
+        for k in range(n):  # (first pass, name rank): ordered
+            keys[k].a, keys[k].b, keys[k].c = given[k].first, given[k].rank, k
+        sorted_keys = sort_triples(keys, keys + n, n)
+        for k in range(n):
+            ordered[k] = given[sorted_keys[k].c]
+        for k in range(n):  # (last pass, name rank): spans
+            keys[k].a, keys[k].b, keys[k].c = given[k].last, given[k].rank, k
+        sorted_keys = sort_triples(keys, keys + n, n)
+        for k in range(n):
+            spans[k] = given[sorted_keys[k].c]
+        for k in range(n):
+            last[k] = spans[k].last
+        for t in range(n):
+            r_first, r_lo, r_hi = ordered[t].first, ordered[t].lo, ordered[t].hi
             m = 0
+            nkeep = 0
             stop = -1
-            keep = []
             for k in range(_bisect_left(last, n, r_first) - 1, -1, -1):
-                p_first, p_last, p_lo, p_hi = first[k], last[k], lo[k], hi[k]
+                p_first, p_last, p_lo, p_hi = spans[k].first, spans[k].last, spans[k].lo, spans[k].hi
                 if p_last < stop:
                     break
                 if not (r_lo < p_hi and p_lo < r_hi):
@@ -169,17 +467,30 @@ cdef int _heap_sources(list names, offsets, memory, dict out) except -1:
                         covered = True
                         break
                 if not covered:
-                    keep.append(by_last[k])
+                    keep[nkeep] = k
+                    nkeep += 1
                 vis[3 * m], vis[3 * m + 1], vis[3 * m + 2] = p_first, p_lo, p_hi
                 m += 1
                 if p_lo <= r_lo and r_hi <= p_hi:
                     if p_first > stop:
                         stop = p_first
-            if keep:
-                out[r] = sorted(keep, key=lambda x: (span[x][0], x))
+            if nkeep:
+                for a in range(1, nkeep):  # insertion sort by (first pass, name): a few
+                    k = keep[a]
+                    v = a
+                    while v > 0 and (spans[keep[v - 1]].first > spans[k].first or (
+                            spans[keep[v - 1]].first == spans[k].first and spans[keep[v - 1]].rank > spans[k].rank)):
+                        keep[v] = keep[v - 1]
+                        v -= 1
+                    keep[v] = k
+                kept = [names[spans[keep[a]].at] for a in range(nkeep)]
+                out[names[ordered[t].at]] = kept
     finally:
-        free(first)
+        free(spans)
+        free(keys)
         free(vis)
+        free(last)
+        free(keep)
     return 0
 
 
@@ -209,14 +520,22 @@ def blocks(list names, memory):
     the alignment is below 1: ``check_blocks`` reports that)."""
     cdef list out = []
     cdef dict d
+    cdef tuple no_args = ()
+    cdef newfunc tp_new = (<PyTypeObject *> Block).tp_new  # object.__new__'s: Block defines none
+    if Block.__new__ is not object.__new__:
+        tp_new = NULL
     new = Block.__new__
     for n in names:
         m = memory[n]
-        b = new(Block)
+        b = tp_new(Block, <PyObject *> no_args, NULL) if tp_new != NULL else new(Block)
         d = b.__dict__
-        size, alignment = m.bytes, m.alignment
-        d["name"], d["start"], d["end"], d["size"] = n, m.first, m.last, size
-        d["alignment"], d["memory_class"] = alignment, m.memory_class
+        if type(m) is ResourceMemory:  # its slots read directly
+            size, alignment, first, last, cls = get(m, MEMORY, 0), get(m, MEMORY, 1), get(m, MEMORY, 5), \
+                get(m, MEMORY, 6), get(m, MEMORY, 3)
+        else:
+            size, alignment, first, last, cls = m.bytes, m.alignment, m.first, m.last, m.memory_class
+        d["name"], d["start"], d["end"], d["size"] = n, first, last, size
+        d["alignment"], d["memory_class"] = alignment, cls
         if type(size) is int and type(alignment) is int and alignment >= 1:
             rem = size % alignment
             d["aligned_size"] = size if rem == 0 else size + alignment - rem
@@ -235,6 +554,32 @@ def split(resources, memory, outputs):
         else:
             rest.append(n)
     return aliasable, rest
+
+
+def split_transients(resources, memory, outputs):
+    """``phases.place``'s candidates and ``split(resources, memory, outputs)`` in one pass
+    where ``memory`` is in name order (the measure phase's is): ``(transients, aliasable,
+    rest)``, ``transients`` the names of ``memory`` whose resource is transient, in
+    ``memory``'s order (outputs included)."""
+    cdef set kept = set(outputs)
+    cdef list names = list(memory), ordered = sorted(names), transients = [], aliasable, rest
+    cdef Py_ssize_t k, n = len(names)
+    if ordered != names:  # another order: the two lists apart
+        for name in names:
+            if resources[name].lifetime == "transient":
+                transients.append(name)
+        aliasable, rest = split(resources, memory, outputs)
+        return transients, aliasable, rest
+    aliasable, rest = [], []
+    for k in range(n):
+        name = names[k]
+        if resources[name].lifetime == "transient":
+            transients.append(name)
+            if name not in kept:
+                aliasable.append(name)
+                continue
+        rest.append(name)
+    return transients, aliasable, rest
 
 
 def dedicated(list rest, memory, list heaps, dict offsets, heap):

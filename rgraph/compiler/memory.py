@@ -58,7 +58,9 @@ _requirement, _resource_memory = builder(Requirement), builder(ResourceMemory)  
 _heap = builder(Heap)  # one per resource placed apart
 
 #: The compiled mirror of :func:`requirements_python`, :func:`resource_memory_python`,
-#: :func:`alias_sources_python`, ``phases._culled_only_python`` and ``place_resources``' loops
+#: :func:`alias_sources_python`, ``phases._culled_only_python``, the whole measure phase
+#: (``phases._measure_python``: ``measure``), ``phases.place``'s candidates with
+#: ``place_resources``' split (``split_transients``) and ``place_resources``' loops
 #: (``rgraph/compiler/_memory.pyx``), None where it is not built or ``RGRAPH_NATIVE=0``.
 NATIVE = load("rgraph.compiler._memory")
 
@@ -163,9 +165,11 @@ def place_resources(
     policy: str,
     outputs: Sequence[str],
     conflicts: Mapping[str, set[str]] | None = None,
+    split: tuple[list[str], list[str]] | None = None,
 ) -> Placement:
     """Place transients with ``policy``; give every other resource its own heap.
-    ``conflicts``: transients that may not alias although apart in time (queue_order.py)."""
+    ``conflicts``: transients that may not alias although apart in time (queue_order.py).
+    ``split`` (compiled path only): ``NATIVE.split(resources, memory, outputs)``, made already."""
     if NATIVE is None:
         kept = set(outputs)
         aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
@@ -173,7 +177,7 @@ def place_resources(
             Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
         ]
     else:  # the same names, and the same blocks built in C with their aligned sizes
-        aliasable, rest = NATIVE.split(resources, memory, outputs)
+        aliasable, rest = NATIVE.split(resources, memory, outputs) if split is None else split
         blocks = NATIVE.blocks(aliasable, memory)
     from rgraph.memory import place
 

@@ -112,20 +112,35 @@ def trace(c: Compilation) -> Compilation:
 
 
 def measure(c: Compilation) -> Compilation:
-    """Sizes, alignments and memory classes of the used resources (and of culled-only ones)."""
+    """Sizes, alignments and memory classes of the used resources (and of culled-only ones).
+    Compiled where built (``memory.NATIVE.measure``: the same values as :func:`_measure_python`)."""
+    assert c.culling is not None and c.trace is not None
+    spec = c.spec
+    if memory.NATIVE is None:
+        used_memory, culled_bytes, culled_only = _measure_python(c)
+    else:
+        used_memory, culled_bytes, culled_only = memory.NATIVE.measure(
+            spec.resources, c.trace.resources, spec.outputs, c.provider, c.culling.culled, spec.passes, spec.empty,
+            memory._SAME_BUFFER_FLAG)
+    return replace(c, memory=used_memory, culled_bytes=culled_bytes, culled_only=culled_only)
+
+
+def _measure_python(c: Compilation) -> tuple[dict[str, memory.ResourceMemory], dict[str, int],
+                                             dict[str, tuple[str, ...]]]:
+    """``measure``'s ``(memory, culled_bytes, culled_only)``: the Python reference (and the
+    path where ``rgraph/compiler/_memory.pyx`` is not built)."""
     assert c.culling is not None and c.trace is not None
     spec = c.spec
     traced = c.trace.resources
     used = {name: r.usages for name, r in traced.items()}
     spans = {name: (r.first, r.last) for name, r in traced.items()}
-    reqs = memory.requirements(spec.resources, used, spec.outputs, c.provider)
-    culled_only, culled_passes = _culled_only(spec, c.culling.culled, traced)
+    reqs = memory.requirements_python(spec.resources, used, spec.outputs, c.provider)
+    culled_only, culled_passes = _culled_only_python(spec, c.culling.culled, traced)
     culled_used = memory.usages_by_resource(culled_passes) if culled_passes else {}
     culled_used = {r: u for r, u in culled_used.items() if r not in traced}
-    culled_reqs = memory.requirements(spec.resources, culled_used, spec.outputs, c.provider) if culled_used else {}
-    return replace(c, memory=memory.resource_memory(reqs, used, spans),
-                   culled_bytes={r: 0 if r in spec.empty else q.bytes for r, q in culled_reqs.items()},
-                   culled_only=culled_only)
+    culled_reqs = memory.requirements_python(spec.resources, culled_used, spec.outputs, c.provider) if culled_used else {}
+    return (memory.resource_memory_python(reqs, used, spans),
+            {r: 0 if r in spec.empty else q.bytes for r, q in culled_reqs.items()}, culled_only)
 
 
 def _culled_only(spec: Spec, culled: Sequence[Culled], traced: Mapping[str, object]
@@ -164,10 +179,15 @@ def place(c: Compilation) -> Compilation:
     """Heaps and offsets: transients by the allocator policy (may alias), others dedicated."""
     try:
         resources = c.spec.resources
-        aliasable = [n for n in c.memory if resources[n].lifetime == "transient"]
         assert c.trace is not None
+        if memory.NATIVE is None:
+            aliasable = [n for n in c.memory if resources[n].lifetime == "transient"]
+            split = None
+        else:  # the same list, and place_resources' split, in one pass
+            aliasable, kept_apart, rest = memory.NATIVE.split_transients(resources, c.memory, c.spec.outputs)
+            split = (kept_apart, rest)
         conflicts = cross_queue_conflicts(c.passes, c.trace, aliasable)
-        placement = memory.place_resources(c.spec.resources, c.memory, c.policy, c.spec.outputs, conflicts)
+        placement = memory.place_resources(resources, c.memory, c.policy, c.spec.outputs, conflicts, split)
     except ValueError as exc:
         raise RGraphError.in_file("<command line>", f"--policy: {exc}") from None
     return replace(c, placement=placement, aliases=memory.alias_sources(placement, c.memory))

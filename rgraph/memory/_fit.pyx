@@ -17,6 +17,33 @@ one instance's arrays, made once per ``Instance`` (``greedy.native_flat``)."""
 from libc.stdlib cimport calloc, free, malloc, qsort, realloc
 from libc.string cimport memmove
 
+include "_sort.pxi"
+from cpython.object cimport PyObject
+
+cdef extern from "Python.h":
+    PyObject *PyDict_GetItemWithError(object d, object key) except? NULL
+    object PyObject_GenericGetDict(object o, void *context)
+
+from rgraph.memory.model import Block
+
+
+cdef inline object block_dict(b):
+    """The ``__dict__`` of ``b`` where it is exactly a ``Block`` (its fields are read from it
+    directly: ``Block`` has no data descriptor, so that is what ``getattr`` finds), else None."""
+    if type(b) is Block:
+        return PyObject_GenericGetDict(b, NULL)
+    return None
+
+
+cdef inline object field(b, d, str key):
+    """``getattr(b, key)``, read from ``d`` (``block_dict(b)``) where it holds ``key``."""
+    cdef PyObject *v
+    if d is not None:
+        v = PyDict_GetItemWithError(d, key)
+        if v != NULL:
+            return <object> v
+    return getattr(b, key)
+
 ctypedef long long i64
 
 #: Sizes plus alignments must stay below this (offsets and tops then fit in 64 bits).
@@ -323,6 +350,7 @@ def conflict_matrix(start, end, names, conflicts):
     import numpy as np
 
     cdef Py_ssize_t n = len(start), i, j, k, count = 0, room = 64
+    cdef i64 si, ei
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef Py_ssize_t *pairs = <Py_ssize_t *> malloc(2 * room * sizeof(Py_ssize_t))
@@ -366,9 +394,11 @@ def conflict_matrix(start, end, names, conflicts):
             m = matrix
             adj = &m[0, 0]
             with nogil:
-                for i in range(n):
+                for i in range(n):  # (bitwise, not short-circuit: no branch to mispredict)
+                    si, ei = s[i], e[i]
                     for j in range(n):
-                        adj[i * n + j] = s[i] <= e[j] and e[i] >= s[j] and i != j
+                        adj[i * n + j] = (si <= e[j]) & (ei >= s[j])
+                    adj[i * n + i] = 0
                 for k in range(count):
                     if not adj[pairs[2 * k] * n + pairs[2 * k + 1]]:
                         separable = False
@@ -421,22 +451,24 @@ def class_arrays(list blocks):
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *z = <i64 *> malloc(max(n, 1) * sizeof(i64))
-    cdef i64 *coords = <i64 *> malloc(max(2 * n, 1) * sizeof(i64))
+    cdef i64 *coords_buf = <i64 *> malloc(2 * max(2 * n, 1) * sizeof(i64))  # the coordinates and a spare
+    cdef i64 *coords = coords_buf
     cdef i64 *diff = NULL
     cdef i64 total = 0, run = 0
     cdef Py_ssize_t *lo = <Py_ssize_t *> malloc(max(n, 1) * sizeof(Py_ssize_t))
     cdef Py_ssize_t *hi = <Py_ssize_t *> malloc(max(n, 1) * sizeof(Py_ssize_t))
     cdef list start = [], end = [], size = [], align = [], sec_lo = [], sec_hi = [], totals = []
     try:
-        if not (s and e and z and coords and lo and hi):
+        if not (s and e and z and coords_buf and lo and hi):
             raise MemoryError()
         for i in range(n):
             b = blocks[i]
-            x, y, w = b.start, b.end, b.aligned_size
+            d = block_dict(b)
+            x, y, w = field(b, d, "start"), field(b, d, "end"), field(b, d, "aligned_size")
             start.append(x)
             end.append(y)
             size.append(w)
-            align.append(b.alignment)
+            align.append(field(b, d, "alignment"))
             s[i], e[i], z[i] = x, y, w  # OverflowError past 64 bits
             if not (-LIMIT < s[i] < LIMIT and -LIMIT < e[i] < LIMIT and 0 <= z[i] < LIMIT):
                 raise OverflowError("times and sizes must be within 2**62")
@@ -445,7 +477,7 @@ def class_arrays(list blocks):
                 raise OverflowError("sizes sum past 2**62")
             coords[2 * i], coords[2 * i + 1] = s[i], e[i] + 1
         if n:
-            qsort(coords, 2 * n, sizeof(i64), by_i64)
+            coords = sort_i64(coords_buf, coords_buf + max(2 * n, 1), 2 * n)
             m = 1
             for i in range(1, 2 * n):
                 if coords[i] != coords[m - 1]:
@@ -470,7 +502,7 @@ def class_arrays(list blocks):
         free(s)
         free(e)
         free(z)
-        free(coords)
+        free(coords_buf)
         free(diff)
         free(lo)
         free(hi)
@@ -484,23 +516,26 @@ def class_groups(list blocks):
     cdef Py_ssize_t n = len(blocks), i, k, g
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
-    cdef i64 *ss = <i64 *> malloc(max(n, 1) * sizeof(i64))
-    cdef i64 *es = <i64 *> malloc(max(n, 1) * sizeof(i64))
+    cdef i64 *ss_buf = <i64 *> malloc(2 * max(n, 1) * sizeof(i64))  # starts and a spare
+    cdef i64 *es_buf = <i64 *> malloc(2 * max(n, 1) * sizeof(i64))
+    cdef i64 *ss = ss_buf
+    cdef i64 *es = es_buf
     cdef i64 pairs
     cdef set seen = set()
     cdef dict groups = {}, at = {}, out = {}
     cdef list members, where
     try:
-        if not (s and e and ss and es):
+        if not (s and e and ss_buf and es_buf):
             raise MemoryError()
         for i in range(n):
             b = blocks[i]
-            name = b.name
+            d = block_dict(b)
+            name = field(b, d, "name")
             if name in seen:
                 return None
             seen.add(name)
-            x, y = b.start, b.end
-            if x > y or b.size < 0 or b.alignment < 1:
+            x, y = field(b, d, "start"), field(b, d, "end")
+            if x > y or field(b, d, "size") < 0 or field(b, d, "alignment") < 1:
                 return None
             try:
                 s[i], e[i] = x, y
@@ -508,7 +543,7 @@ def class_groups(list blocks):
                 return None
             if not (-LIMIT < s[i] < LIMIT and -LIMIT < e[i] < LIMIT):
                 return None
-            cls = b.memory_class
+            cls = field(b, d, "memory_class")
             members = groups.get(cls)
             if members is None:
                 members = groups[cls] = []
@@ -522,14 +557,15 @@ def class_groups(list blocks):
             bytes_ = 0
             for k in range(g):
                 i = where[k]
-                ss[k], es[k] = s[i], e[i]
+                ss_buf[k], es_buf[k] = s[i], e[i]
                 b = members[k]
-                a = b.alignment
+                d = block_dict(b)
+                a = field(b, d, "alignment")
                 if top is None or a > top:
                     top = a
-                bytes_ += b.aligned_size
-            qsort(ss, g, sizeof(i64), by_i64)
-            qsort(es, g, sizeof(i64), by_i64)
+                bytes_ += field(b, d, "aligned_size")
+            ss = sort_i64(ss_buf, ss_buf + max(n, 1), g)
+            es = sort_i64(es_buf, es_buf + max(n, 1), g)
             pairs = 0
             for k in range(g):  # j overlaps i: start_j <= end_i, less those with end_j < start_i
                 i = where[k]
@@ -539,8 +575,8 @@ def class_groups(list blocks):
     finally:
         free(s)
         free(e)
-        free(ss)
-        free(es)
+        free(ss_buf)
+        free(es_buf)
 
 
 cdef struct Key:

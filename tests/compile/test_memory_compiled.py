@@ -77,6 +77,11 @@ def test_place_resources_compiled_loops_match_python(seed: int, monkeypatch: pyt
     aliasable, rest = memory.NATIVE.split(resources, mem, outputs)
     assert aliasable == [n for n in sorted(mem) if resources[n].lifetime == "transient" and n not in outputs]
     assert rest == sorted(set(mem) - set(aliasable))
+    transients = [n for n in mem if resources[n].lifetime == "transient"]
+    for order in (mem, dict(sorted(mem.items()))):  # names out of order, then in name order
+        want = [n for n in order if resources[n].lifetime == "transient"]
+        assert memory.NATIVE.split_transients(resources, order, outputs) == (want, aliasable, rest)
+    assert sorted(transients) == sorted(set(aliasable) | (set(transients) & set(outputs)))
     native = memory.place_resources(resources, mem, "aliased", outputs)
     monkeypatch.setattr(memory, "NATIVE", None)
     python = memory.place_resources(resources, mem, "aliased", outputs)
@@ -85,3 +90,91 @@ def test_place_resources_compiled_loops_match_python(seed: int, monkeypatch: pyt
     assert native.stats.peak_bytes == python.stats.peak_bytes
     assert native.stats.allocations == python.stats.allocations
     assert native.stats.lower_bound_bytes == python.stats.lower_bound_bytes
+
+
+@pytest.mark.parametrize("seed", [1, 7, 23, 99])
+def test_compiled_measure_matches_python(tmp_path: Path, seed: int) -> None:
+    """``_memory.measure`` (the whole measure phase compiled) against ``phases._measure_python``:
+    the same values in the same key order, on random graphs with culled passes and outputs."""
+    from rgraph.compiler import phases
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=150)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    python = phases._measure_python(c)
+    native = memory.NATIVE.measure(spec.resources, c.trace.resources, spec.outputs, c.provider, c.culling.culled,
+                                   spec.passes, spec.empty, memory._SAME_BUFFER_FLAG)
+    for got, want in zip(native, python, strict=True):
+        assert got == want and list(got) == list(want)
+    assert [type(m) for m in native[0].values()] == [memory.ResourceMemory] * len(native[0])
+
+
+def test_compiled_culled_only_finds_names_by_value_too(tmp_path: Path) -> None:
+    """The compiled ``culled_only`` finds passes and traced resources by the address of their
+    names; equal names in other string objects, and passes of another type, are found by value."""
+    from types import SimpleNamespace
+
+    from rgraph.compiler import phases
+    from rgraph.ir.cull import Culled
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=5, passes=150)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    culled, traced = c.culling.culled, c.trace.resources
+    want = phases._culled_only_python(spec, culled, traced)
+    assert want[0], "the graph should have culled-only resources"
+    copied = [Culled("".join(list(x.pass_name)), x.reason) for x in culled]  # equal, not the same object
+    assert all(a.pass_name is not b.pass_name for a, b in zip(copied, culled, strict=True))
+    retraced = {"".join(list(name)): r for name, r in traced.items()}
+    for args in [(spec.passes, culled, traced), (spec.passes, copied, traced), (spec.passes, culled, retraced),
+                 ([SimpleNamespace(name=p.name, accesses=p.accesses) for p in spec.passes], culled, traced)]:
+        got = memory.NATIVE.culled_only(*args)
+        assert got[0] == want[0] and list(got[0]) == list(want[0])
+        assert [p.name for p in got[1]] == [p.name for p in want[1]]
+
+
+@pytest.mark.parametrize("seed", [3, 11, 1000])
+def test_compiled_cross_queue_conflicts_match_python(tmp_path: Path, seed: int) -> None:
+    """``_queue_order.cross_queue_conflicts`` against the Python code: the same pairs, the
+    same keys in the same order, each set filled in the same order."""
+    from rgraph.compiler import queue_order
+
+    if queue_order.NATIVE is None:
+        pytest.skip("compiled accelerators not built")
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=400)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    candidates = [n for n in c.memory if spec.resources[n].lifetime == "transient"]
+    for names in (candidates, candidates[::-1]):
+        want = queue_order.cross_queue_conflicts_python(c.passes, c.trace, names)
+        got = queue_order.NATIVE.cross_queue_conflicts(c.passes, c.trace, names)
+        assert want, "the graph should have cross-queue pairs"
+        assert got == want and list(got) == list(want)
+        assert all(list(got[k]) == list(want[k]) for k in want)
+    one_queue = [p for p in c.passes if p.queue == c.passes[0].queue]
+    assert queue_order.NATIVE.cross_queue_conflicts(one_queue, c.trace, candidates) == {}
+
+
+@pytest.mark.parametrize("seed", [2, 1000])
+def test_compiled_alias_sources_match_python(tmp_path: Path, seed: int) -> None:
+    """``_memory.alias_sources`` against ``alias_sources_python``: the same sources in the
+    same order, with a heap's names in name order (as placements list them) and shuffled."""
+    import random
+
+    from rgraph.memory.model import Placement
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=seed, passes=400)))
+    c = compilation(frontend(path, size=(16, 16)).spec)
+    placement = c.placement
+    items = list(placement.offsets.items())
+    random.Random(seed).shuffle(items)
+    for offsets in (placement.offsets, dict(items)):
+        p = Placement(offsets, placement.heaps, placement.stats)
+        want = memory.alias_sources_python(p, c.memory)
+        got = memory.NATIVE.alias_sources(p, c.memory)
+        assert want, "the graph should alias"
+        assert got == want and list(got) == list(want)

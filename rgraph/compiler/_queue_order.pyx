@@ -51,6 +51,15 @@ cdef struct Row:
     i64 k  # the resource's rank in name order
 
 
+cdef void *_grown(void *p, size_t size) except NULL:
+    """``p`` reallocated to ``size`` bytes (MemoryError where that fails: ``p`` is then still
+    the caller's to free)."""
+    cdef void *grown = realloc(p, size)
+    if grown == NULL:
+        raise MemoryError()
+    return grown
+
+
 cdef Py_ssize_t _queue(list qs, q) except -1:
     """The index of ``q`` in ``qs`` (by address, then by value), appended where absent."""
     cdef Py_ssize_t i, n = len(qs)
@@ -164,10 +173,7 @@ cdef object _conflicts(trace, candidates):
                 first, end = uses[0], uses[len(uses) - 1]
                 if nentries == eroom:
                     eroom *= 2
-                    grown = realloc(entry_q, eroom * sizeof(i64))
-                    if grown == NULL:
-                        raise MemoryError()
-                    entry_q = <i64 *> grown
+                    entry_q = <i64 *> _grown(entry_q, eroom * sizeof(i64))
                 qi = _queue(qs, first[3])
                 if qi >= MAX_QUEUES:
                     return None
@@ -196,10 +202,7 @@ cdef object _conflicts(trace, candidates):
                     row_queues.append(qs[qi])
                 if nrows == room:
                     room *= 2
-                    grown = realloc(rows, room * sizeof(Row))
-                    if grown == NULL:
-                        raise MemoryError()
-                    rows = <Row *> grown
+                    rows = <Row *> _grown(rows, room * sizeof(Row))
                 rows[nrows].q, rows[nrows].j, rows[nrows].k = row_of[qi], permax[i], k
                 nrows += 1
         nq = len(row_queues)

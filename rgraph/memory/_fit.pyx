@@ -157,7 +157,7 @@ cdef inline i64 align_up(i64 x, i64 a) noexcept nogil:
 cdef int place(Flat flat, const int *order, int count, i64 limit, i64 *offsets) noexcept nogil:
     """Best fit of ``order[:count]`` into ``offsets`` (all -1 on entry); 1 if given up at
     ``limit`` (negative: never), -1 out of memory, else 0."""
-    cdef int n = flat.n, i, j, k, e, placed = 0, lo_k, hi_k, mid, deg, found
+    cdef int n = flat.n, i, j, k, e, placed = 0, lo_k, deg, found
     cdef const i64 *size = flat.size
     cdef const i64 *align = flat.align
     cdef const int *ptr = flat.nbr_ptr
@@ -231,13 +231,7 @@ cdef int place(Flat flat, const int *order, int count, i64 limit, i64 *offsets) 
                 break
             offsets[i] = off
             if dense:  # insert after the last entry at or below off
-                lo_k, hi_k = 0, placed
-                while lo_k < hi_k:
-                    mid = (lo_k + hi_k) >> 1
-                    if e_lo[mid] <= off:
-                        lo_k = mid + 1
-                    else:
-                        hi_k = mid
+                lo_k = upper_bound(e_lo, placed, off)
                 memmove(e_lo + lo_k + 1, e_lo + lo_k, (placed - lo_k) * sizeof(i64))
                 memmove(e_hi + lo_k + 1, e_hi + lo_k, (placed - lo_k) * sizeof(i64))
                 memmove(e_blk + lo_k + 1, e_blk + lo_k, (placed - lo_k) * sizeof(int))
@@ -413,11 +407,6 @@ def conflict_matrix(start, end, names, conflicts):
         free(pairs)
 
 
-cdef int by_i64(const void *a, const void *b) noexcept nogil:
-    cdef i64 x = (<const i64 *> a)[0], y = (<const i64 *> b)[0]
-    return (x > y) - (x < y)
-
-
 cdef Py_ssize_t lower_bound(const i64 *a, Py_ssize_t n, i64 x) noexcept nogil:
     """The first index of ``a`` (ascending) holding ``x`` or more."""
     cdef Py_ssize_t lo = 0, hi = n, mid
@@ -579,78 +568,13 @@ def class_groups(list blocks):
         free(es_buf)
 
 
-cdef struct Key:
-    i64 a  # most significant
-    i64 b
-    Py_ssize_t i  # ties: by index (np.lexsort is stable)
-
-
-cdef int by_key(const void *x, const void *y) noexcept nogil:
-    cdef const Key *p = <const Key *> x
-    cdef const Key *q = <const Key *> y
-    if p.a != q.a:
-        return (p.a > q.a) - (p.a < q.a)
-    if p.b != q.b:
-        return (p.b > q.b) - (p.b < q.b)
-    return (p.i > q.i) - (p.i < q.i)
-
-
-cdef inline bint key_less(const Key *p, const Key *q) noexcept nogil:
-    if p.a != q.a:
-        return p.a < q.a
-    if p.b != q.b:
-        return p.b < q.b
-    return p.i < q.i
-
-
-cdef list sorted_by(Key *keys, Key *spare, Py_ssize_t n):
-    """The indices of ``keys`` sorted by (a, b, index): a merge sort (runs of 8 by insertion)
-    with the comparison inlined (``qsort``'s call per comparison cost more than the rest)."""
-    cdef Py_ssize_t k, j, width, lo, mid, hi, x, y, o
-    cdef Key item
-    cdef Key *src = keys
-    cdef Key *dst = spare
-    cdef Key *swap
+cdef list sorted_by(Triple *keys, Triple *spare, Py_ssize_t n):
+    """The indices ``c`` of ``keys`` sorted by (a, b, c): ``sort_triples`` (``c``: the index,
+    so ties go by index, as np.lexsort's stable sort has them)."""
+    cdef Triple *done
     with nogil:
-        lo = 0
-        while lo < n:
-            hi = min(lo + 8, n)
-            for k in range(lo + 1, hi):
-                item = src[k]
-                j = k
-                while j > lo and key_less(&item, &src[j - 1]):
-                    src[j] = src[j - 1]
-                    j -= 1
-                src[j] = item
-            lo = hi
-        width = 8
-        while width < n:
-            lo = 0
-            while lo < n:
-                mid, hi = min(lo + width, n), min(lo + 2 * width, n)
-                x, y, o = lo, mid, lo
-                while x < mid and y < hi:
-                    if key_less(&src[y], &src[x]):
-                        dst[o] = src[y]
-                        y += 1
-                    else:
-                        dst[o] = src[x]
-                        x += 1
-                    o += 1
-                while x < mid:
-                    dst[o] = src[x]
-                    x += 1
-                    o += 1
-                while y < hi:
-                    dst[o] = src[y]
-                    y += 1
-                    o += 1
-                lo = hi
-            swap = src
-            src = dst
-            dst = swap
-            width *= 2
-    return [src[k].i for k in range(n)]
+        done = sort_triples(keys, spare, n)
+    return [done[k].c for k in range(n)]
 
 
 def orderings(start, end, size, sec_lo, sec_hi, totals):
@@ -664,8 +588,8 @@ def orderings(start, end, size, sec_lo, sec_hi, totals):
     cdef i64 *w = <i64 *> malloc(max(n, 1) * sizeof(i64))  # minus the width
     cdef i64 *area = <i64 *> malloc(max(n, 1) * sizeof(i64))  # minus the area
     cdef i64 *peak = <i64 *> malloc(max(n, 1) * sizeof(i64))  # minus the contention
-    cdef Key *keys = <Key *> malloc(2 * max(n, 1) * sizeof(Key))
-    cdef Key *spare = keys + max(n, 1)
+    cdef Triple *keys = <Triple *> malloc(2 * max(n, 1) * sizeof(Triple))
+    cdef Triple *spare = keys + max(n, 1)
     cdef i64 e, top, width
     cdef Py_ssize_t lo, hi, count = len(totals)
     cdef i64 *tot = <i64 *> malloc(max(count, 1) * sizeof(i64))
@@ -696,22 +620,22 @@ def orderings(start, end, size, sec_lo, sec_hi, totals):
                     top = tot[s]
             peak[i] = -top
         for i in range(n):
-            keys[i].a, keys[i].b, keys[i].i = -z[i], s_[i], i
+            keys[i].a, keys[i].b, keys[i].c = -z[i], s_[i], i
         out.append(sorted_by(keys, spare, n))  # size
         for i in range(n):
-            keys[i].a, keys[i].b, keys[i].i = area[i], 0, i
+            keys[i].a, keys[i].b, keys[i].c = area[i], 0, i
         out.append(sorted_by(keys, spare, n))  # area
         for i in range(n):
-            keys[i].a, keys[i].b, keys[i].i = w[i], -z[i], i
+            keys[i].a, keys[i].b, keys[i].c = w[i], -z[i], i
         out.append(sorted_by(keys, spare, n))  # length
         for i in range(n):
-            keys[i].a, keys[i].b, keys[i].i = s_[i], -z[i], i
+            keys[i].a, keys[i].b, keys[i].c = s_[i], -z[i], i
         out.append(sorted_by(keys, spare, n))  # start
         for i in range(n):
-            keys[i].a, keys[i].b, keys[i].i = peak[i], area[i], i
+            keys[i].a, keys[i].b, keys[i].c = peak[i], area[i], i
         out.append(sorted_by(keys, spare, n))  # contention
         for i in range(n):
-            keys[i].a, keys[i].b, keys[i].i = peak[i], -z[i], i
+            keys[i].a, keys[i].b, keys[i].c = peak[i], -z[i], i
         out.append(sorted_by(keys, spare, n))  # contention_size
         return out
     finally:

@@ -7,8 +7,41 @@ instead of through its builder. Any change to the Python code must be made here 
 from rgraph.plan import model as pm
 
 include "../plan/_slots.pxi"
+include "../plan/_spec_slots.pxi"
 
-cdef Slots PASS = Slots(pm.PlanPass, ("name", "index", "device", "queue", "kind", "impl", "params", "accesses",
+from rgraph.compiler.memory import ResourceMemory
+from rgraph.spec.specialize import ResourceSpec
+
+cdef object RESOURCE_SPEC = ResourceSpec
+cdef object RESOURCE_MEMORY = ResourceMemory
+#: Every field named (only read here): name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6,
+#: samples 7, bytes 8, loc 9, geometry 10, accel 11, scratch_of 12.
+cdef Slots RES = Slots(ResourceSpec, tuple(f.name for f in _dataclasses.fields(ResourceSpec)))
+#: bytes 0, alignment 1, memory_type_bits 2, memory_class 3, usages 4, first 5, last 6.
+cdef Slots MEM = Slots(ResourceMemory, tuple(f.name for f in _dataclasses.fields(ResourceMemory)))
+cdef tuple _RES_NAMES = ("name", "kind", "lifetime", "format", "extent", "layers", "mips", "samples", "bytes", "loc",
+                         "geometry", "accel", "scratch_of")
+cdef tuple _MEM_NAMES = ("bytes", "alignment", "memory_type_bits", "memory_class", "usages", "first", "last")
+if tuple(f.name for f in _dataclasses.fields(ResourceSpec)) != _RES_NAMES:
+    raise TypeError(f"ResourceSpec: fields {_RES_NAMES} expected")
+if tuple(f.name for f in _dataclasses.fields(ResourceMemory)) != _MEM_NAMES:
+    raise TypeError(f"ResourceMemory: fields {_MEM_NAMES} expected")
+
+
+cdef inline object res_field(object r, Py_ssize_t k):
+    """Field ``k`` of resource ``r`` (from its slot where it is a ``ResourceSpec``)."""
+    if type(r) is RESOURCE_SPEC:
+        return get(r, RES, k)
+    return getattr(r, <str> _RES_NAMES[k])
+
+
+cdef inline object mem_field(object m, Py_ssize_t k):
+    """Field ``k`` of ``ResourceMemory`` ``m`` (the same, for ``_MEM_NAMES``)."""
+    if type(m) is RESOURCE_MEMORY:
+        return get(m, MEM, k)
+    return getattr(m, <str> _MEM_NAMES[k])
+
+cdef Slots PLAN_PASS = Slots(pm.PlanPass, ("name", "index", "device", "queue", "kind", "impl", "params", "accesses",
                                      "barriers", "releases", "waits", "signals"))
 cdef Slots RESOURCE = Slots(pm.PlanResource, (
     "name", "kind", "format", "bytes", "size_bytes", "alignment", "memory_type_bits", "memory_class", "usages",
@@ -27,29 +60,29 @@ def passes(list passes, list accesses, barriers, releases, waits, signals, signa
         raise ValueError("zip() argument 2 is shorter or longer than argument 1")
     for i in range(n):
         p = passes[i]
-        params = p.params
-        queue = p.queue
-        value = new_slots(PASS)
-        put(value, PASS, 0, p.name)
-        put(value, PASS, 1, i)
-        put(value, PASS, 2, 0)
-        put(value, PASS, 3, queue)
-        put(value, PASS, 4, p.kind)
-        put(value, PASS, 5, p.impl)
-        put(value, PASS, 6, frozen(params) if params else EMPTY)
+        params = pass_field(p, 8, "params")
+        queue = pass_field(p, 3, "queue")
+        value = new_slots(PLAN_PASS)
+        put(value, PLAN_PASS, 0, pass_field(p, 0, "name"))
+        put(value, PLAN_PASS, 1, i)
+        put(value, PLAN_PASS, 2, 0)
+        put(value, PLAN_PASS, 3, queue)
+        put(value, PLAN_PASS, 4, pass_field(p, 2, "kind"))
+        put(value, PLAN_PASS, 5, pass_field(p, 4, "impl"))
+        put(value, PLAN_PASS, 6, frozen(params) if params else EMPTY)
         found = accesses[i]  # a tuple from the compiled trace (kept), a list from the Python one
-        put(value, PASS, 7, found if type(found) is tuple else tuple(found))
-        put(value, PASS, 8, barriers[i])
-        put(value, PASS, 9, releases[i])
-        put(value, PASS, 10, waits[i])
+        put(value, PLAN_PASS, 7, found if type(found) is tuple else tuple(found))
+        put(value, PLAN_PASS, 8, barriers[i])
+        put(value, PLAN_PASS, 9, releases[i])
+        put(value, PLAN_PASS, 10, waits[i])
         if signals[i]:
             signal = new_slots(SIGNAL)
             put(signal, SIGNAL, 0, queue)
             put(signal, SIGNAL, 1, signal_values[i])
             put(signal, SIGNAL, 2, signal_stages)
-            put(value, PASS, 11, (signal,))
+            put(value, PLAN_PASS, 11, (signal,))
         else:
-            put(value, PASS, 11, ())
+            put(value, PLAN_PASS, 11, ())
         out.append(value)
     return tuple(out)
 
@@ -60,42 +93,42 @@ def resources(resources, memory, set outputs, initial, final, offsets, frozen_js
     for name in sorted(memory):
         res, mem = resources[name], memory[name]
         heap, offset = offsets[name]
-        lifetime = res.lifetime
-        if name in outputs and lifetime == "transient":
+        lifetime = res_field(res, 2)
+        if lifetime == "transient" and name in outputs:
             lifetime = "output"
-        fmt = res.format
-        accel = res.accel
-        kind = res.kind
+        fmt = res_field(res, 3)
+        accel = res_field(res, 11)
+        kind = res_field(res, 1)
         value = new_slots(RESOURCE)
         put(value, RESOURCE, 0, name)
         put(value, RESOURCE, 1, kind)
-        put(value, RESOURCE, 2, fmt.vk_name if fmt else None)
-        put(value, RESOURCE, 3, mem.bytes)
-        put(value, RESOURCE, 5, mem.alignment)
-        put(value, RESOURCE, 6, mem.memory_type_bits)
-        put(value, RESOURCE, 7, mem.memory_class)
-        put(value, RESOURCE, 8, mem.usages)
+        put(value, RESOURCE, 2, fmt.vk_name if fmt is not None else None)
+        put(value, RESOURCE, 3, mem_field(mem, 0))
+        put(value, RESOURCE, 5, mem_field(mem, 1))
+        put(value, RESOURCE, 6, mem_field(mem, 2))
+        put(value, RESOURCE, 7, mem_field(mem, 3))
+        put(value, RESOURCE, 8, mem_field(mem, 4))
         put(value, RESOURCE, 9, lifetime)
-        put(value, RESOURCE, 10, mem.first)
-        put(value, RESOURCE, 11, mem.last)
+        put(value, RESOURCE, 10, mem_field(mem, 5))
+        put(value, RESOURCE, 11, mem_field(mem, 6))
         put(value, RESOURCE, 12, heap)
         put(value, RESOURCE, 13, offset)
         put(value, RESOURCE, 14, initial.get(name))
         put(value, RESOURCE, 15, final.get(name))
         if kind == "image":
             put(value, RESOURCE, 4, None)
-            put(value, RESOURCE, 16, tuple(res.extent))
-            put(value, RESOURCE, 17, res.mips)
-            put(value, RESOURCE, 18, res.layers)
-            put(value, RESOURCE, 19, res.samples)
+            put(value, RESOURCE, 16, tuple(res_field(res, 4)))
+            put(value, RESOURCE, 17, res_field(res, 6))
+            put(value, RESOURCE, 18, res_field(res, 5))
+            put(value, RESOURCE, 19, res_field(res, 7))
         else:
-            put(value, RESOURCE, 4, res.bytes)
+            put(value, RESOURCE, 4, res_field(res, 8))
             put(value, RESOURCE, 16, None)
             put(value, RESOURCE, 17, None)
             put(value, RESOURCE, 18, None)
             put(value, RESOURCE, 19, None)
         put(value, RESOURCE, 20, frozen_json(accel.as_plan()) if accel is not None else None)
-        put(value, RESOURCE, 21, res.scratch_of)
+        put(value, RESOURCE, 21, res_field(res, 12))
         out.append(value)
     return tuple(out)
 

@@ -3,7 +3,7 @@
     .venv/bin/python benchmarks/compile_scaling.py [--sizes 250,1000,4000,16000] [--policy aliased]
         [--chain 10000] [--side-effects 5000] [--phases] [--repeats N]
 
-Prints one row per size and the growth exponent fitted on log(time) vs log(passes) (of the
+Prints one row per size (wall median, CPU minimum and median) and the growth exponent fitted on log(time) vs log(passes) (of the
 wall medians and of the minimum CPU times: on a shared machine the second is steadier), then
 two structured graphs: a chain (pass i reads buffer b_i and writes b_{i+1}: every buffer
 reuses the memory of the one before) and one with N side-effect buffers (each written by
@@ -29,9 +29,9 @@ from rgraph.random_graph import random_graph, to_yaml  # noqa: E402
 from rgraph.spec.specialize import Spec  # noqa: E402
 
 
-def timed(spec: Spec, policy: str, repeats: int) -> tuple[float, float, Plan]:
-    """Median wall time and minimum CPU time (process time: less disturbed by other jobs on a
-    shared machine) of ``repeats`` compiles of ``spec``, and the plan."""
+def timed(spec: Spec, policy: str, repeats: int) -> tuple[float, float, float, Plan]:
+    """Median wall time, minimum CPU time and median CPU time (process time: less disturbed by
+    other jobs on a shared machine) of ``repeats`` compiles of ``spec``, and the plan."""
     wall, cpu = [], []
     plan = None
     for _ in range(repeats):
@@ -40,7 +40,7 @@ def timed(spec: Spec, policy: str, repeats: int) -> tuple[float, float, Plan]:
         wall.append(time.perf_counter() - start)
         cpu.append(time.process_time() - start_cpu)
     assert plan is not None
-    return statistics.median(wall), min(cpu), plan
+    return statistics.median(wall), min(cpu), statistics.median(cpu), plan
 
 
 def phase_times(spec: Spec, policy: str, repeats: int) -> dict[str, float]:
@@ -89,14 +89,14 @@ def phases_line(spec: Spec, policy: str, repeats: int) -> str:
         f" (of place: placement search {search * 1e3:.1f})"
 
 
-def measure(passes: int, policy: str, repeats: int) -> tuple[float, float, int, int, Spec]:
+def measure(passes: int, policy: str, repeats: int) -> tuple[float, float, float, int, int, Spec]:
     graph = random_graph(seed=passes, passes=passes)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "g.yaml"
         path.write_text(to_yaml(graph))
         spec = frontend(path, size=(16, 16)).spec
-    median, cpu, plan = timed(spec, policy, repeats)
-    return median, cpu, len(plan.passes), plan.stats.barriers, spec
+    median, cpu, median_cpu, plan = timed(spec, policy, repeats)
+    return median, cpu, median_cpu, len(plan.passes), plan.stats.barriers, spec
 
 
 def chain_yaml(count: int) -> str:
@@ -126,7 +126,7 @@ def measure_text(text: str, policy: str, repeats: int) -> tuple[float, float, in
         path = Path(tmp) / "g.yaml"
         path.write_text(text)
         spec = frontend(path, size=(16, 16)).spec
-    median, cpu, plan = timed(spec, policy, repeats)
+    median, cpu, _, plan = timed(spec, policy, repeats)
     return median, cpu, len(plan.passes), spec
 
 
@@ -204,12 +204,14 @@ def main() -> None:
     args = parser.parse_args()
     sizes = [int(s) for s in args.sizes.split(",")]
     rows = []
-    print(f"{'passes':>8} {'executed':>9} {'barriers':>9} {'median ms':>10} {'us/pass':>8} {'min cpu ms':>11}")
+    print(f"{'passes':>8} {'executed':>9} {'barriers':>9} {'median ms':>10} {'us/pass':>8} {'min cpu ms':>11}"
+          f" {'median cpu ms':>14}")
     for n in sizes:
         repeats = args.repeats or max(3, min(15, 16000 // n))
-        median, cpu, executed, barriers, spec = measure(n, args.policy, repeats)
+        median, cpu, median_cpu, executed, barriers, spec = measure(n, args.policy, repeats)
         rows.append((n, median, cpu))
-        print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f} {cpu * 1e3:>11.1f}")
+        print(f"{n:>8} {executed:>9} {barriers:>9} {median * 1e3:>10.1f} {median / n * 1e6:>8.1f} {cpu * 1e3:>11.1f}"
+              f" {median_cpu * 1e3:>14.1f}")
         if args.phases:
             print(phases_line(spec, args.policy, repeats))
     if len(rows) > 1:

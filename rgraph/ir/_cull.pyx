@@ -133,6 +133,68 @@ cdef enum:
     _MAX_SIDE = 1 << 20  # more mips or layers in a resource: the same
 
 
+cdef extern from "Python.h":
+    PyObject *_list_item "PyList_GET_ITEM" (PyObject *l, Py_ssize_t k)  # borrowed
+    PyObject *_tuple_item "PyTuple_GET_ITEM" (PyObject *t, Py_ssize_t k)  # borrowed
+    Py_ssize_t _tuple_size "PyTuple_GET_SIZE" (PyObject *t)
+    PyObject *_type "(PyObject *) Py_TYPE" (PyObject *o)
+    void _prefetch "__builtin_prefetch" (const void *p)
+
+
+cdef inline PyObject *_slot(PyObject *o, Slots layout, Py_ssize_t k):
+    """Field ``k`` of ``o`` (exactly ``layout``'s class), borrowed; NULL where unset."""
+    return (<PyObject **> ((<char *> o) + layout.off[k]))[0]
+
+
+cdef inline PyObject *_accesses_of(list passes, Py_ssize_t x):
+    """Pass ``x``'s accesses tuple (borrowed), NULL where not an exact ``PassSpec``'s tuple."""
+    cdef PyObject *o = _list_item(<PyObject *> passes, x)
+    if _type(o) != <PyObject *> PASS_SPEC:
+        return NULL
+    o = _slot(o, PASS, 7)
+    if o == NULL or _type(o) != <PyObject *> tuple:
+        return NULL
+    return o
+
+
+cdef void _ahead(list passes, Py_ssize_t x):
+    """Prefetch what the backwards walk reads of the passes before ``x``: the chain pass ->
+    accesses tuple -> accesses -> their cells tuples -> cells, a step further back each pass
+    ahead, so that each pointer read was prefetched a pass earlier (the spec's objects are cold
+    when a compile starts)."""
+    cdef PyObject *o
+    cdef PyObject *a
+    cdef Py_ssize_t k, j
+    if x >= 5:
+        _prefetch(_list_item(<PyObject *> passes, x - 5))
+    if x >= 4:
+        o = _list_item(<PyObject *> passes, x - 4)
+        if _type(o) == <PyObject *> PASS_SPEC:
+            _prefetch(_slot(o, PASS, 7))
+    if x >= 3:
+        o = _accesses_of(passes, x - 3)
+        if o != NULL:
+            for k in range(_tuple_size(o)):
+                _prefetch(_tuple_item(o, k))
+    if x >= 2:
+        o = _accesses_of(passes, x - 2)
+        if o != NULL:
+            for k in range(_tuple_size(o)):
+                a = _tuple_item(o, k)
+                if _type(a) == <PyObject *> ACCESS_SPEC and _slot(a, SPEC, 9) != NULL:
+                    _prefetch(_slot(a, SPEC, 9))
+    if x >= 1:
+        o = _accesses_of(passes, x - 1)
+        if o != NULL:
+            for k in range(_tuple_size(o)):
+                a = _tuple_item(o, k)
+                if _type(a) == <PyObject *> ACCESS_SPEC:
+                    a = _slot(a, SPEC, 9)
+                    if a != NULL and _type(a) == <PyObject *> tuple:
+                        for j in range(_tuple_size(a)):
+                            _prefetch(_tuple_item(a, j))
+
+
 cdef inline object res_field(object r, Py_ssize_t k, str name):
     """Field ``k`` (named ``name``) of resource ``r``."""
     if type(r) is RESOURCE_SPEC:
@@ -247,6 +309,7 @@ def plain(spec, list passes, frozenset rw, culled_class):
         if t.state == NULL:
             raise MemoryError()
         for x in range(npasses - 1, -1, -1):
+            _ahead(passes, x)
             p = passes[x]
             live = pass_field(p, 6, "side_effects")
             accesses = <tuple> pass_field(p, 7, "accesses")

@@ -346,6 +346,100 @@ cdef void _sub_reset():
     _sub_keep.clear()
 
 
+# ---- barriers by (resource, subresource, src, dst, aliases) -------------------------------
+# A plan's barriers are frozen values: an equal one made earlier (this compile, or an earlier
+# compile of the same graph) is reused, which saves building it and freeing the old plan's.
+# The barriers are listed in the order made; a compile of the same graph asks for them in that
+# order again, so the one after the last found is tried before the hash index.
+
+cdef enum:
+    _BAR_CAP = 8192  # index slots (power of two)
+    _BAR_MAX = 4096  # barriers listed: the index at most half used
+
+cdef struct BarSlot:
+    Py_hash_t res_hash
+    PyObject *res  # the key: the barrier's own fields (it keeps them alive)
+    PyObject *sub
+    PyObject *src
+    PyObject *dst
+    PyObject *al
+    PyObject *barrier
+    PyObject *one  # (barrier,), a one-cell release's entry, once made; else NULL
+
+cdef BarSlot _bars[_BAR_MAX]  # in the order made
+cdef int _bar_index[_BAR_CAP]  # hash index: 1 + the barrier's place in ``_bars``; 0: free
+cdef BarSlot _unlisted  # a barrier made while the list is full (kept by the sink)
+cdef Py_ssize_t _bar_count = 0, _bar_next = 0  # listed barriers; the place to try first
+cdef list _bar_keep = []  # the barriers and one-tuples listed
+
+
+cdef inline bint _bar_is(BarSlot *slot, object res, object sub, object ps, object pd, object al) except -1:
+    return (slot.sub == <PyObject *> sub and slot.src == <PyObject *> ps and slot.dst == <PyObject *> pd
+            and _same(slot.res, res) and _same(slot.al, al))
+
+
+cdef BarSlot *_barrier(_Sink sink, object res, object sub, object ps, object pd, object al) except NULL:
+    """The slot of ``pm.Barrier(res, sub, ps, pd, al)``: ``sub``, ``ps`` and ``pd`` compared by
+    identity (interned: ``_sub``, ``_state``), the resource name and aliases by value."""
+    global _bar_count, _bar_next
+    cdef BarSlot *slot
+    cdef int found
+    if _bar_next < _bar_count and _bar_is(&_bars[_bar_next], res, sub, ps, pd, al):
+        _bar_next += 1
+        return &_bars[_bar_next - 1]
+    cdef Py_hash_t rh = hash(res)
+    cdef size_t h = <size_t> (<u64> rh * <u64> 0x9E3779B97F4A7C15 ^ ((<size_t> <PyObject *> sub >> 4) * 31)
+                              ^ ((<size_t> <PyObject *> ps >> 4) * 1000003) ^ (<size_t> <PyObject *> pd >> 4))
+    h &= _BAR_CAP - 1
+    while _bar_index[h]:
+        found = _bar_index[h] - 1
+        slot = &_bars[found]
+        if slot.res_hash == rh and _bar_is(slot, res, sub, ps, pd, al):
+            _bar_next = found + 1
+            return slot
+        h = (h + 1) & (_BAR_CAP - 1)
+    barrier = new_slots(BARRIER)
+    put(barrier, BARRIER, 0, res)
+    put(barrier, BARRIER, 1, sub)
+    put(barrier, BARRIER, 2, ps)
+    put(barrier, BARRIER, 3, pd)
+    put(barrier, BARRIER, 4, al)
+    if _bar_count >= _BAR_MAX:
+        sink.keep.append(barrier)
+        slot = &_unlisted
+    else:
+        _bar_keep.append(barrier)
+        slot = &_bars[_bar_count]
+        _bar_count += 1
+        _bar_index[h] = _bar_count
+        _bar_next = _bar_count
+    slot.res_hash = rh
+    slot.res, slot.sub, slot.src, slot.dst, slot.al = (<PyObject *> res, <PyObject *> sub, <PyObject *> ps,
+                                                       <PyObject *> pd, <PyObject *> al)
+    slot.barrier = <PyObject *> barrier
+    slot.one = NULL
+    return slot
+
+
+cdef PyObject *_one(_Sink sink, BarSlot *slot) except NULL:
+    """``(barrier,)`` of ``slot``'s barrier (kept with it)."""
+    if slot.one == NULL:
+        one = (<object> slot.barrier,)
+        if slot == &_unlisted:
+            sink.keep.append(one)
+        else:
+            _bar_keep.append(one)
+        slot.one = <PyObject *> one
+    return slot.one
+
+
+cdef void _bar_reset():
+    global _bar_count, _bar_next
+    memset(_bar_index, 0, sizeof(_bar_index))
+    _bar_count = _bar_next = 0
+    _bar_keep.clear()
+
+
 # ---- the cell walk on a C state ------------------------------------------------------------
 
 cdef inline object _end_state_of(CellState *st):
@@ -434,6 +528,7 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
     cdef GroupRec *gr
     cdef BarRec *b
     cdef RelRec *rr
+    cdef BarSlot *bs
     layout = <object> st.layout
     cq = <object> st.cq
     for k in range(n):
@@ -584,21 +679,13 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
             continue
         ps = _state(src_st, src_ac, key_src_layout, src_queue)
         pd = _state(dst_st, dst_ac, new_layout, queue)
-        barrier = new_slots(BARRIER)
-        put(barrier, BARRIER, 0, res)
-        put(barrier, BARRIER, 1, sub)
-        put(barrier, BARRIER, 2, ps)
-        put(barrier, BARRIER, 3, pd)
-        put(barrier, BARRIER, 4, key_aliases)
-        sink.keep.append(barrier)
+        bs = _barrier(sink, res, sub, ps, pd, key_aliases)
         b = sink.bar()
-        b.at, b.res, b.barrier = i, <PyObject *> res, <PyObject *> barrier
+        b.at, b.res, b.barrier = i, <PyObject *> res, bs.barrier
         b.m0 = b.m1 = b.l0 = b.l1 = 0
         if release_at >= 0:
-            made = (barrier,)
-            sink.keep.append(made)
             rr = sink.rel()
-            rr.at, rr.i, rr.res, rr.pos, rr.made = release_at, i, <PyObject *> res, pos, <PyObject *> made
+            rr.at, rr.i, rr.res, rr.pos, rr.made = release_at, i, <PyObject *> res, pos, _one(sink, bs)
     st.layout = <PyObject *> layout
     st.cq = <PyObject *> cq
     st.has_write, st.w_st, st.w_ac = has_write, w_st, w_ac
@@ -712,13 +799,7 @@ cdef int _rect(_Sink sink, GroupRec *gr, object res, long m0, long m1, long l0, 
                list made) except -1:
     """The barrier of one rectangle of group ``gr``."""
     cdef Py_ssize_t at = gr.at
-    barrier = new_slots(BARRIER)
-    put(barrier, BARRIER, 0, res)
-    put(barrier, BARRIER, 1, _sub(m0, m1, l0, l1))
-    put(barrier, BARRIER, 2, ps)
-    put(barrier, BARRIER, 3, pd)
-    put(barrier, BARRIER, 4, al)
-    sink.keep.append(barrier)
+    barrier = <object> _barrier(sink, res, _sub(m0, m1, l0, l1), ps, pd, al).barrier
     cdef BarRec *b = sink.bar()  # (``gr`` may move when groups grow: none are added here)
     b.at, b.res, b.barrier = at, <PyObject *> res, <PyObject *> barrier
     b.m0, b.m1, b.l0, b.l1 = m0, m1, l0, l1
@@ -1011,6 +1092,8 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
         _reset()
     if _sub_count > _SUB_CAP // 4:
         _sub_reset()
+    if _bar_count > _BAR_MAX * 3 // 4:  # room for one more graph's barriers
+        _bar_reset()
     _overflow = False
     alias_sources = alias_sources or {}
     touched = {n: len(traced[n].cells) for preds in alias_sources.values() for n in preds if n in traced}

@@ -11,7 +11,8 @@ and test_native_phases.py compare them)."""
 from libc.stdint cimport uint64_t
 from libc.stdlib cimport free, malloc, qsort, realloc
 from libc.string cimport memset
-from cpython.ref cimport PyObject
+from cpython.ref cimport Py_INCREF, PyObject
+from cpython.tuple cimport PyTuple_New, PyTuple_SET_ITEM
 
 from rgraph.compiler.plan_values import plan_state
 from rgraph.compiler.usages import WRITE_ACCESS
@@ -226,28 +227,36 @@ cdef struct CellRec:
     long mip, layer
     Py_ssize_t next
 
+cdef struct WaitRec:  # a pass's wait for another queue
+    PyObject *queue  # borrowed: a use's queue or an earlier occupant's (alive through the phase)
+    Py_ssize_t j  # the latest pass waited for
+    u64 stages
+    Py_ssize_t next  # the pass's next wait, -1
+
 
 cdef class _Sink:
     """What the walks of one ``synchronize`` find (C records; the objects they point at are
     kept alive in ``keep`` or by the trace)."""
 
-    cdef list waits, keep
+    cdef list keep
     cdef BarRec *bars
     cdef RelRec *rels
     cdef GroupRec *groups
     cdef CellRec *cells
+    cdef WaitRec *waits
     cdef Py_ssize_t *head  # per pass: its first group of the resource being walked, -1
-    cdef Py_ssize_t nbars, cbars, nrels, crels, ngroups, cgroups, ncells, ccells, count
+    cdef Py_ssize_t *whead  # per pass: its first wait, -1
+    cdef Py_ssize_t nbars, cbars, nrels, crels, ngroups, cgroups, ncells, ccells, nwaits, cwaits, count
 
     def __cinit__(self, Py_ssize_t count):
         self.count = count
-        self.waits = [None] * count
         self.keep = []
-        self.head = <Py_ssize_t *> malloc((count + 1) * sizeof(Py_ssize_t))
+        self.head = <Py_ssize_t *> malloc(2 * (count + 1) * sizeof(Py_ssize_t))
         if self.head == NULL:
             raise MemoryError()
+        self.whead = self.head + count + 1
         cdef Py_ssize_t k
-        for k in range(count + 1):
+        for k in range(2 * (count + 1)):
             self.head[k] = -1
 
     def __dealloc__(self):
@@ -255,7 +264,40 @@ cdef class _Sink:
         free(self.rels)
         free(self.groups)
         free(self.cells)
+        free(self.waits)
         free(self.head)
+
+    cdef int wait(self, Py_ssize_t i, object queue, Py_ssize_t j, u64 stages) except -1:
+        """Pass ``i`` waits for pass ``j`` on ``queue`` in ``stages`` (merged with its other
+        wait for that queue: the latest pass, the union of the stages); a pass's waits are
+        listed in queue order."""
+        cdef Py_ssize_t g = self.whead[i], before = -1  # the wait it follows in the list
+        cdef WaitRec *r
+        while g >= 0:
+            r = &self.waits[g]
+            if _same(r.queue, queue):
+                if j > r.j:
+                    r.j = j
+                r.stages |= stages
+                return 0
+            if <object> r.queue > queue:
+                break
+            before = g
+            g = r.next
+        if self.nwaits == self.cwaits:
+            self.cwaits = 2 * self.cwaits + 64
+            r = <WaitRec *> realloc(self.waits, self.cwaits * sizeof(WaitRec))
+            if r == NULL:
+                raise MemoryError()
+            self.waits = r
+        r = &self.waits[self.nwaits]
+        r.queue, r.j, r.stages = <PyObject *> queue, j, stages
+        if before < 0:
+            r.next, self.whead[i] = self.whead[i], self.nwaits
+        else:
+            r.next, self.waits[before].next = self.waits[before].next, self.nwaits
+        self.nwaits += 1
+        return 0
 
     cdef BarRec *bar(self) except NULL:
         cdef BarRec *grown
@@ -482,6 +524,23 @@ cdef Py_ssize_t _group_at(list uses, SyncInfo **infos, Py_ssize_t k, Py_ssize_t 
 
 cdef enum:
     _INFOS_ON_STACK = 64
+    _AHEAD = 4  # uses prefetched ahead
+
+
+cdef extern from "Python.h":
+    PyObject *_list_item "PyList_GET_ITEM" (PyObject *l, Py_ssize_t k)  # borrowed
+    PyObject *_tuple_item "PyTuple_GET_ITEM" (PyObject *t, Py_ssize_t k)  # borrowed
+    Py_ssize_t _as_ssize "PyLong_AsSsize_t" (PyObject *o) except? -1
+    void _prefetch "__builtin_prefetch" (const void *p)
+
+
+cdef inline bint _truth(PyObject *o) except -1:
+    """``bool(o)``, a bool without a call."""
+    if o == <PyObject *> True:
+        return True
+    if o == <PyObject *> False:
+        return False
+    return bool(<object> o)
 
 
 cdef inline bint _same(PyObject *a, object b) except -1:
@@ -500,13 +559,18 @@ cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alia
     cdef SyncInfo *on_stack[_INFOS_ON_STACK]
     cdef SyncInfo **infos = on_stack
     cdef Py_ssize_t n = len(uses), k
+    cdef PyObject *u
     if n > _INFOS_ON_STACK:
         infos = <SyncInfo **> malloc(n * sizeof(SyncInfo *))
         if infos == NULL:
             raise MemoryError()
     try:
         for k in range(n):  # every scope's masks before anything is written
-            infos[k] = _sync((<tuple> uses[k])[1])
+            if k + _AHEAD < n:  # (the trace's use tuples are cold by now)
+                _prefetch(_list_item(<PyObject *> uses, k + _AHEAD))
+            u = _list_item(<PyObject *> uses, k)
+            _prefetch(_tuple_item(u, 0))  # its pass number, read by the walk
+            infos[k] = _sync(<object> _tuple_item(u, 1))
             if infos[k] == NULL:
                 return 1
         return _walk_infos(uses, infos, image, st, aliases, alias_waits, last_prev, sink, res, mip, layer, sub, multi)
@@ -520,11 +584,13 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
     cdef Py_ssize_t n = len(uses), k, end = n - 1, covered_until = -1, i = 0, last_pass = st.last_pass
     cdef Py_ssize_t release_at, pos, g, cr
     cdef SyncInfo *si
-    cdef bint w, has_write = st.has_write, has_reads = st.has_reads, transfer, has_key, changed
+    cdef bint w, has_write = st.has_write, has_reads = st.has_reads, transfer, has_key, changed, wait_prev
+    cdef Py_ssize_t wait_j = 0
+    cdef tuple wait_from
     cdef u64 w_st = st.w_st, w_ac = st.w_ac, rd = st.rd, vis_st = st.vis_st, vis_ac = st.vis_ac
     cdef u64 src_st = 0, src_ac = 0, dst_st = 0, dst_ac = 0, wait_st
     cdef dict found
-    cdef tuple u
+    cdef PyObject *u
     cdef GroupRec *gr
     cdef BarRec *b
     cdef RelRec *rr
@@ -532,24 +598,24 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
     layout = <object> st.layout
     cq = <object> st.cq
     for k in range(n):
-        u = <tuple> uses[k]
-        i = <Py_ssize_t> u[0]
-        s = u[1]
-        w = u[2]
-        queue = u[3]
-        pos = <Py_ssize_t> u[4]
+        u = _list_item(<PyObject *> uses, k)  # (i, sync, written, queue, position): read in place
+        i = _as_ssize(_tuple_item(u, 0))
+        w = _truth(_tuple_item(u, 2))
+        queue = <object> _tuple_item(u, 3)
+        pos = _as_ssize(_tuple_item(u, 4))
         si = infos[k]
-        wait_on = None
+        wait_from = ()  # aliased memory used on another queue: these (queue, last pass) to wait for
+        wait_prev = False  # wait for (wait_q, wait_j), the cell's last use on another queue
         transfer = False
         release_at = -1
         if alias_waits or (cq is not None and _differ(cq, queue)):
-            if alias_waits:  # aliased memory used on another queue
-                wait_on = [(q, j) for q, j in alias_waits if q != queue]
-            else:
-                wait_on = []
+            for q, j in alias_waits:
+                if _differ(q, queue):
+                    wait_from = alias_waits
+                    break
             if cq is not None and _differ(cq, queue):
-                if last_pass >= 0 and not last_prev:
-                    wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
+                if last_pass >= 0 and not last_prev:  # earlier frames: the runtime's frame-boundary waits
+                    wait_prev, wait_q, wait_j = True, cq, last_pass
                 if image:
                     transfer = layout is not None and _differ(layout, "UNDEFINED")
                 else:
@@ -622,9 +688,9 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
             aliases = ()
             alias_waits = ()
             last_prev = False
-        if sink is None or (not has_key and not wait_on):
+        if sink is None or (not has_key and not wait_from and not wait_prev):
             continue
-        if wait_on:
+        if wait_from or wait_prev:
             wait_st = si.stages
             if has_key and not _differ(src_queue, queue):
                 # A semaphore wait orders only its own stages, and a barrier chains after it
@@ -632,15 +698,11 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
                 if not src_st:
                     src_st = si.stages
                 wait_st = wait_st | src_st
-            found = sink.waits[i]
-            if found is None:
-                found = sink.waits[i] = {}
-            for q, j in wait_on:  # queue -> (latest pass waited for, stage mask)
-                prev = found.get(q)
-                if prev is None:
-                    found[q] = (j, wait_st)
-                else:
-                    found[q] = (max(j, prev[0]), <u64> prev[1] | wait_st)
+            for q, j in wait_from:
+                if _differ(q, queue):
+                    sink.wait(i, q, j, wait_st)
+            if wait_prev:
+                sink.wait(i, wait_q, wait_j, wait_st)
         if not has_key:
             continue
         if multi:  # the pass's group of this key and release pass, else a new one
@@ -921,6 +983,7 @@ cdef list _bars_by_pass(_Sink sink):
     """Each pass's barriers in (resource, mips, layers) order (``sync._gather``)."""
     cdef Py_ssize_t count = sink.count, n = sink.nbars, k, m, j, at, lo
     cdef list out = [()] * count
+    cdef tuple made
     cdef Py_ssize_t *start = <Py_ssize_t *> malloc((count + 1) * sizeof(Py_ssize_t))
     cdef BarRec *order = <BarRec *> malloc((n + 1) * sizeof(BarRec))
     cdef BarRec t
@@ -942,11 +1005,8 @@ cdef list _bars_by_pass(_Sink sink):
         lo = 0
         for at in range(count):
             m = start[at] - lo  # (start[at] is now the bucket's end)
-            if m == 1:
-                out[at] = (<object> order[lo].barrier,)
-            elif m > 16:
+            if m > 16:
                 qsort(&order[lo], m, sizeof(BarRec), _bar_cmp)
-                out[at] = tuple([<object> order[k].barrier for k in range(lo, lo + m)])
             elif m > 1:
                 for k in range(lo + 1, lo + m):  # insertion sort: few per pass
                     t = order[k]
@@ -955,7 +1015,12 @@ cdef list _bars_by_pass(_Sink sink):
                         order[j] = order[j - 1]
                         j -= 1
                     order[j] = t
-                out[at] = tuple([<object> order[k].barrier for k in range(lo, lo + m)])
+            if m:
+                made = PyTuple_New(m)
+                for k in range(m):
+                    Py_INCREF(<object> order[lo + k].barrier)
+                    PyTuple_SET_ITEM(made, k, <object> order[lo + k].barrier)
+                out[at] = made
             lo = start[at]
     finally:
         free(start)
@@ -1038,23 +1103,35 @@ cdef object _wait(queue, value, stages):
 
 cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     """``sync._gather``."""
-    cdef Py_ssize_t count = sink.count, i
-    cdef list waits = sink.waits, signals = [False] * count, values = [0] * count, pass_waits = [()] * count
-    cdef dict counters = {}, found
-    for i in range(count):
-        found = waits[i]
-        if found is not None:
-            for j, _ in found.values():
-                signals[<Py_ssize_t> j] = True
+    cdef Py_ssize_t count = sink.count, i, g, n
+    cdef list signals = [False] * count, values = [0] * count, pass_waits = [()] * count
+    cdef dict counters = {}
+    cdef WaitRec *r
+    cdef tuple made
+    for g in range(sink.nwaits):
+        signals[sink.waits[g].j] = True
     for i in range(count):  # timeline values per queue, 1, 2, ... in plan order
-        if signals[i]:
+        if signals[i] is True:
             queue = passes[i].queue
             values[i] = counters[queue] = counters.get(queue, 0) + 1
     for i in range(count):
-        found = waits[i]
-        if found is not None:
-            pass_waits[i] = tuple([_wait(q, values[<Py_ssize_t> jm[0]], _stage_names(<u64> jm[1]))
-                                   for q, jm in sorted(found.items())])
+        g = sink.whead[i]
+        if g < 0:
+            continue
+        n = 0
+        while g >= 0:
+            n += 1
+            g = sink.waits[g].next
+        made = PyTuple_New(n)
+        g, n = sink.whead[i], 0
+        while g >= 0:  # in queue order
+            r = &sink.waits[g]
+            w = _wait(<object> r.queue, values[r.j], _stage_names(r.stages))
+            Py_INCREF(w)
+            PyTuple_SET_ITEM(made, n, w)
+            n += 1
+            g = r.next
+        pass_waits[i] = made
     return SyncResult(_bars_by_pass(sink), _rels_by_pass(sink), pass_waits, signals, values, final, initial)
 
 

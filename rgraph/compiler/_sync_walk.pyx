@@ -12,7 +12,9 @@ from libc.stdint cimport uint64_t
 from libc.stdlib cimport free, malloc, qsort, realloc
 from libc.string cimport memset
 from cpython.ref cimport Py_INCREF, PyObject
-from cpython.tuple cimport PyTuple_New, PyTuple_SET_ITEM
+from cpython.list cimport PyList_CheckExact
+from cpython.tuple cimport PyTuple_CheckExact, PyTuple_New, PyTuple_SET_ITEM
+from cpython.unicode cimport PyUnicode_CheckExact, PyUnicode_Compare, PyUnicode_GET_LENGTH
 
 from rgraph.compiler.plan_values import plan_state
 from rgraph.compiler.usages import WRITE_ACCESS
@@ -151,10 +153,14 @@ cdef void _reset():
     _keep.clear()
 
 
-cdef inline bint _differ(object a, object b):
-    """``a != b`` for the walk's strings and None (identity first)."""
+cdef inline bint _differ(object a, object b) except -1:
+    """``a != b`` for the walk's strings and None (identity first; strings without a rich compare)."""
     if a is b:
         return False
+    if a is None or b is None:
+        return True
+    if PyUnicode_CheckExact(a) and PyUnicode_CheckExact(b):
+        return PyUnicode_GET_LENGTH(a) != PyUnicode_GET_LENGTH(b) or PyUnicode_Compare(a, b) != 0
     return a != b
 
 
@@ -173,6 +179,8 @@ cdef extern from "Python.h":
 from rgraph.compiler.alias_starts import with_partial_handoffs
 from rgraph.compiler.plan_values import names as _sorted_names, subresource as _subresource
 from rgraph.compiler.sync_types import SyncResult
+from rgraph.compiler.trace import ResourceTrace
+from rgraph.spec.specialize import ResourceSpec
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
 
@@ -507,14 +515,15 @@ cdef Py_ssize_t _group_at(list uses, SyncInfo **infos, Py_ssize_t k, Py_ssize_t 
     """``sync._group``: stages and accesses (into ``stages``, ``access``) of the read group starting
     at use ``k``, with the uses' masks in ``infos``; returns its last use."""
     cdef Py_ssize_t e = k
-    cdef tuple u
+    cdef PyObject *u
     cdef SyncInfo *sj
     stages[0] = infos[k].stages
     access[0] = infos[k].access
     while e < last:
-        u = <tuple> uses[e + 1]
+        u = _list_item(<PyObject *> uses, e + 1)
         sj = infos[e + 1]
-        if u[2] or _differ(<object> sj.layout, layout) or _differ(u[3], queue):
+        if (_truth(_tuple_item(u, 2)) or _differ(<object> sj.layout, layout)
+                or _differ(<object> _tuple_item(u, 3), queue)):
             break
         stages[0] |= sj.stages
         access[0] |= sj.access
@@ -532,6 +541,11 @@ cdef extern from "Python.h":
     PyObject *_tuple_item "PyTuple_GET_ITEM" (PyObject *t, Py_ssize_t k)  # borrowed
     Py_ssize_t _as_ssize "PyLong_AsSsize_t" (PyObject *o) except? -1
     void _prefetch "__builtin_prefetch" (const void *p)
+    ctypedef struct PyListObject:
+        PyObject **ob_item
+    Py_ssize_t _list_size "PyList_GET_SIZE" (PyObject *l)
+    Py_ssize_t _tuple_size "PyTuple_GET_SIZE" (PyObject *t)
+    PyObject *_type "(PyObject *) Py_TYPE" (PyObject *o)
 
 
 cdef inline bint _truth(PyObject *o) except -1:
@@ -1135,6 +1149,76 @@ cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     return SyncResult(_bars_by_pass(sink), _rels_by_pass(sink), pass_waits, signals, values, final, initial)
 
 
+# ---- the resources' fields ------------------------------------------------------------------
+
+cdef object RESOURCE_TRACE = ResourceTrace, RESOURCE_SPEC = ResourceSpec
+#: Field positions: usages 0, first 1, last 2, cells 3 (the fields without a default named).
+cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group"))
+#: Field positions: name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6 (as ``TRACE``).
+cdef Slots RESOURCE = Slots(ResourceSpec, ("name", "kind", "lifetime", "format", "extent", "layers", "mips", "samples",
+                                           "bytes", "loc"))
+
+
+cdef inline object _trace_field(object r, Py_ssize_t k, str name):
+    """Field ``k`` (named ``name``) of a resource's trace: from its slot where it is exactly a
+    ``ResourceTrace``."""
+    if type(r) is RESOURCE_TRACE:
+        return get(r, TRACE, k)
+    return getattr(r, name)
+
+
+cdef inline object _res_field(object res, Py_ssize_t k, str name):
+    """Field ``k`` (named ``name``) of a ``ResourceSpec`` (as ``_trace_field``)."""
+    if type(res) is RESOURCE_SPEC:
+        return get(res, RESOURCE, k)
+    return getattr(res, name)
+
+
+cdef inline PyObject *_slot(PyObject *o, Slots layout, Py_ssize_t k):
+    """Field ``k`` of ``o`` (exactly ``layout``'s class), borrowed; NULL where unset."""
+    return (<PyObject **> ((<char *> o) + layout.off[k]))[0]
+
+
+cdef inline PyObject *_cells_of(list rs, Py_ssize_t k):
+    """Resource ``k``'s cells list (borrowed), NULL where not an exact ``ResourceTrace``'s list."""
+    cdef PyObject *o = _list_item(<PyObject *> rs, k)
+    if _type(o) != <PyObject *> RESOURCE_TRACE:
+        return NULL
+    o = _slot(o, TRACE, 3)
+    if o == NULL or not PyList_CheckExact(<object> o):
+        return NULL
+    return o
+
+
+cdef void _ahead(list rs, Py_ssize_t k, Py_ssize_t n):
+    """Prefetch what the resource loop reads of the traces after ``k`` (``rs``): the chain trace ->
+    cells list -> its items -> first cell -> (cell, uses), a step further back each resource
+    ahead, so that each pointer read was prefetched a resource earlier (the trace's objects are
+    cold by now)."""
+    cdef PyObject *o
+    if k + 5 < n:
+        _prefetch(_list_item(<PyObject *> rs, k + 5))
+    if k + 4 < n:
+        o = _list_item(<PyObject *> rs, k + 4)
+        if _type(o) == <PyObject *> RESOURCE_TRACE and _slot(o, TRACE, 3) != NULL:
+            _prefetch(_slot(o, TRACE, 3))
+    if k + 3 < n:
+        o = _cells_of(rs, k + 3)
+        if o != NULL:
+            _prefetch((<PyListObject *> o).ob_item)
+    if k + 2 < n:
+        o = _cells_of(rs, k + 2)
+        if o != NULL and _list_size(o):
+            _prefetch(_list_item(o, 0))
+    if k + 1 < n:
+        o = _cells_of(rs, k + 1)
+        if o != NULL and _list_size(o):
+            o = _list_item(o, 0)
+            if PyTuple_CheckExact(<object> o) and _tuple_size(o) == 2:
+                _prefetch(_tuple_item(o, 0))
+                _prefetch(_tuple_item(o, 1))
+
+
 # ---- the phase ------------------------------------------------------------------------------
 
 def synchronize(passes, resources, trace, alias_sources=None, ranges=None, outputs=()):
@@ -1156,7 +1240,8 @@ def synchronize(passes, resources, trace, alias_sources=None, ranges=None, outpu
 
 cdef object _synchronize(passes, resources, trace, alias_sources, ranges, outputs):
     global _overflow
-    cdef Py_ssize_t count = len(passes), ncell, g0
+    cdef Py_ssize_t count = len(passes), ncell, g0, ri, nres
+    cdef list names, rs
     cdef dict traced = trace.resources, sources, touched, initial = {}, final = {}, ends = {}
     cdef set wanted, kept_outputs
     cdef bint image, persistent, want
@@ -1178,13 +1263,18 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
     wanted = {pred for preds in sources.values() for pred in preds}
     kept_outputs = outputs if type(outputs) is set else set(outputs)
     sink = _Sink(count)
-    for name, r in traced.items():
+    names, rs = list(traced), list(traced.values())
+    nres = len(rs)
+    for ri in range(nres):
+        _ahead(rs, ri, nres)
+        name = names[ri]
+        r = rs[ri]
         res = resources[name]
-        image = res.kind == "image"
-        cells = r.cells
+        image = _res_field(res, 1, "kind") == "image"
+        cells = _trace_field(r, 3, "cells")
         ncell = len(cells)
         preds = sources.get(name)
-        lifetime = res.lifetime
+        lifetime = _res_field(res, 2, "lifetime")
         persistent = lifetime == "persistent" or lifetime == "imported"
         want = name in wanted
         layout = "UNDEFINED" if image else None
@@ -1196,7 +1286,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
             sub = _sub(mip, mip + 1, layer, layer + 1) if image else None
             _fresh(&st, layout)
             if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
-                aliases, alias_waits = _alias_start(preds, ends, r.first, &st)
+                aliases, alias_waits = _alias_start(preds, ends, _trace_field(r, 1, "first"), &st)
                 initial[name] = _end_state_of(&st)
             else:
                 aliases = alias_waits = ()
@@ -1234,7 +1324,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
             _fresh(&first, layout)
             aliases = alias_waits = ()
             if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
-                aliases, alias_waits = _alias_start(preds, ends, r.first, &first)
+                aliases, alias_waits = _alias_start(preds, ends, _trace_field(r, 1, "first"), &first)
             first_state = _end_state_of(&first)  # every cell starts alike
             for cell in cells:
                 c = <tuple> cell[0]
@@ -1249,7 +1339,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
                     _end_masks(&st, &es, &ea)
                     kept.append((es, ea, <object> st.cq, st.last_pass))
         if ncell > 1:
-            _rect_groups(sink, g0, name, res.mips, res.layers)
+            _rect_groups(sink, g0, name, _res_field(res, 6, "mips"), _res_field(res, 5, "layers"))
         per_cell = lifetime != "transient" or name in kept_outputs
         initial[name] = _end_state_c(per_cell, cells, starts)
         final[name] = _end_state_c(per_cell, cells, finals)

@@ -196,3 +196,30 @@ def test_more_barriers_than_the_table_lists(tmp_path: Path) -> None:
     small = tmp_path / "small.yaml"
     small.write_text(to_yaml(random_graph(seed=0, passes=60)))
     same(*both(compilation(frontend(small, size=(16, 16)).spec)))
+
+
+def test_resources_of_other_classes_read_by_attribute(tmp_path: Path) -> None:
+    """Traces and resource specs of subclasses (not read from their slots) give the same result."""
+    import dataclasses
+
+    from rgraph.compiler.trace import ResourceTrace
+    from rgraph.spec.specialize import ResourceSpec
+
+    class OtherTrace(ResourceTrace):
+        pass
+
+    class OtherSpec(ResourceSpec):
+        pass
+
+    def copy(value, cls):
+        return cls(**{f.name: getattr(value, f.name) for f in dataclasses.fields(value)})
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=5, passes=200)))
+    c = compilation(frontend(path, size=(16, 16)).spec)
+    expected = both(c)[0]
+    trace = dataclasses.replace(c.trace, resources={n: copy(r, OtherTrace) for n, r in c.trace.resources.items()})
+    spec = dataclasses.replace(c.spec, resources={n: copy(r, OtherSpec) for n, r in c.spec.resources.items()})
+    native, python = both(dataclasses.replace(c, trace=trace, spec=spec))
+    same(native, python)
+    same(native, expected)

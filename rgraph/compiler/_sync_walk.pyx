@@ -993,10 +993,16 @@ cdef int _rel_cmp(const void *a, const void *b) noexcept nogil:
     return 1 if _rel_less(<RelRec *> b, <RelRec *> a) else 0
 
 
+#: The last phase's barrier tuples per pass: a pass with the same barriers (the same objects:
+#: ``_barrier``) gets its tuple again, which touches none of them.
+cdef list _last_bars = []
+
+
 cdef list _bars_by_pass(_Sink sink):
     """Each pass's barriers in (resource, mips, layers) order (``sync._gather``)."""
+    global _last_bars
     cdef Py_ssize_t count = sink.count, n = sink.nbars, k, m, j, at, lo
-    cdef list out = [()] * count
+    cdef list out = [()] * count, last = _last_bars
     cdef tuple made
     cdef Py_ssize_t *start = <Py_ssize_t *> malloc((count + 1) * sizeof(Py_ssize_t))
     cdef BarRec *order = <BarRec *> malloc((n + 1) * sizeof(BarRec))
@@ -1030,16 +1036,31 @@ cdef list _bars_by_pass(_Sink sink):
                         j -= 1
                     order[j] = t
             if m:
-                made = PyTuple_New(m)
-                for k in range(m):
-                    Py_INCREF(<object> order[lo + k].barrier)
-                    PyTuple_SET_ITEM(made, k, <object> order[lo + k].barrier)
-                out[at] = made
+                if at < len(last) and _same_bars(_list_item(<PyObject *> last, at), &order[lo], m):
+                    out[at] = <object> _list_item(<PyObject *> last, at)
+                else:
+                    made = PyTuple_New(m)
+                    for k in range(m):
+                        Py_INCREF(<object> order[lo + k].barrier)
+                        PyTuple_SET_ITEM(made, k, <object> order[lo + k].barrier)
+                    out[at] = made
             lo = start[at]
     finally:
         free(start)
         free(order)
+    _last_bars = out
     return out
+
+
+cdef inline bint _same_bars(PyObject *t, BarRec *bars, Py_ssize_t m):
+    """Whether ``t`` is a tuple of exactly the ``m`` barriers of ``bars``."""
+    cdef Py_ssize_t k
+    if not PyTuple_CheckExact(<object> t) or _tuple_size(t) != m:
+        return False
+    for k in range(m):
+        if _tuple_item(t, k) != bars[k].barrier:
+            return False
+    return True
 
 
 cdef list _rels_by_pass(_Sink sink):

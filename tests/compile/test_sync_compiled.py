@@ -159,7 +159,8 @@ def test_a_full_scope_table_retries_from_empty_tables(tmp_path: Path, monkeypatc
 
 def test_barriers_are_reused_across_compiles(tmp_path: Path) -> None:
     """A compile of the same graph, from the same spec or a freshly parsed one, gets the
-    earlier compile's barrier objects (equal values are one object), still the reference's."""
+    earlier compile's barrier objects (equal values are one object) and each pass's tuple of
+    them, still the reference's."""
     path = tmp_path / "g.yaml"
     path.write_text(to_yaml(random_graph(seed=5, passes=200)))
     first, python = both(compilation(frontend(path, size=(16, 16)).spec))
@@ -170,6 +171,7 @@ def test_barriers_are_reused_across_compiles(tmp_path: Path) -> None:
         for kind in ("barriers", "releases"):
             old, new = getattr(first, kind), getattr(again, kind)
             assert all(a is b for olds, news in zip(old, new) for a, b in zip(olds, news)), kind
+        assert all(a is b for a, b in zip(first.barriers, again.barriers))  # each pass's tuple too
     assert any(first.releases)
 
 

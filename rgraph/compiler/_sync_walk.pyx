@@ -11,7 +11,10 @@ and test_native_phases.py compare them)."""
 from libc.stdint cimport uint64_t
 from libc.stdlib cimport free, malloc, qsort, realloc
 from libc.string cimport memset
-from cpython.ref cimport PyObject
+from cpython.ref cimport Py_INCREF, PyObject
+from cpython.list cimport PyList_CheckExact
+from cpython.tuple cimport PyTuple_CheckExact, PyTuple_New, PyTuple_SET_ITEM
+from cpython.unicode cimport PyUnicode_CheckExact, PyUnicode_Compare, PyUnicode_GET_LENGTH
 
 from rgraph.compiler.plan_values import plan_state
 from rgraph.compiler.usages import WRITE_ACCESS
@@ -150,10 +153,14 @@ cdef void _reset():
     _keep.clear()
 
 
-cdef inline bint _differ(object a, object b):
-    """``a != b`` for the walk's strings and None (identity first)."""
+cdef inline bint _differ(object a, object b) except -1:
+    """``a != b`` for the walk's strings and None (identity first; strings without a rich compare)."""
     if a is b:
         return False
+    if a is None or b is None:
+        return True
+    if PyUnicode_CheckExact(a) and PyUnicode_CheckExact(b):
+        return PyUnicode_GET_LENGTH(a) != PyUnicode_GET_LENGTH(b) or PyUnicode_Compare(a, b) != 0
     return a != b
 
 
@@ -172,6 +179,8 @@ cdef extern from "Python.h":
 from rgraph.compiler.alias_starts import with_partial_handoffs
 from rgraph.compiler.plan_values import names as _sorted_names, subresource as _subresource
 from rgraph.compiler.sync_types import SyncResult
+from rgraph.compiler.trace import ResourceTrace
+from rgraph.spec.specialize import ResourceSpec
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
 
@@ -226,28 +235,36 @@ cdef struct CellRec:
     long mip, layer
     Py_ssize_t next
 
+cdef struct WaitRec:  # a pass's wait for another queue
+    PyObject *queue  # borrowed: a use's queue or an earlier occupant's (alive through the phase)
+    Py_ssize_t j  # the latest pass waited for
+    u64 stages
+    Py_ssize_t next  # the pass's next wait, -1
+
 
 cdef class _Sink:
     """What the walks of one ``synchronize`` find (C records; the objects they point at are
     kept alive in ``keep`` or by the trace)."""
 
-    cdef list waits, keep
+    cdef list keep
     cdef BarRec *bars
     cdef RelRec *rels
     cdef GroupRec *groups
     cdef CellRec *cells
+    cdef WaitRec *waits
     cdef Py_ssize_t *head  # per pass: its first group of the resource being walked, -1
-    cdef Py_ssize_t nbars, cbars, nrels, crels, ngroups, cgroups, ncells, ccells, count
+    cdef Py_ssize_t *whead  # per pass: its first wait, -1
+    cdef Py_ssize_t nbars, cbars, nrels, crels, ngroups, cgroups, ncells, ccells, nwaits, cwaits, count
 
     def __cinit__(self, Py_ssize_t count):
         self.count = count
-        self.waits = [None] * count
         self.keep = []
-        self.head = <Py_ssize_t *> malloc((count + 1) * sizeof(Py_ssize_t))
+        self.head = <Py_ssize_t *> malloc(2 * (count + 1) * sizeof(Py_ssize_t))
         if self.head == NULL:
             raise MemoryError()
+        self.whead = self.head + count + 1
         cdef Py_ssize_t k
-        for k in range(count + 1):
+        for k in range(2 * (count + 1)):
             self.head[k] = -1
 
     def __dealloc__(self):
@@ -255,7 +272,40 @@ cdef class _Sink:
         free(self.rels)
         free(self.groups)
         free(self.cells)
+        free(self.waits)
         free(self.head)
+
+    cdef int wait(self, Py_ssize_t i, object queue, Py_ssize_t j, u64 stages) except -1:
+        """Pass ``i`` waits for pass ``j`` on ``queue`` in ``stages`` (merged with its other
+        wait for that queue: the latest pass, the union of the stages); a pass's waits are
+        listed in queue order."""
+        cdef Py_ssize_t g = self.whead[i], before = -1  # the wait it follows in the list
+        cdef WaitRec *r
+        while g >= 0:
+            r = &self.waits[g]
+            if _same(r.queue, queue):
+                if j > r.j:
+                    r.j = j
+                r.stages |= stages
+                return 0
+            if <object> r.queue > queue:
+                break
+            before = g
+            g = r.next
+        if self.nwaits == self.cwaits:
+            self.cwaits = 2 * self.cwaits + 64
+            r = <WaitRec *> realloc(self.waits, self.cwaits * sizeof(WaitRec))
+            if r == NULL:
+                raise MemoryError()
+            self.waits = r
+        r = &self.waits[self.nwaits]
+        r.queue, r.j, r.stages = <PyObject *> queue, j, stages
+        if before < 0:
+            r.next, self.whead[i] = self.whead[i], self.nwaits
+        else:
+            r.next, self.waits[before].next = self.waits[before].next, self.nwaits
+        self.nwaits += 1
+        return 0
 
     cdef BarRec *bar(self) except NULL:
         cdef BarRec *grown
@@ -346,6 +396,100 @@ cdef void _sub_reset():
     _sub_keep.clear()
 
 
+# ---- barriers by (resource, subresource, src, dst, aliases) -------------------------------
+# A plan's barriers are frozen values: an equal one made earlier (this compile, or an earlier
+# compile of the same graph) is reused, which saves building it and freeing the old plan's.
+# The barriers are listed in the order made; a compile of the same graph asks for them in that
+# order again, so the one after the last found is tried before the hash index.
+
+cdef enum:
+    _BAR_CAP = 8192  # index slots (power of two)
+    _BAR_MAX = 4096  # barriers listed: the index at most half used
+
+cdef struct BarSlot:
+    Py_hash_t res_hash
+    PyObject *res  # the key: the barrier's own fields (it keeps them alive)
+    PyObject *sub
+    PyObject *src
+    PyObject *dst
+    PyObject *al
+    PyObject *barrier
+    PyObject *one  # (barrier,), a one-cell release's entry, once made; else NULL
+
+cdef BarSlot _bars[_BAR_MAX]  # in the order made
+cdef int _bar_index[_BAR_CAP]  # hash index: 1 + the barrier's place in ``_bars``; 0: free
+cdef BarSlot _unlisted  # a barrier made while the list is full (kept by the sink)
+cdef Py_ssize_t _bar_count = 0, _bar_next = 0  # listed barriers; the place to try first
+cdef list _bar_keep = []  # the barriers and one-tuples listed
+
+
+cdef inline bint _bar_is(BarSlot *slot, object res, object sub, object ps, object pd, object al) except -1:
+    return (slot.sub == <PyObject *> sub and slot.src == <PyObject *> ps and slot.dst == <PyObject *> pd
+            and _same(slot.res, res) and _same(slot.al, al))
+
+
+cdef BarSlot *_barrier(_Sink sink, object res, object sub, object ps, object pd, object al) except NULL:
+    """The slot of ``pm.Barrier(res, sub, ps, pd, al)``: ``sub``, ``ps`` and ``pd`` compared by
+    identity (interned: ``_sub``, ``_state``), the resource name and aliases by value."""
+    global _bar_count, _bar_next
+    cdef BarSlot *slot
+    cdef int found
+    if _bar_next < _bar_count and _bar_is(&_bars[_bar_next], res, sub, ps, pd, al):
+        _bar_next += 1
+        return &_bars[_bar_next - 1]
+    cdef Py_hash_t rh = hash(res)
+    cdef size_t h = <size_t> (<u64> rh * <u64> 0x9E3779B97F4A7C15 ^ ((<size_t> <PyObject *> sub >> 4) * 31)
+                              ^ ((<size_t> <PyObject *> ps >> 4) * 1000003) ^ (<size_t> <PyObject *> pd >> 4))
+    h &= _BAR_CAP - 1
+    while _bar_index[h]:
+        found = _bar_index[h] - 1
+        slot = &_bars[found]
+        if slot.res_hash == rh and _bar_is(slot, res, sub, ps, pd, al):
+            _bar_next = found + 1
+            return slot
+        h = (h + 1) & (_BAR_CAP - 1)
+    barrier = new_slots(BARRIER)
+    put(barrier, BARRIER, 0, res)
+    put(barrier, BARRIER, 1, sub)
+    put(barrier, BARRIER, 2, ps)
+    put(barrier, BARRIER, 3, pd)
+    put(barrier, BARRIER, 4, al)
+    if _bar_count >= _BAR_MAX:
+        sink.keep.append(barrier)
+        slot = &_unlisted
+    else:
+        _bar_keep.append(barrier)
+        slot = &_bars[_bar_count]
+        _bar_count += 1
+        _bar_index[h] = _bar_count
+        _bar_next = _bar_count
+    slot.res_hash = rh
+    slot.res, slot.sub, slot.src, slot.dst, slot.al = (<PyObject *> res, <PyObject *> sub, <PyObject *> ps,
+                                                       <PyObject *> pd, <PyObject *> al)
+    slot.barrier = <PyObject *> barrier
+    slot.one = NULL
+    return slot
+
+
+cdef PyObject *_one(_Sink sink, BarSlot *slot) except NULL:
+    """``(barrier,)`` of ``slot``'s barrier (kept with it)."""
+    if slot.one == NULL:
+        one = (<object> slot.barrier,)
+        if slot == &_unlisted:
+            sink.keep.append(one)
+        else:
+            _bar_keep.append(one)
+        slot.one = <PyObject *> one
+    return slot.one
+
+
+cdef void _bar_reset():
+    global _bar_count, _bar_next
+    memset(_bar_index, 0, sizeof(_bar_index))
+    _bar_count = _bar_next = 0
+    _bar_keep.clear()
+
+
 # ---- the cell walk on a C state ------------------------------------------------------------
 
 cdef inline object _end_state_of(CellState *st):
@@ -371,14 +515,15 @@ cdef Py_ssize_t _group_at(list uses, SyncInfo **infos, Py_ssize_t k, Py_ssize_t 
     """``sync._group``: stages and accesses (into ``stages``, ``access``) of the read group starting
     at use ``k``, with the uses' masks in ``infos``; returns its last use."""
     cdef Py_ssize_t e = k
-    cdef tuple u
+    cdef PyObject *u
     cdef SyncInfo *sj
     stages[0] = infos[k].stages
     access[0] = infos[k].access
     while e < last:
-        u = <tuple> uses[e + 1]
+        u = _list_item(<PyObject *> uses, e + 1)
         sj = infos[e + 1]
-        if u[2] or _differ(<object> sj.layout, layout) or _differ(u[3], queue):
+        if (_truth(_tuple_item(u, 2)) or _differ(<object> sj.layout, layout)
+                or _differ(<object> _tuple_item(u, 3), queue)):
             break
         stages[0] |= sj.stages
         access[0] |= sj.access
@@ -388,6 +533,28 @@ cdef Py_ssize_t _group_at(list uses, SyncInfo **infos, Py_ssize_t k, Py_ssize_t 
 
 cdef enum:
     _INFOS_ON_STACK = 64
+    _AHEAD = 4  # uses prefetched ahead
+
+
+cdef extern from "Python.h":
+    PyObject *_list_item "PyList_GET_ITEM" (PyObject *l, Py_ssize_t k)  # borrowed
+    PyObject *_tuple_item "PyTuple_GET_ITEM" (PyObject *t, Py_ssize_t k)  # borrowed
+    Py_ssize_t _as_ssize "PyLong_AsSsize_t" (PyObject *o) except? -1
+    void _prefetch "__builtin_prefetch" (const void *p)
+    ctypedef struct PyListObject:
+        PyObject **ob_item
+    Py_ssize_t _list_size "PyList_GET_SIZE" (PyObject *l)
+    Py_ssize_t _tuple_size "PyTuple_GET_SIZE" (PyObject *t)
+    PyObject *_type "(PyObject *) Py_TYPE" (PyObject *o)
+
+
+cdef inline bint _truth(PyObject *o) except -1:
+    """``bool(o)``, a bool without a call."""
+    if o == <PyObject *> True:
+        return True
+    if o == <PyObject *> False:
+        return False
+    return bool(<object> o)
 
 
 cdef inline bint _same(PyObject *a, object b) except -1:
@@ -406,13 +573,18 @@ cdef int _walk_c(list uses, bint image, CellState *st, tuple aliases, tuple alia
     cdef SyncInfo *on_stack[_INFOS_ON_STACK]
     cdef SyncInfo **infos = on_stack
     cdef Py_ssize_t n = len(uses), k
+    cdef PyObject *u
     if n > _INFOS_ON_STACK:
         infos = <SyncInfo **> malloc(n * sizeof(SyncInfo *))
         if infos == NULL:
             raise MemoryError()
     try:
         for k in range(n):  # every scope's masks before anything is written
-            infos[k] = _sync((<tuple> uses[k])[1])
+            if k + _AHEAD < n:  # (the trace's use tuples are cold by now)
+                _prefetch(_list_item(<PyObject *> uses, k + _AHEAD))
+            u = _list_item(<PyObject *> uses, k)
+            _prefetch(_tuple_item(u, 0))  # its pass number, read by the walk
+            infos[k] = _sync(<object> _tuple_item(u, 1))
             if infos[k] == NULL:
                 return 1
         return _walk_infos(uses, infos, image, st, aliases, alias_waits, last_prev, sink, res, mip, layer, sub, multi)
@@ -426,35 +598,38 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
     cdef Py_ssize_t n = len(uses), k, end = n - 1, covered_until = -1, i = 0, last_pass = st.last_pass
     cdef Py_ssize_t release_at, pos, g, cr
     cdef SyncInfo *si
-    cdef bint w, has_write = st.has_write, has_reads = st.has_reads, transfer, has_key, changed
+    cdef bint w, has_write = st.has_write, has_reads = st.has_reads, transfer, has_key, changed, wait_prev
+    cdef Py_ssize_t wait_j = 0
+    cdef tuple wait_from
     cdef u64 w_st = st.w_st, w_ac = st.w_ac, rd = st.rd, vis_st = st.vis_st, vis_ac = st.vis_ac
     cdef u64 src_st = 0, src_ac = 0, dst_st = 0, dst_ac = 0, wait_st
     cdef dict found
-    cdef tuple u
+    cdef PyObject *u
     cdef GroupRec *gr
     cdef BarRec *b
     cdef RelRec *rr
+    cdef BarSlot *bs
     layout = <object> st.layout
     cq = <object> st.cq
     for k in range(n):
-        u = <tuple> uses[k]
-        i = <Py_ssize_t> u[0]
-        s = u[1]
-        w = u[2]
-        queue = u[3]
-        pos = <Py_ssize_t> u[4]
+        u = _list_item(<PyObject *> uses, k)  # (i, sync, written, queue, position): read in place
+        i = _as_ssize(_tuple_item(u, 0))
+        w = _truth(_tuple_item(u, 2))
+        queue = <object> _tuple_item(u, 3)
+        pos = _as_ssize(_tuple_item(u, 4))
         si = infos[k]
-        wait_on = None
+        wait_from = ()  # aliased memory used on another queue: these (queue, last pass) to wait for
+        wait_prev = False  # wait for (wait_q, wait_j), the cell's last use on another queue
         transfer = False
         release_at = -1
         if alias_waits or (cq is not None and _differ(cq, queue)):
-            if alias_waits:  # aliased memory used on another queue
-                wait_on = [(q, j) for q, j in alias_waits if q != queue]
-            else:
-                wait_on = []
+            for q, j in alias_waits:
+                if _differ(q, queue):
+                    wait_from = alias_waits
+                    break
             if cq is not None and _differ(cq, queue):
-                if last_pass >= 0 and not last_prev:
-                    wait_on.append((cq, last_pass))  # earlier frames: the runtime's frame-boundary waits
+                if last_pass >= 0 and not last_prev:  # earlier frames: the runtime's frame-boundary waits
+                    wait_prev, wait_q, wait_j = True, cq, last_pass
                 if image:
                     transfer = layout is not None and _differ(layout, "UNDEFINED")
                 else:
@@ -527,9 +702,9 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
             aliases = ()
             alias_waits = ()
             last_prev = False
-        if sink is None or (not has_key and not wait_on):
+        if sink is None or (not has_key and not wait_from and not wait_prev):
             continue
-        if wait_on:
+        if wait_from or wait_prev:
             wait_st = si.stages
             if has_key and not _differ(src_queue, queue):
                 # A semaphore wait orders only its own stages, and a barrier chains after it
@@ -537,15 +712,11 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
                 if not src_st:
                     src_st = si.stages
                 wait_st = wait_st | src_st
-            found = sink.waits[i]
-            if found is None:
-                found = sink.waits[i] = {}
-            for q, j in wait_on:  # queue -> (latest pass waited for, stage mask)
-                prev = found.get(q)
-                if prev is None:
-                    found[q] = (j, wait_st)
-                else:
-                    found[q] = (max(j, prev[0]), <u64> prev[1] | wait_st)
+            for q, j in wait_from:
+                if _differ(q, queue):
+                    sink.wait(i, q, j, wait_st)
+            if wait_prev:
+                sink.wait(i, wait_q, wait_j, wait_st)
         if not has_key:
             continue
         if multi:  # the pass's group of this key and release pass, else a new one
@@ -584,21 +755,13 @@ cdef int _walk_infos(list uses, SyncInfo **infos, bint image, CellState *st, tup
             continue
         ps = _state(src_st, src_ac, key_src_layout, src_queue)
         pd = _state(dst_st, dst_ac, new_layout, queue)
-        barrier = new_slots(BARRIER)
-        put(barrier, BARRIER, 0, res)
-        put(barrier, BARRIER, 1, sub)
-        put(barrier, BARRIER, 2, ps)
-        put(barrier, BARRIER, 3, pd)
-        put(barrier, BARRIER, 4, key_aliases)
-        sink.keep.append(barrier)
+        bs = _barrier(sink, res, sub, ps, pd, key_aliases)
         b = sink.bar()
-        b.at, b.res, b.barrier = i, <PyObject *> res, <PyObject *> barrier
+        b.at, b.res, b.barrier = i, <PyObject *> res, bs.barrier
         b.m0 = b.m1 = b.l0 = b.l1 = 0
         if release_at >= 0:
-            made = (barrier,)
-            sink.keep.append(made)
             rr = sink.rel()
-            rr.at, rr.i, rr.res, rr.pos, rr.made = release_at, i, <PyObject *> res, pos, <PyObject *> made
+            rr.at, rr.i, rr.res, rr.pos, rr.made = release_at, i, <PyObject *> res, pos, _one(sink, bs)
     st.layout = <PyObject *> layout
     st.cq = <PyObject *> cq
     st.has_write, st.w_st, st.w_ac = has_write, w_st, w_ac
@@ -712,13 +875,7 @@ cdef int _rect(_Sink sink, GroupRec *gr, object res, long m0, long m1, long l0, 
                list made) except -1:
     """The barrier of one rectangle of group ``gr``."""
     cdef Py_ssize_t at = gr.at
-    barrier = new_slots(BARRIER)
-    put(barrier, BARRIER, 0, res)
-    put(barrier, BARRIER, 1, _sub(m0, m1, l0, l1))
-    put(barrier, BARRIER, 2, ps)
-    put(barrier, BARRIER, 3, pd)
-    put(barrier, BARRIER, 4, al)
-    sink.keep.append(barrier)
+    barrier = <object> _barrier(sink, res, _sub(m0, m1, l0, l1), ps, pd, al).barrier
     cdef BarRec *b = sink.bar()  # (``gr`` may move when groups grow: none are added here)
     b.at, b.res, b.barrier = at, <PyObject *> res, <PyObject *> barrier
     b.m0, b.m1, b.l0, b.l1 = m0, m1, l0, l1
@@ -836,10 +993,17 @@ cdef int _rel_cmp(const void *a, const void *b) noexcept nogil:
     return 1 if _rel_less(<RelRec *> b, <RelRec *> a) else 0
 
 
+#: The last phase's barrier tuples per pass: a pass with the same barriers (the same objects:
+#: ``_barrier``) gets its tuple again, which touches none of them.
+cdef list _last_bars = []
+
+
 cdef list _bars_by_pass(_Sink sink):
     """Each pass's barriers in (resource, mips, layers) order (``sync._gather``)."""
+    global _last_bars
     cdef Py_ssize_t count = sink.count, n = sink.nbars, k, m, j, at, lo
-    cdef list out = [()] * count
+    cdef list out = [()] * count, last = _last_bars
+    cdef tuple made
     cdef Py_ssize_t *start = <Py_ssize_t *> malloc((count + 1) * sizeof(Py_ssize_t))
     cdef BarRec *order = <BarRec *> malloc((n + 1) * sizeof(BarRec))
     cdef BarRec t
@@ -861,11 +1025,8 @@ cdef list _bars_by_pass(_Sink sink):
         lo = 0
         for at in range(count):
             m = start[at] - lo  # (start[at] is now the bucket's end)
-            if m == 1:
-                out[at] = (<object> order[lo].barrier,)
-            elif m > 16:
+            if m > 16:
                 qsort(&order[lo], m, sizeof(BarRec), _bar_cmp)
-                out[at] = tuple([<object> order[k].barrier for k in range(lo, lo + m)])
             elif m > 1:
                 for k in range(lo + 1, lo + m):  # insertion sort: few per pass
                     t = order[k]
@@ -874,12 +1035,32 @@ cdef list _bars_by_pass(_Sink sink):
                         order[j] = order[j - 1]
                         j -= 1
                     order[j] = t
-                out[at] = tuple([<object> order[k].barrier for k in range(lo, lo + m)])
+            if m:
+                if at < len(last) and _same_bars(_list_item(<PyObject *> last, at), &order[lo], m):
+                    out[at] = <object> _list_item(<PyObject *> last, at)
+                else:
+                    made = PyTuple_New(m)
+                    for k in range(m):
+                        Py_INCREF(<object> order[lo + k].barrier)
+                        PyTuple_SET_ITEM(made, k, <object> order[lo + k].barrier)
+                    out[at] = made
             lo = start[at]
     finally:
         free(start)
         free(order)
+    _last_bars = out
     return out
+
+
+cdef inline bint _same_bars(PyObject *t, BarRec *bars, Py_ssize_t m):
+    """Whether ``t`` is a tuple of exactly the ``m`` barriers of ``bars``."""
+    cdef Py_ssize_t k
+    if not PyTuple_CheckExact(<object> t) or _tuple_size(t) != m:
+        return False
+    for k in range(m):
+        if _tuple_item(t, k) != bars[k].barrier:
+            return False
+    return True
 
 
 cdef list _rels_by_pass(_Sink sink):
@@ -957,24 +1138,106 @@ cdef object _wait(queue, value, stages):
 
 cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
     """``sync._gather``."""
-    cdef Py_ssize_t count = sink.count, i
-    cdef list waits = sink.waits, signals = [False] * count, values = [0] * count, pass_waits = [()] * count
-    cdef dict counters = {}, found
-    for i in range(count):
-        found = waits[i]
-        if found is not None:
-            for j, _ in found.values():
-                signals[<Py_ssize_t> j] = True
+    cdef Py_ssize_t count = sink.count, i, g, n
+    cdef list signals = [False] * count, values = [0] * count, pass_waits = [()] * count
+    cdef dict counters = {}
+    cdef WaitRec *r
+    cdef tuple made
+    for g in range(sink.nwaits):
+        signals[sink.waits[g].j] = True
     for i in range(count):  # timeline values per queue, 1, 2, ... in plan order
-        if signals[i]:
+        if signals[i] is True:
             queue = passes[i].queue
             values[i] = counters[queue] = counters.get(queue, 0) + 1
     for i in range(count):
-        found = waits[i]
-        if found is not None:
-            pass_waits[i] = tuple([_wait(q, values[<Py_ssize_t> jm[0]], _stage_names(<u64> jm[1]))
-                                   for q, jm in sorted(found.items())])
+        g = sink.whead[i]
+        if g < 0:
+            continue
+        n = 0
+        while g >= 0:
+            n += 1
+            g = sink.waits[g].next
+        made = PyTuple_New(n)
+        g, n = sink.whead[i], 0
+        while g >= 0:  # in queue order
+            r = &sink.waits[g]
+            w = _wait(<object> r.queue, values[r.j], _stage_names(r.stages))
+            Py_INCREF(w)
+            PyTuple_SET_ITEM(made, n, w)
+            n += 1
+            g = r.next
+        pass_waits[i] = made
     return SyncResult(_bars_by_pass(sink), _rels_by_pass(sink), pass_waits, signals, values, final, initial)
+
+
+# ---- the resources' fields ------------------------------------------------------------------
+
+cdef object RESOURCE_TRACE = ResourceTrace, RESOURCE_SPEC = ResourceSpec
+#: Field positions: usages 0, first 1, last 2, cells 3 (the fields without a default named).
+cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group"))
+#: Field positions: name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6 (as ``TRACE``).
+cdef Slots RESOURCE = Slots(ResourceSpec, ("name", "kind", "lifetime", "format", "extent", "layers", "mips", "samples",
+                                           "bytes", "loc"))
+
+
+cdef inline object _trace_field(object r, Py_ssize_t k, str name):
+    """Field ``k`` (named ``name``) of a resource's trace: from its slot where it is exactly a
+    ``ResourceTrace``."""
+    if type(r) is RESOURCE_TRACE:
+        return get(r, TRACE, k)
+    return getattr(r, name)
+
+
+cdef inline object _res_field(object res, Py_ssize_t k, str name):
+    """Field ``k`` (named ``name``) of a ``ResourceSpec`` (as ``_trace_field``)."""
+    if type(res) is RESOURCE_SPEC:
+        return get(res, RESOURCE, k)
+    return getattr(res, name)
+
+
+cdef inline PyObject *_slot(PyObject *o, Slots layout, Py_ssize_t k):
+    """Field ``k`` of ``o`` (exactly ``layout``'s class), borrowed; NULL where unset."""
+    return (<PyObject **> ((<char *> o) + layout.off[k]))[0]
+
+
+cdef inline PyObject *_cells_of(list rs, Py_ssize_t k):
+    """Resource ``k``'s cells list (borrowed), NULL where not an exact ``ResourceTrace``'s list."""
+    cdef PyObject *o = _list_item(<PyObject *> rs, k)
+    if _type(o) != <PyObject *> RESOURCE_TRACE:
+        return NULL
+    o = _slot(o, TRACE, 3)
+    if o == NULL or not PyList_CheckExact(<object> o):
+        return NULL
+    return o
+
+
+cdef void _ahead(list rs, Py_ssize_t k, Py_ssize_t n):
+    """Prefetch what the resource loop reads of the traces after ``k`` (``rs``): the chain trace ->
+    cells list -> its items -> first cell -> (cell, uses), a step further back each resource
+    ahead, so that each pointer read was prefetched a resource earlier (the trace's objects are
+    cold by now)."""
+    cdef PyObject *o
+    if k + 5 < n:
+        _prefetch(_list_item(<PyObject *> rs, k + 5))
+    if k + 4 < n:
+        o = _list_item(<PyObject *> rs, k + 4)
+        if _type(o) == <PyObject *> RESOURCE_TRACE and _slot(o, TRACE, 3) != NULL:
+            _prefetch(_slot(o, TRACE, 3))
+    if k + 3 < n:
+        o = _cells_of(rs, k + 3)
+        if o != NULL:
+            _prefetch((<PyListObject *> o).ob_item)
+    if k + 2 < n:
+        o = _cells_of(rs, k + 2)
+        if o != NULL and _list_size(o):
+            _prefetch(_list_item(o, 0))
+    if k + 1 < n:
+        o = _cells_of(rs, k + 1)
+        if o != NULL and _list_size(o):
+            o = _list_item(o, 0)
+            if PyTuple_CheckExact(<object> o) and _tuple_size(o) == 2:
+                _prefetch(_tuple_item(o, 0))
+                _prefetch(_tuple_item(o, 1))
 
 
 # ---- the phase ------------------------------------------------------------------------------
@@ -998,7 +1261,8 @@ def synchronize(passes, resources, trace, alias_sources=None, ranges=None, outpu
 
 cdef object _synchronize(passes, resources, trace, alias_sources, ranges, outputs):
     global _overflow
-    cdef Py_ssize_t count = len(passes), ncell, g0
+    cdef Py_ssize_t count = len(passes), ncell, g0, ri, nres
+    cdef list names, rs
     cdef dict traced = trace.resources, sources, touched, initial = {}, final = {}, ends = {}
     cdef set wanted, kept_outputs
     cdef bint image, persistent, want
@@ -1011,6 +1275,8 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
         _reset()
     if _sub_count > _SUB_CAP // 4:
         _sub_reset()
+    if _bar_count > _BAR_MAX * 3 // 4:  # room for one more graph's barriers
+        _bar_reset()
     _overflow = False
     alias_sources = alias_sources or {}
     touched = {n: len(traced[n].cells) for preds in alias_sources.values() for n in preds if n in traced}
@@ -1018,13 +1284,18 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
     wanted = {pred for preds in sources.values() for pred in preds}
     kept_outputs = outputs if type(outputs) is set else set(outputs)
     sink = _Sink(count)
-    for name, r in traced.items():
+    names, rs = list(traced), list(traced.values())
+    nres = len(rs)
+    for ri in range(nres):
+        _ahead(rs, ri, nres)
+        name = names[ri]
+        r = rs[ri]
         res = resources[name]
-        image = res.kind == "image"
-        cells = r.cells
+        image = _res_field(res, 1, "kind") == "image"
+        cells = _trace_field(r, 3, "cells")
         ncell = len(cells)
         preds = sources.get(name)
-        lifetime = res.lifetime
+        lifetime = _res_field(res, 2, "lifetime")
         persistent = lifetime == "persistent" or lifetime == "imported"
         want = name in wanted
         layout = "UNDEFINED" if image else None
@@ -1036,7 +1307,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
             sub = _sub(mip, mip + 1, layer, layer + 1) if image else None
             _fresh(&st, layout)
             if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
-                aliases, alias_waits = _alias_start(preds, ends, r.first, &st)
+                aliases, alias_waits = _alias_start(preds, ends, _trace_field(r, 1, "first"), &st)
                 initial[name] = _end_state_of(&st)
             else:
                 aliases = alias_waits = ()
@@ -1074,7 +1345,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
             _fresh(&first, layout)
             aliases = alias_waits = ()
             if preds:  # start from the earlier occupants' last accesses (UNDEFINED)
-                aliases, alias_waits = _alias_start(preds, ends, r.first, &first)
+                aliases, alias_waits = _alias_start(preds, ends, _trace_field(r, 1, "first"), &first)
             first_state = _end_state_of(&first)  # every cell starts alike
             for cell in cells:
                 c = <tuple> cell[0]
@@ -1089,7 +1360,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
                     _end_masks(&st, &es, &ea)
                     kept.append((es, ea, <object> st.cq, st.last_pass))
         if ncell > 1:
-            _rect_groups(sink, g0, name, res.mips, res.layers)
+            _rect_groups(sink, g0, name, _res_field(res, 6, "mips"), _res_field(res, 5, "layers"))
         per_cell = lifetime != "transient" or name in kept_outputs
         initial[name] = _end_state_c(per_cell, cells, starts)
         final[name] = _end_state_c(per_cell, cells, finals)

@@ -155,3 +155,73 @@ def test_a_full_scope_table_retries_from_empty_tables(tmp_path: Path, monkeypatc
         calls.clear()
         same(*both(c))
         calls.clear()
+
+
+def test_barriers_are_reused_across_compiles(tmp_path: Path) -> None:
+    """A compile of the same graph, from the same spec or a freshly parsed one, gets the
+    earlier compile's barrier objects (equal values are one object) and each pass's tuple of
+    them, still the reference's."""
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=5, passes=200)))
+    first, python = both(compilation(frontend(path, size=(16, 16)).spec))
+    same(first, python)
+    for spec in (frontend(path, size=(16, 16)).spec, frontend(path, size=(16, 16)).spec):
+        again, python = both(compilation(spec))
+        same(again, python)
+        for kind in ("barriers", "releases"):
+            old, new = getattr(first, kind), getattr(again, kind)
+            assert all(a is b for olds, news in zip(old, new) for a, b in zip(olds, news)), kind
+        assert all(a is b for a, b in zip(first.barriers, again.barriers))  # each pass's tuple too
+    assert any(first.releases)
+
+
+def test_more_barriers_than_the_table_lists(tmp_path: Path) -> None:
+    """More distinct barriers than the table lists (4,096): the rest are made and kept for the
+    one compile; the next compile starts from an empty table."""
+    count = 2100  # buffers written by w, read by r (a barrier each), written again by x (another)
+    names = [f"b{k}" for k in range(count)]
+    lines = ["rgraph: 1", "name: many_barriers", "resources:"]
+    lines += [f"  {n}: {{kind: buffer, bytes: 256}}" for n in names]
+    lines += ["  out: {kind: buffer, bytes: 256}", "passes:"]
+    for name, kind, usage, extra in (("w", "writes", "storage_write", ()), ("r", "reads", "storage_read", ()),
+                                     ("x", "writes", "storage_write", ("out: storage_rw",))):
+        lines += [f"  {name}:", "    kind: compute", f"    {kind}:"] + [f"      {n}: {usage}" for n in names]
+        if name == "r":
+            lines += ["    writes:", "      out: storage_write"]
+        lines += [f"      {e}" for e in extra]
+    lines += ["outputs:"] + [f"  - {n}" for n in names + ["out"]]
+    path = tmp_path / "g.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    native, python = both(compilation(frontend(path, size=(16, 16)).spec))
+    assert len({id(b) for bs in native.barriers for b in bs}) > 4096
+    same(native, python)
+    small = tmp_path / "small.yaml"
+    small.write_text(to_yaml(random_graph(seed=0, passes=60)))
+    same(*both(compilation(frontend(small, size=(16, 16)).spec)))
+
+
+def test_resources_of_other_classes_read_by_attribute(tmp_path: Path) -> None:
+    """Traces and resource specs of subclasses (not read from their slots) give the same result."""
+    import dataclasses
+
+    from rgraph.compiler.trace import ResourceTrace
+    from rgraph.spec.specialize import ResourceSpec
+
+    class OtherTrace(ResourceTrace):
+        pass
+
+    class OtherSpec(ResourceSpec):
+        pass
+
+    def copy(value, cls):
+        return cls(**{f.name: getattr(value, f.name) for f in dataclasses.fields(value)})
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=5, passes=200)))
+    c = compilation(frontend(path, size=(16, 16)).spec)
+    expected = both(c)[0]
+    trace = dataclasses.replace(c.trace, resources={n: copy(r, OtherTrace) for n, r in c.trace.resources.items()})
+    spec = dataclasses.replace(c.spec, resources={n: copy(r, OtherSpec) for n, r in c.spec.resources.items()})
+    native, python = both(dataclasses.replace(c, trace=trace, spec=spec))
+    same(native, python)
+    same(native, expected)

@@ -543,6 +543,28 @@ def blocks(list names, memory):
     return out
 
 
+def columns(list names, memory):
+    """``blocks(names, memory)`` as the columns of ``rgraph.memory._fit.Columns``: ``(start,
+    end, size, alignment, memory_class)``, the first and last pass, bytes, alignment and
+    class of each name's ``memory``."""
+    cdef list start = [], end = [], size = [], alignment = [], classes = []
+    for n in names:
+        m = memory[n]
+        if type(m) is ResourceMemory:  # its slots read directly
+            start.append(get(m, MEMORY, 5))
+            end.append(get(m, MEMORY, 6))
+            size.append(get(m, MEMORY, 0))
+            alignment.append(get(m, MEMORY, 1))
+            classes.append(get(m, MEMORY, 3))
+        else:
+            start.append(m.first)
+            end.append(m.last)
+            size.append(m.bytes)
+            alignment.append(m.alignment)
+            classes.append(m.memory_class)
+    return start, end, size, alignment, classes
+
+
 def split(resources, memory, outputs):
     """``place_resources``' ``(aliasable, rest)``: the names of ``memory`` in sorted order,
     the transients that are not ``outputs`` in the first list, the others in the second."""

@@ -32,6 +32,9 @@ def test_blocks_equal_the_python_ones() -> None:
     assert "aligned_size" not in vars(native[3])  # computed on use, as before: ZeroDivisionError then
     with pytest.raises(ZeroDivisionError):
         _ = native[3].aligned_size
+    start, end, size, alignment, classes = memory.NATIVE.columns(names, mem)  # the same, as columns
+    assert list(zip(names, start, end, size, alignment, classes, strict=True)) == [
+        (b.name, b.start, b.end, b.size, b.alignment, b.memory_class) for b in python]
 
 
 def test_requirements_read_the_provider_memos_by_its_keys(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -181,3 +181,21 @@ def test_compiled_alias_sources_match_python(tmp_path: Path, seed: int) -> None:
         got = memory.NATIVE.alias_sources(p, c.memory)
         assert want, "the graph should alias"
         assert got == want and list(got) == list(want)
+
+
+def test_measure_reads_resources_of_another_type_by_attribute(tmp_path: Path) -> None:
+    """``_memory.measure`` reads a ``ResourceSpec``'s slots directly and any other object's
+    attributes: the same values either way."""
+    from dataclasses import fields
+    from types import SimpleNamespace
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=7, passes=120)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    args = (c.trace.resources, spec.outputs, c.provider, c.culling.culled, spec.passes, spec.empty,
+            memory._SAME_BUFFER_FLAG)
+    plain = {n: SimpleNamespace(**{f.name: getattr(r, f.name) for f in fields(r)}) for n, r in spec.resources.items()}
+    want = memory.NATIVE.measure(spec.resources, *args)
+    got = memory.NATIVE.measure(plain, *args)
+    assert got == want and list(got[0]) == list(want[0]) == list(c.memory)

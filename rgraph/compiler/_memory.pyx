@@ -26,15 +26,15 @@ cdef Slots MEMORY = Slots(ResourceMemory, ("bytes", "alignment", "memory_type_bi
 
 # The slots of the values ``measure`` reads (set on first use: their modules import later
 # than this one); each read checks the exact type first, else falls back to ``getattr``.
-cdef Slots TRACE = None, ACCESS = None, PASS = None, CULLED = None
-cdef object TRACE_T = None, ACCESS_T = None, PASS_T = None, CULLED_T = None
+cdef Slots TRACE = None, ACCESS = None, PASS = None, CULLED = None, RES = None
+cdef object TRACE_T = None, ACCESS_T = None, PASS_T = None, CULLED_T = None, RES_T = None
 
 
 cdef int _layouts() except -1:
-    global TRACE, ACCESS, PASS, CULLED, TRACE_T, ACCESS_T, PASS_T, CULLED_T
+    global TRACE, ACCESS, PASS, CULLED, RES, TRACE_T, ACCESS_T, PASS_T, CULLED_T, RES_T
     from rgraph.compiler.trace import ResourceTrace
     from rgraph.ir.cull import Culled
-    from rgraph.spec.specialize import AccessSpec, PassSpec
+    from rgraph.spec.specialize import AccessSpec, PassSpec, ResourceSpec
 
     TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group"))
     ACCESS = Slots(AccessSpec, ("resource", "usage", "write", "mips", "layers", "stages", "optional", "loc",
@@ -42,7 +42,9 @@ cdef int _layouts() except -1:
     PASS = Slots(PassSpec, ("name", "order", "kind", "queue", "impl", "requires", "side_effects", "accesses",
                             "params", "loc", "requires_any"))
     CULLED = Slots(Culled, ("pass_name", "reason"))
-    TRACE_T, ACCESS_T, PASS_T, CULLED_T = ResourceTrace, AccessSpec, PassSpec, Culled
+    RES = Slots(ResourceSpec, ("name", "kind", "lifetime", "format", "extent", "layers", "mips", "samples", "bytes",
+                               "loc"))
+    TRACE_T, ACCESS_T, PASS_T, CULLED_T, RES_T = ResourceTrace, AccessSpec, PassSpec, Culled, ResourceSpec
     return 0
 
 
@@ -275,7 +277,7 @@ def measure(resources, traced, outputs, provider, culled, passes, empty, dict sa
     requirements of the used resources (``requirements_python`` of their usages), their
     ``resource_memory_python`` values, and the culled-only resources' bytes, in one pass
     over the used resources: each usage set sorted once (twice where ``transfer_src`` joins
-    it), no ``Requirement`` made for them, the trace read from its slots."""
+    it), no ``Requirement`` made for them, the trace and the resources read from their slots."""
     cdef dict out = {}, memo = None, buffer_memo = None, flags_memo = {}
     cdef dict culled_bytes = {}, only_by_pass
     cdef set kept = set(outputs), usage_set
@@ -309,25 +311,29 @@ def measure(resources, traced, outputs, provider, culled, passes, empty, dict sa
                 firsts.append(rt.first)
                 lasts.append(rt.last)
             res = resources[name]
+            if type(res) is RES_T:  # its slots read directly
+                kind, lifetime, fmt, extent = get(res, RES, 1), get(res, RES, 2), get(res, RES, 3), get(res, RES, 4)
+                layers, mips, samples, size_ = get(res, RES, 5), get(res, RES, 6), get(res, RES, 7), get(res, RES, 8)
+            else:
+                kind, lifetime, fmt, extent = res.kind, res.lifetime, res.format, res.extent
+                layers, mips, samples, size_ = res.layers, res.mips, res.samples, res.bytes
             usages = sorted(usage_set)
             utuple = tuple(usages)
             tuples.append(utuple)
-            if name in kept or res.lifetime == "output":
+            if name in kept or lifetime == "output":
                 usages = sorted(usage_set | {"transfer_src"})
                 key_usages = tuple(usages)
             else:
                 key_usages = utuple
             try:
-                image = res.kind == "image"  # ``res.is_image``
+                image = kind == "image"  # ``res.is_image``
                 if image:
-                    fmt = res.format
                     assert fmt is not None
                     got = None
                     if memo is not None:  # ``ProfileMemoryRequirements.image``'s key
-                        got = memo.get((fmt.vk_name, tuple(res.extent), res.mips, res.layers, res.samples,
-                                        key_usages))
+                        got = memo.get((fmt.vk_name, tuple(extent), mips, layers, samples, key_usages))
                     if got is None:
-                        got = provider.image(fmt.vk_name, res.extent, res.mips, res.layers, res.samples, usages)
+                        got = provider.image(fmt.vk_name, extent, mips, layers, samples, usages)
                 else:
                     flags_pair = flags_memo.get(key_usages)
                     if flags_pair is None:
@@ -336,9 +342,9 @@ def measure(resources, traced, outputs, provider, culled, passes, empty, dict sa
                         flags_memo[key_usages] = flags_pair
                     got = None
                     if buffer_memo is not None:  # ``ProfileMemoryRequirements.buffer``'s key
-                        got = buffer_memo.get((res.bytes, flags_pair[1]))
+                        got = buffer_memo.get((size_, flags_pair[1]))
                     if got is None:
-                        got = provider.buffer(res.bytes, list(flags_pair[0]))
+                        got = provider.buffer(size_, list(flags_pair[0]))
                 if type(got) is tuple and len(<tuple> got) == 3:
                     found = <tuple> got
                     bits = found[2]
@@ -541,6 +547,28 @@ def blocks(list names, memory):
             d["aligned_size"] = size if rem == 0 else size + alignment - rem
         out.append(b)
     return out
+
+
+def columns(list names, memory):
+    """``blocks(names, memory)`` as the columns of ``rgraph.memory._fit.Columns``: ``(start,
+    end, size, alignment, memory_class)``, the first and last pass, bytes, alignment and
+    class of each name's ``memory``."""
+    cdef list start = [], end = [], size = [], alignment = [], classes = []
+    for n in names:
+        m = memory[n]
+        if type(m) is ResourceMemory:  # its slots read directly
+            start.append(get(m, MEMORY, 5))
+            end.append(get(m, MEMORY, 6))
+            size.append(get(m, MEMORY, 0))
+            alignment.append(get(m, MEMORY, 1))
+            classes.append(get(m, MEMORY, 3))
+        else:
+            start.append(m.first)
+            end.append(m.last)
+            size.append(m.bytes)
+            alignment.append(m.alignment)
+            classes.append(m.memory_class)
+    return start, end, size, alignment, classes
 
 
 def split(resources, memory, outputs):

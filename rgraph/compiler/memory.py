@@ -170,17 +170,21 @@ def place_resources(
     """Place transients with ``policy``; give every other resource its own heap.
     ``conflicts``: transients that may not alias although apart in time (queue_order.py).
     ``split`` (compiled path only): ``NATIVE.split(resources, memory, outputs)``, made already."""
+    from rgraph.memory import _NATIVE as fit
+    from rgraph.memory import place
+
     if NATIVE is None:
         kept = set(outputs)
         aliasable = [n for n in sorted(memory) if resources[n].lifetime == "transient" and n not in kept]
         blocks = [
             Block(n, m.first, m.last, m.bytes, m.alignment, m.memory_class) for n in aliasable for m in (memory[n],)
         ]
-    else:  # the same names, and the same blocks built in C with their aligned sizes
+    else:  # the same names, and the same blocks built in C: as columns where built (no Block each)
         aliasable, rest = NATIVE.split(resources, memory, outputs) if split is None else split
-        blocks = NATIVE.blocks(aliasable, memory)
-    from rgraph.memory import place
-
+        if fit is None:
+            blocks = NATIVE.blocks(aliasable, memory)
+        else:
+            blocks = fit.Columns(aliasable, *NATIVE.columns(aliasable, memory))
     placed = place(blocks, policy, conflicts=conflicts)
     offsets = dict(placed.offsets)
     heaps = list(placed.heaps)

@@ -9,16 +9,25 @@ from __future__ import annotations
 import time
 from collections.abc import Collection, Mapping, Sequence
 
-from rgraph.memory.aliased import overlapping_pairs, place_class, too_dense_pairs
+from rgraph.memory.aliased import (
+    MIN_GREEDY_PAIRS,
+    OPS_PER_SECOND,
+    PAIRS_PER_SECOND,
+    dive_ops,
+    overlapping_pairs,
+    place_class,
+    too_dense_pairs,
+)
 from rgraph.memory.bounds import class_lower_bound
-from rgraph.memory.instance import Instance
+from rgraph.memory.instance import SWEEP_FROM, Instance
 from rgraph.memory.model import Block, Heap, Placement, PlacementStats, by_class, check_blocks
 from rgraph.memory.online import place_blocks, place_tlsf
 from rgraph.memory.policy import Policy, parse_policy
 from rgraph.native import load
 
 #: ``rgraph/memory/_fit.pyx`` (its ``class_groups``: the checks, the classes and their
-#: overlapping pairs in one pass), None where not built or ``RGRAPH_NATIVE=0``.
+#: overlapping pairs in one pass; ``Columns``: blocks as arrays, each class's greedy on them),
+#: None where not built or ``RGRAPH_NATIVE=0``.
 _NATIVE = load("rgraph.memory._fit")
 
 __all__ = ["Block", "Heap", "Placement", "PlacementStats", "Policy", "parse_policy", "parse_place_args", "place"]
@@ -76,22 +85,27 @@ def place(
     """Place ``blocks`` under ``policy``. Heap ids go by memory class (sorted), then by
     creation order within a class. Deterministic: the same input gives the same output.
     ``conflicts`` (``aliased`` and ``optimal``): pairs of names that may not share bytes
-    although apart in time."""
+    although apart in time. ``blocks`` may be ``Columns`` (compiled: the same placement,
+    each class's greedy run on its arrays, no ``Block`` made unless a class needs the search)."""
     began = time.perf_counter()
     chosen = parse_policy(policy)
-    grouped = class_groups(blocks)
+    columns = blocks if _NATIVE is not None and type(blocks) is _NATIVE.Columns else None
+    if columns is not None and not (columns.valid and chosen.kind in ("aliased", "optimal")):
+        blocks, columns = columns.blocks(), None
+    grouped = class_groups(blocks) if columns is None else None
     if chosen.kind == "optimal" and time_budget_s == DEFAULT_BUDGET_S:
         time_budget_s = OPTIMAL_BUDGET_S
     offsets: dict[str, tuple[int, int]] = {}
     heaps: list[Heap] = []
     bound = 0  # the time bound summed over classes
+    unaliased = 0
 
     def new_heap(size: int, memory_class: str, alignment: int) -> int:
         heaps.append(Heap(len(heaps), size, memory_class, alignment))
         return len(heaps) - 1
 
-    unaliased = 0
-    for memory_class, (group, max_align, pairs, group_bytes) in grouped.items():
+    def place_group(memory_class: str, group: list[Block], max_align: int, pairs: int, group_bytes: int) -> None:
+        nonlocal bound, unaliased
         unaliased += group_bytes
         searched = chosen.kind in ("aliased", "optimal") and not too_dense_pairs(pairs, time_budget_s)
         if not searched:  # place_class gives it otherwise
@@ -123,6 +137,23 @@ def place(
                 new_heap(size, memory_class, max(members, default=1))
             for b, (alloc, offset) in zip(group, where, strict=True):
                 offsets[b.name] = (first + alloc, offset)
+
+    if columns is None:
+        assert grouped is not None
+        for memory_class, found in grouped.items():
+            place_group(memory_class, *found)
+    else:
+        dense = max(MIN_GREEDY_PAIRS, time_budget_s * PAIRS_PER_SECOND)  # too_dense_pairs's limit
+        dives = dive_ops(int(time_budget_s * OPS_PER_SECOND))
+        for k, memory_class in enumerate(columns.classes):
+            done = columns.greedy(k, conflicts, dense, dives, SWEEP_FROM, len(heaps), offsets)
+            if done is None:  # TLSF or the search: on the blocks
+                place_group(memory_class, *class_groups_python(columns.group(k))[memory_class])
+                continue
+            max_align, group_bytes, time_bound, peak = done
+            unaliased += group_bytes
+            bound += time_bound
+            new_heap(peak, memory_class, max_align)
     stats = PlacementStats(
         policy=str(chosen),
         peak_bytes=sum(h.bytes for h in heaps),

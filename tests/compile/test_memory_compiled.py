@@ -32,6 +32,9 @@ def test_blocks_equal_the_python_ones() -> None:
     assert "aligned_size" not in vars(native[3])  # computed on use, as before: ZeroDivisionError then
     with pytest.raises(ZeroDivisionError):
         _ = native[3].aligned_size
+    start, end, size, alignment, classes = memory.NATIVE.columns(names, mem)  # the same, as columns
+    assert list(zip(names, start, end, size, alignment, classes, strict=True)) == [
+        (b.name, b.start, b.end, b.size, b.alignment, b.memory_class) for b in python]
 
 
 def test_requirements_read_the_provider_memos_by_its_keys(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -178,3 +181,21 @@ def test_compiled_alias_sources_match_python(tmp_path: Path, seed: int) -> None:
         got = memory.NATIVE.alias_sources(p, c.memory)
         assert want, "the graph should alias"
         assert got == want and list(got) == list(want)
+
+
+def test_measure_reads_resources_of_another_type_by_attribute(tmp_path: Path) -> None:
+    """``_memory.measure`` reads a ``ResourceSpec``'s slots directly and any other object's
+    attributes: the same values either way."""
+    from dataclasses import fields
+    from types import SimpleNamespace
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=7, passes=120)))
+    spec = frontend(path, size=(16, 16)).spec
+    c = compilation(spec)
+    args = (c.trace.resources, spec.outputs, c.provider, c.culling.culled, spec.passes, spec.empty,
+            memory._SAME_BUFFER_FLAG)
+    plain = {n: SimpleNamespace(**{f.name: getattr(r, f.name) for f in fields(r)}) for n, r in spec.resources.items()}
+    want = memory.NATIVE.measure(spec.resources, *args)
+    got = memory.NATIVE.measure(plain, *args)
+    assert got == want and list(got[0]) == list(want[0]) == list(c.memory)

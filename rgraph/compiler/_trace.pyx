@@ -28,16 +28,20 @@ cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared
 # ---- each pass's accesses, by the pass's identity --------------------------------------------
 # A ``PassSpec`` is frozen, and so are its ``AccessSpec``s: its queue, kind and accesses, and
 # each access's fields, scope (``trace._SCOPES`` by (usage, kind, stages, code, refit)) and
-# subresource (by (mips, layers)) depend only on it and on its resource's format code. The
-# walk meets the same passes at every compile of a graph: this table finds them by the pass's
-# pointer, one probe per pass, with each access's fields read once, at the pass's first walk,
-# into a C array (``_Acc``); later walks read those instead of the cold ``AccessSpec``s and
-# look up no scope. Each object is kept alive while listed (``_table_keep``), so no pointer
-# is reused; a scope is used only where its resource's format code is the one it was found
-# for (else found again). The values are the ones the lookups give (equal ones, where those
-# tables were cleared since): the walk's results do not change. The table is emptied at a
-# walk's start once half full, and only when no other walk (another thread's) is under way:
-# while one is, what the table points at stays.
+# plan value (``pm.Access``, frozen: of its fields, the scope and the subresource by (mips,
+# layers)) depend only on it and on its resource's format code. The walk meets the same passes
+# at every compile of a graph: this table finds them by the pass's pointer, one probe per pass,
+# with each access's fields read once, at the pass's first walk, into a C array (``_Acc``);
+# later walks read those instead of the cold ``AccessSpec``s, look up no scope and build no
+# plan value: the pass's tuple of them is the first walk's (shared by the plans; ``patch``
+# copies a tuple it changes). So are its uses of its cells (``Use``: the pass's index and
+# queue, the access's scope and write, and the position, which depends only on the pass's
+# accesses) where the pass has its first walk's index. Each object is kept alive while listed
+# (``_table_keep``), so no pointer is reused; a scope, value or use is used only where its
+# resource's format code is the one it was found for (else found again). The values are the
+# ones the lookups give (equal ones, where those tables were cleared since): the walk's results
+# do not change. The table is emptied at a walk's start once half full, and only when no other
+# walk (another thread's) is under way: while one is, what the table points at stays.
 
 from libc.stdlib cimport malloc, free
 from cpython.exc cimport PyErr_Clear, PyErr_Occurred
@@ -48,7 +52,6 @@ cdef enum:
     _MAX_CACHED = 64  # passes of more accesses are not listed
 
 cdef struct _Acc:
-    PyObject *access
     PyObject *name
     PyObject *usage
     PyObject *write
@@ -56,8 +59,11 @@ cdef struct _Acc:
     PyObject *mips
     PyObject *layers
     PyObject *scope  # tuple: trace._SCOPES' value, for ``code``
-    PyObject *sub  # pm.Subresource or None
+    PyObject *value  # pm.Access, for ``code``
+    PyObject *uses  # the uses of its cells (all appended, none merged), for ``code`` and the pass's ``i``: the
+    # use (a tuple) where it has one cell (``one``), else a tuple of them; or NULL
     long code
+    bint one
     bint w  # ``write``'s truth
     bint ranges  # mips and layers are pairs of ints, (mlo, mhi) and (llo, lhi)
     long mlo, mhi, llo, lhi
@@ -67,6 +73,9 @@ cdef struct PassSlot:
     PyObject *queue
     PyObject *kind
     PyObject *accesses  # tuple
+    PyObject *values  # tuple: the accesses' ``value``s
+    PyObject *oi  # int: the pass's index at its first walk, ``i``
+    Py_ssize_t i
     Py_ssize_t n
     _Acc *accs
 
@@ -86,9 +95,11 @@ cdef inline PassSlot *_pass_find(object p):
     return NULL
 
 
-cdef void _pass_add(object p, object queue, object kind, object accesses, Py_ssize_t n, _Acc *accs):
-    """List pass ``p`` with a copy of its accesses' ``accs`` (not once the table is half full,
-    nor where it is listed already: another thread's walk may have listed it meanwhile)."""
+cdef void _pass_add(object p, object queue, object kind, object accesses, tuple values, object oi, Py_ssize_t i,
+                    Py_ssize_t n, _Acc *accs, list held):
+    """List pass ``p`` (index ``i``, ``oi``) with its plan ``values`` and a copy of its accesses'
+    ``accs`` (``held``: their scopes and uses); not once the table is half full, nor where it is
+    listed already (another thread's walk may have listed it meanwhile)."""
     global _pass_count
     cdef Py_ssize_t k
     if _pass_count >= _TABLE_CAP // 2 or _pass_find(p) != NULL:
@@ -100,14 +111,18 @@ cdef void _pass_add(object p, object queue, object kind, object accesses, Py_ssi
     while _passes[h].pass_ != NULL:
         h = (h + 1) & (_TABLE_CAP - 1)
     _table_keep.append(p)  # holds its queue, kind, accesses and their fields
+    _table_keep.append(values)  # and the values their subresources
+    _table_keep.append(oi)
+    _table_keep.extend(held)
     for k in range(n):
         copy[k] = accs[k]
-        _table_keep.append(<object> accs[k].scope)
-        _table_keep.append(<object> accs[k].sub)
     _passes[h].pass_ = <PyObject *> p
     _passes[h].queue = <PyObject *> queue
     _passes[h].kind = <PyObject *> kind
     _passes[h].accesses = <PyObject *> accesses
+    _passes[h].values = <PyObject *> values
+    _passes[h].oi = <PyObject *> oi
+    _passes[h].i = i
     _passes[h].n = n
     _passes[h].accs = copy
     _pass_count += 1
@@ -128,6 +143,7 @@ def reset_access_table():
     """Empty the table (tests: a walk that fills it afresh gives the same results)."""
     if _walking == 0:
         _table_reset()
+
 
 
 cdef inline bint _pair(object t, long *lo, long *hi):
@@ -227,19 +243,22 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     return r
 
 
-cdef inline int _add_use(list uses, Py_ssize_t i, object oi, object s, object w, object queue, Py_ssize_t pos,
-                         dict waits) except -1:
-    """Pass ``i``'s use of a cell that has ``uses`` already: 1 where appended (at ``pos``), 0 where a
-    second access of the pass to the cell merged into its last use."""
+cdef inline tuple _add_use(list uses, Py_ssize_t i, object oi, object s, object w, object queue, Py_ssize_t pos,
+                           dict waits, object use):
+    """Pass ``i``'s use of a cell that has ``uses`` already: the use appended (at ``pos``; ``use``
+    where given: the same values), or None where a second access of the pass to the cell merged
+    into its last use."""
     cdef tuple prev = <tuple> uses[len(uses) - 1]
     if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
         uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
-        return 0
+        return None
     q = prev[3]
     if q is not queue and q != queue:  # the dedicated plan waits for that use
         _wait(waits, oi, prev, q)
-    uses.append((oi, s, w, queue, pos))
-    return 1
+    if use is None:
+        use = (oi, s, w, queue, pos)
+    uses.append(use)
+    return <tuple> use
 
 
 cdef inline void _wait(dict waits, object i, tuple prev, object q):
@@ -249,6 +268,21 @@ cdef inline void _wait(dict waits, object i, tuple prev, object q):
         waits[i] = {q: prev[0]}
     elif found.get(q, -1) < prev[0]:
         found[q] = prev[0]
+
+
+cdef inline void _set(tuple t, Py_ssize_t k, object value):
+    """Item ``k`` of a new tuple ``t`` (each once)."""
+    Py_INCREF(value)
+    PyTuple_SET_ITEM(t, k, value)
+
+
+cdef tuple _prefix(tuple values, Py_ssize_t j):
+    """A new tuple as long as ``values``, with its first ``j`` items (the others to set)."""
+    cdef tuple out = PyTuple_New(len(values))
+    cdef Py_ssize_t k
+    for k in range(j):
+        _set(out, k, values[k])
+    return out
 
 
 def walk(passes, resources, dict scopes, scope_of, list moved=None):
@@ -271,45 +305,51 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
     cdef list plan_accesses = [], uses, cells
     cdef tuple values, accs
     cdef dict info = {}, timeline = {}, waits = {}
-    cdef list pending = []  # the scopes and subresources of ``fresh``
-    cdef Py_ssize_t i = -1, j, n, pos
-    cdef bint raytrace, whole, listing
+    cdef list held = []  # the scopes and uses of ``fresh`` (the caches may drop the scopes before it is listed)
+    cdef Py_ssize_t i = -1, j, n, m, pos
+    cdef bint raytrace, whole, listing, shared, same, reuse, keep
     cdef PassSlot *slot
     cdef _Acc *known  # the listed pass's accesses
     cdef _Acc fresh[_MAX_CACHED]  # an unlisted pass's, to list it
-    cdef _Acc cur
+    cdef _Acc spare  # an unlisted pass's access, not to list
+    cdef _Acc *cur
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, a
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, a, use, given, made
     for p in passes:
         i += 1
-        oi = i
         slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
         if slot != NULL:
             queue, kind, accs = <object> slot.queue, <object> slot.kind, <tuple> slot.accesses
             known = slot.accs
             listing = False
+            values = <tuple> slot.values  # shared: copied (``_prefix``) where a value differs
+            shared = True
+            same = slot.i == i  # the listed uses hold (their index)
+            oi = <object> slot.oi if same else i
         else:
             queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
             accs = <tuple> pass_field(p, 7, "accesses")
             known = NULL
             listing = type(p) is PASS_SPEC and len(accs) <= _MAX_CACHED
-            if pending:
-                pending.clear()
+            if held:
+                held.clear()
+            values = PyTuple_New(len(accs))  # the plan's tuple (emit keeps it)
+            shared = same = False
+            oi = i
         raytrace = kind == "raytrace"
         n = len(accs)
-        values = PyTuple_New(n)  # the plan's tuple (emit keeps it)
         pos = 0
         for j in range(n):
             if known != NULL:
-                cur = known[j]
+                cur = &known[j]
                 name, usage, w = <object> cur.name, <object> cur.usage, <object> cur.write
             else:
                 a = accs[j]
                 if listing and type(a) is not ACCESS_SPEC:  # only AccessSpecs are frozen
                     listing = False
+                cur = &fresh[j] if listing else &spare
                 name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
-                cur.access = <PyObject *> a
                 cur.name, cur.usage, cur.write = <PyObject *> name, <PyObject *> usage, <PyObject *> w
                 cur.w = w
                 cur.scope = NULL
@@ -326,9 +366,11 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
             if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 r.usages.add("trace_indirect")
                 r.last_usage = None
-            if cur.scope != NULL and cur.code == r.icode:  # listed, for this format code
+            reuse = cur.scope != NULL and cur.code == r.icode  # listed, for this format code
+            if reuse:
                 scope = <tuple> cur.scope
-                sub = <object> cur.sub
+                if not shared:
+                    _set(values, j, <object> cur.value)
             else:
                 a = accs[j]
                 key = (usage, kind, access_field(a, 5, "stages"), r.code, access_field(a, 8, "refit"))
@@ -341,27 +383,28 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                     sub = SUBRESOURCES.get((mips, layers))
                     if sub is None:
                         sub = subresource(mips, layers)
+                value = new_slots(ACCESS)
+                put(value, ACCESS, 0, name)
+                put(value, ACCESS, 1, sub)
+                put(value, ACCESS, 2, usage)
+                put(value, ACCESS, 3, scope[1])
+                put(value, ACCESS, 4, scope[2])
+                put(value, ACCESS, 5, scope[3])
+                put(value, ACCESS, 6, w)
+                if shared:  # the listed tuple holds another value here
+                    values = _prefix(values, j)
+                    shared = False
+                _set(values, j, value)
                 if listing:
-                    cells = None
                     c = access_field(a, 9, "cells")
                     cur.cells, cur.mips, cur.layers = <PyObject *> c, <PyObject *> mips, <PyObject *> layers
                     cur.ranges = _pair(mips, &cur.mlo, &cur.mhi) and _pair(layers, &cur.llo, &cur.lhi)
-                    cur.scope, cur.sub, cur.code = <PyObject *> scope, <PyObject *> sub, r.icode
-                    fresh[j] = cur
-                    pending.append(scope)  # (the caches may drop them before the pass is listed)
-                    pending.append(sub)
+                    cur.scope, cur.value, cur.code = <PyObject *> scope, <PyObject *> value, r.icode
+                    cur.uses = NULL
+                    cur.one = len(<tuple> c) == 1
+                    held.append(scope)
             s = scope[0]
             layout = scope[3]
-            value = new_slots(ACCESS)
-            put(value, ACCESS, 0, name)
-            put(value, ACCESS, 1, sub)
-            put(value, ACCESS, 2, usage)
-            put(value, ACCESS, 3, scope[1])
-            put(value, ACCESS, 4, scope[2])
-            put(value, ACCESS, 5, layout)
-            put(value, ACCESS, 6, w)
-            Py_INCREF(value)
-            PyTuple_SET_ITEM(values, j, value)
             if r.candidate:
                 if known != NULL and cur.ranges and r.cranges:
                     whole = cur.mlo == 0 and cur.mhi == r.cm and cur.llo == 0 and cur.lhi == r.cl
@@ -385,27 +428,56 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                         r.cur.append((oi, j))
                         if not r.mixed and layout is not r.lay0 and layout != r.lay0:
                             r.mixed = True
+            # the uses: the listed ones (``given``), else new ones, which a listing pass keeps (``made``)
+            given = <object> cur.uses if reuse and same and cur.uses != NULL else None
+            made = None
             if r.single:  # most resources: the one cell's uses without a lookup by cell
+                if given is not None and not cur.one:
+                    given = (<tuple> given)[0]
                 cells = r.cells
-                if not cells:  # (the cells tuple is read only here: it is cold)
+                if cells:
+                    use = _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits, given)
+                else:  # (the cells tuple is read only here: it is cold)
+                    use = (oi, s, w, queue, pos) if given is None else given
                     cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
-                    cells.append((cs[0], [(oi, s, w, queue, pos)]))
+                    cells.append((cs[0], [use]))
+                if use is not None:
                     pos += 1
-                    continue
-                pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
-                continue
-            cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
-            for c in cs:
-                found = timeline.get(c)
-                if found is None:
-                    uses = [(oi, s, w, queue, pos)]
-                    timeline[c] = uses
-                    r.cells.append((c, uses))
+                    if listing and cur.one:
+                        made = use
+            else:
+                cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
+                keep = listing
+                if keep and not cur.one:
+                    made = PyTuple_New(len(cs))
+                m = -1
+                for c in cs:
+                    m += 1
+                    use = given if given is None or cur.one else (<tuple> given)[m]
+                    found = timeline.get(c)
+                    if found is None:
+                        if use is None:
+                            use = (oi, s, w, queue, pos)
+                        uses = [use]
+                        timeline[c] = uses
+                        r.cells.append((c, uses))
+                    else:
+                        use = _add_use(<list> found, i, oi, s, w, queue, pos, waits, use)
+                    if use is None:  # merged: the positions after it are others
+                        given = made = None
+                        keep = False
+                        continue
                     pos += 1
-                    continue
-                pos += _add_use(<list> found, i, oi, s, w, queue, pos, waits)
+                    if keep:
+                        if cur.one:
+                            made = use
+                        else:
+                            _set(<tuple> made, m, use)
+            if made is not None:
+                cur.uses = <PyObject *> made
+                held.append(made)
         if listing:
-            _pass_add(p, queue, kind, accs, n, fresh)
+            _pass_add(p, queue, kind, accs, values, oi, i, n, fresh, held)
         plan_accesses.append(values)
     traced = {}
     for name, found in info.items():

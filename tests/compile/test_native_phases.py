@@ -185,6 +185,46 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
     walks_alike(passes, recoded)
 
 
+def test_the_access_table_gives_a_listed_pass_s_values_and_uses_again(tmp_path: Path) -> None:
+    """A listed pass's plan values (its tuple of them) and its uses of its cells (but those merged
+    from several accesses) are the objects of its first walk where its index is the same; at
+    another index (here: the first pass left out) it gets new uses; after ``reset_access_table``
+    all are new: every walk gives the Python walk's results."""
+    from collections import Counter
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=9, passes=150)))
+    spec = frontend(path, size=(16, 16)).spec
+    passes, resources = list(spec.passes), spec.resources
+
+    def walk(ps) -> tuple:
+        native = trace.NATIVE.walk(ps, resources, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, resources)
+        assert rows(native[0]) == rows(python[0]) and native[2] == python[2] and native[3] == python[3]
+        assert [(n, r.usages, r.first, r.last, r.cells) for n, r in native[1].items()] == \
+            [(n, r.usages, r.first, r.last, r.cells) for n, r in python[1].items()]
+        return native
+
+    def uses(walked) -> list:
+        return [u for r in walked[1].values() for _, cell_uses in r.cells for u in cell_uses]
+
+    merged = {(i, c) for i, p in enumerate(passes)
+              for c, k in Counter(c for a in p.accesses for c in a.cells).items() if k > 1}
+
+    trace.NATIVE.reset_access_table()
+    first = walk(passes)  # lists every pass
+    again = walk(passes)
+    assert all(a is b for a, b in zip(first[0], again[0], strict=True))
+    cells = [(u[0], c) for r in first[1].values() for c, cell_uses in r.cells for u in cell_uses]
+    assert merged and [a is b for a, b in zip(uses(first), uses(again), strict=True)] == [k not in merged for k in cells]
+    shifted = walk(passes[1:])
+    assert all(a is b for a, b in zip(first[0][1:], shifted[0], strict=True))  # the values do not hold the index
+    assert not {id(u) for u in uses(first)} & {id(u) for u in uses(shifted)}
+    trace.NATIVE.reset_access_table()
+    fresh = walk(passes)
+    assert not any(a is b for a, b in zip(first[0], fresh[0], strict=True))
+
+
 def test_the_optional_scan_agrees(tmp_path: Path) -> None:
     """``cull._has_optional``'s compiled scan answers as the Python one, with and without an
     optional access (first, last or none)."""

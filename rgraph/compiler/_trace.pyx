@@ -30,13 +30,14 @@ cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared
 # each access's fields, scope (``trace._SCOPES`` by (usage, kind, stages, code, refit)) and
 # plan value (``pm.Access``, frozen: of its fields, the scope and the subresource by (mips,
 # layers)) depend only on it and on its resource's format code. The walk meets the same passes
-# at every compile of a graph: this table finds them by the pass's pointer, one probe per pass,
-# with each access's fields read once, at the pass's first walk, into a C array (``_Acc``);
-# later walks read those instead of the cold ``AccessSpec``s, look up no scope and build no
-# plan value: the pass's tuple of them is the first walk's (shared by the plans; ``patch``
-# copies a tuple it changes). So are its uses of its cells (``Use``: the pass's index and
-# queue, the access's scope and write, and the position, which depends only on the pass's
-# accesses) where the pass has its first walk's index. Each object is kept alive while listed
+# at every compile of a graph: this table finds them by the pass's pointer, one probe per pass.
+# A pass's first walk only notes it (``_pass_mark``: a spec compiled once pays nothing more);
+# its second lists it, with each access's fields read into a C array (``_Acc``); later walks
+# read those instead of the cold ``AccessSpec``s, look up no scope and build no plan value: the
+# pass's tuple of them is the listing walk's (shared by the plans; ``patch`` copies a tuple it
+# changes). So are its uses of its cells (``Use``: the pass's index and queue, the access's
+# scope and write, and the position, which depends only on the pass's accesses) where the pass
+# has the listing walk's index. A listed pass and what its slot points at are kept alive
 # (``_table_keep``), so no pointer is reused; a scope, value or use is used only where its
 # resource's format code is the one it was found for (else found again). The values are the
 # ones the lookups give (equal ones, where those tables were cleared since): the walk's results
@@ -74,10 +75,10 @@ cdef struct PassSlot:
     PyObject *kind
     PyObject *accesses  # tuple
     PyObject *values  # tuple: the accesses' ``value``s
-    PyObject *oi  # int: the pass's index at its first walk, ``i``
+    PyObject *oi  # int: the pass's index at its listing walk, ``i``
     Py_ssize_t i
     Py_ssize_t n
-    _Acc *accs
+    _Acc *accs  # NULL: noted, not listed (only ``pass_`` is set)
 
 cdef PassSlot _passes[_TABLE_CAP]
 cdef Py_ssize_t _pass_count = 0
@@ -95,37 +96,44 @@ cdef inline PassSlot *_pass_find(object p):
     return NULL
 
 
-cdef void _pass_add(object p, object queue, object kind, object accesses, tuple values, object oi, Py_ssize_t i,
-                    Py_ssize_t n, _Acc *accs, list held):
-    """List pass ``p`` (index ``i``, ``oi``) with its plan ``values`` and a copy of its accesses'
-    ``accs`` (``held``: their scopes and uses); not once the table is half full, nor where it is
-    listed already (another thread's walk may have listed it meanwhile)."""
+cdef void _pass_mark(object p):
+    """Note pass ``p`` as walked once (a slot without accesses; not kept alive: a later pass at its
+    address is then listed at its first walk); not once the table is half full."""
     global _pass_count
-    cdef Py_ssize_t k
-    if _pass_count >= _TABLE_CAP // 2 or _pass_find(p) != NULL:
-        return
-    cdef _Acc *copy = <_Acc *> malloc(n * sizeof(_Acc) + 1)
-    if copy == NULL:
+    if _pass_count >= _TABLE_CAP // 2:
         return
     cdef size_t h = (<size_t> <PyObject *> p >> 4) & (_TABLE_CAP - 1)
     while _passes[h].pass_ != NULL:
         h = (h + 1) & (_TABLE_CAP - 1)
+    _passes[h].pass_ = <PyObject *> p
+    _pass_count += 1
+
+
+cdef void _pass_add(PassSlot *slot, object p, object queue, object kind, object accesses, tuple values, object oi,
+                    Py_ssize_t i, Py_ssize_t n, _Acc *accs, list held):
+    """List pass ``p`` in its ``slot`` (``_pass_mark``'s) with its index ``i`` (``oi``), its plan
+    ``values`` and a copy of its accesses' ``accs`` (``held``: their scopes and uses); not where
+    it is listed already (another thread's walk may have listed it meanwhile)."""
+    cdef Py_ssize_t k
+    if slot.pass_ != <PyObject *> p or slot.accs != NULL:
+        return
+    cdef _Acc *copy = <_Acc *> malloc(n * sizeof(_Acc) + 1)
+    if copy == NULL:
+        return
     _table_keep.append(p)  # holds its queue, kind, accesses and their fields
     _table_keep.append(values)  # and the values their subresources
     _table_keep.append(oi)
     _table_keep.extend(held)
     for k in range(n):
         copy[k] = accs[k]
-    _passes[h].pass_ = <PyObject *> p
-    _passes[h].queue = <PyObject *> queue
-    _passes[h].kind = <PyObject *> kind
-    _passes[h].accesses = <PyObject *> accesses
-    _passes[h].values = <PyObject *> values
-    _passes[h].oi = <PyObject *> oi
-    _passes[h].i = i
-    _passes[h].n = n
-    _passes[h].accs = copy
-    _pass_count += 1
+    slot.queue = <PyObject *> queue
+    slot.kind = <PyObject *> kind
+    slot.accesses = <PyObject *> accesses
+    slot.values = <PyObject *> values
+    slot.oi = <PyObject *> oi
+    slot.i = i
+    slot.n = n
+    slot.accs = copy
 
 
 cdef void _table_reset():
@@ -319,7 +327,7 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
     for p in passes:
         i += 1
         slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
-        if slot != NULL:
+        if slot != NULL and slot.accs != NULL:
             queue, kind, accs = <object> slot.queue, <object> slot.kind, <tuple> slot.accesses
             known = slot.accs
             listing = False
@@ -331,7 +339,9 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
             queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
             accs = <tuple> pass_field(p, 7, "accesses")
             known = NULL
-            listing = type(p) is PASS_SPEC and len(accs) <= _MAX_CACHED
+            listing = slot != NULL and len(accs) <= _MAX_CACHED  # walked before: listed now
+            if slot == NULL and type(p) is PASS_SPEC:
+                _pass_mark(p)
             if held:
                 held.clear()
             values = PyTuple_New(len(accs))  # the plan's tuple (emit keeps it)
@@ -477,7 +487,7 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                 cur.uses = <PyObject *> made
                 held.append(made)
         if listing:
-            _pass_add(p, queue, kind, accs, values, oi, i, n, fresh, held)
+            _pass_add(slot, p, queue, kind, accs, values, oi, i, n, fresh, held)
         plan_accesses.append(values)
     traced = {}
     for name, found in info.items():
@@ -514,6 +524,8 @@ cdef list _row(p, dict info, dict scopes, scope_of):
     _walking += 1
     try:
         slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
+        if slot != NULL and slot.accs == NULL:  # walked once, not listed
+            slot = NULL
         kind = pass_field(p, 2, "kind")
         for a in <tuple> pass_field(p, 7, "accesses"):
             j += 1

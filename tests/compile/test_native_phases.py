@@ -175,7 +175,8 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
         assert [(n, r.cells) for n, r in native[1].items()] == [(n, r.cells) for n, r in python[1].items()]
 
     trace.NATIVE.reset_access_table()
-    walks_alike(passes, resources)  # fills the table
+    walks_alike(passes, resources)  # notes the passes
+    walks_alike(passes, resources)  # lists them
     swapped = [replace(p, kind="raytrace") if p.kind == "compute" else p for p in passes]
     assert swapped != passes
     walks_alike(swapped, resources)
@@ -186,10 +187,11 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
 
 
 def test_the_access_table_gives_a_listed_pass_s_values_and_uses_again(tmp_path: Path) -> None:
-    """A listed pass's plan values (its tuple of them) and its uses of its cells (but those merged
-    from several accesses) are the objects of its first walk where its index is the same; at
-    another index (here: the first pass left out) it gets new uses; after ``reset_access_table``
-    all are new: every walk gives the Python walk's results."""
+    """A pass's first walk notes it, its second lists it: then its plan values (its tuple of them)
+    and its uses of its cells (but those merged from several accesses) are the objects of that
+    walk where its index is the same; at another index (here: the first pass left out) it gets
+    new uses; after ``reset_access_table`` all are new: every walk gives the Python walk's
+    results."""
     from collections import Counter
 
     path = tmp_path / "g.yaml"
@@ -212,7 +214,9 @@ def test_the_access_table_gives_a_listed_pass_s_values_and_uses_again(tmp_path: 
               for c, k in Counter(c for a in p.accesses for c in a.cells).items() if k > 1}
 
     trace.NATIVE.reset_access_table()
-    first = walk(passes)  # lists every pass
+    noted = walk(passes)  # notes every pass
+    first = walk(passes)  # lists them
+    assert not any(a is b for a, b in zip(noted[0], first[0], strict=True))
     again = walk(passes)
     assert all(a is b for a, b in zip(first[0], again[0], strict=True))
     cells = [(u[0], c) for r in first[1].values() for c, cell_uses in r.cells for u in cell_uses]

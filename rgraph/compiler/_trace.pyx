@@ -153,6 +153,66 @@ def reset_access_table():
         _table_reset()
 
 
+# ---- scopes by their key's objects ---------------------------------------------------------
+# ``trace._SCOPES`` is keyed by a tuple (usage, kind, stages, code, refit): a tuple to build and
+# hash for every access of a pass the pass table has not listed. Accesses of no explicit stages
+# (most) find their scope here instead, by the pointers of their usage, their pass's kind and
+# their refit, and the format code: the spec's usage and kind strings are interned, so few
+# entries serve every spec. The objects are kept alive while listed (``_scope_keep``); the
+# table is emptied once half full (a scope is held by whatever uses it).
+
+cdef struct _ScopeSlot:
+    PyObject *usage
+    PyObject *kind
+    PyObject *refit
+    long code
+    PyObject *scope
+
+cdef enum:
+    _SCOPE_CAP = 512  # slots (power of two): at most half used
+
+cdef _ScopeSlot _scope_slots[_SCOPE_CAP]
+cdef Py_ssize_t _scope_count = 0
+cdef list _scope_keep = []
+
+
+cdef inline size_t _scope_hash(object usage, object kind, long code, object refit):
+    """The first slot to probe for these objects and code."""
+    return ((<size_t> <PyObject *> usage >> 4) * 3 + (<size_t> <PyObject *> kind >> 4) * 5
+            + (<size_t> <PyObject *> refit >> 4) + <size_t> code * 7) & (_SCOPE_CAP - 1)
+
+
+cdef inline object _scope_find(object usage, object kind, long code, object refit):
+    """The scope listed for these objects and code, or None."""
+    cdef size_t h = _scope_hash(usage, kind, code, refit)
+    while _scope_slots[h].usage != NULL:
+        if (_scope_slots[h].usage == <PyObject *> usage and _scope_slots[h].kind == <PyObject *> kind
+                and _scope_slots[h].code == code and _scope_slots[h].refit == <PyObject *> refit):
+            return <object> _scope_slots[h].scope
+        h = (h + 1) & (_SCOPE_CAP - 1)
+    return None
+
+
+cdef void _scope_add(object usage, object kind, long code, object refit, object scope):
+    """List ``scope`` for these objects and code (emptying the table first where half full)."""
+    global _scope_count
+    if _scope_find(usage, kind, code, refit) is not None:
+        return
+    if _scope_count >= _SCOPE_CAP // 2:
+        memset(_scope_slots, 0, sizeof(_scope_slots))
+        _scope_count = 0
+        _scope_keep.clear()
+    cdef size_t h = _scope_hash(usage, kind, code, refit)
+    while _scope_slots[h].usage != NULL:
+        h = (h + 1) & (_SCOPE_CAP - 1)
+    _scope_keep.append((usage, kind, refit, scope))
+    _scope_slots[h].usage = <PyObject *> usage
+    _scope_slots[h].kind = <PyObject *> kind
+    _scope_slots[h].refit = <PyObject *> refit
+    _scope_slots[h].code = code
+    _scope_slots[h].scope = <PyObject *> scope
+    _scope_count += 1
+
 
 cdef inline bint _pair(object t, long *lo, long *hi):
     """Whether ``t`` is a pair of ints (within a C long): then ``lo``, ``hi``."""
@@ -323,7 +383,7 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
     cdef _Acc *cur
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, a, use, given, made
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, stages, refit, c, q, value, a, use, given, made
     for p in passes:
         i += 1
         slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
@@ -383,9 +443,16 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                     _set(values, j, <object> cur.value)
             else:
                 a = accs[j]
-                key = (usage, kind, access_field(a, 5, "stages"), r.code, access_field(a, 8, "refit"))
-                found = scopes.get(key)
-                scope = <tuple> (scope_of(key) if found is None else found)
+                stages, refit = access_field(a, 5, "stages"), access_field(a, 8, "refit")
+                found = _scope_find(usage, kind, r.icode, refit) if stages is None else None
+                if found is None:
+                    key = (usage, kind, stages, r.code, refit)
+                    found = scopes.get(key)
+                    if found is None:
+                        found = scope_of(key)
+                    if stages is None:
+                        _scope_add(usage, kind, r.icode, refit, found)
+                scope = <tuple> found
                 mips, layers = access_field(a, 3, "mips"), access_field(a, 4, "layers")
                 if mips is None:  # buffers and accels
                     sub = None

@@ -229,6 +229,28 @@ def test_the_access_table_gives_a_listed_pass_s_values_and_uses_again(tmp_path: 
     assert not any(a is b for a, b in zip(first[0], fresh[0], strict=True))
 
 
+def test_the_scope_table_keys_on_the_objects_alike() -> None:
+    """The compiled walk finds the scope of an access of no explicit stages by the pointers of its
+    usage, kind and refit (``_trace.pyx``'s scope table): equal usage strings that are other
+    objects, a refitted accel build after a plain one, and explicit stages give the Python
+    walk's scopes."""
+    from dataclasses import replace
+
+    spec = frontend(Path(__file__).resolve().parents[2] / "graphs" / "rt_hybrid.yaml", size=(64, 64)).spec
+    copied = [replace(p, accesses=tuple(replace(a, usage="".join(list(a.usage)),
+                                                stages=("compute",) if p.kind == "compute" else None)
+                                        for a in p.accesses)) for p in spec.passes]
+    refitted = [replace(p, accesses=tuple(replace(a, refit=a.usage == "accel_build") for a in p.accesses))
+                for p in spec.passes]
+    assert any(a.stages for p in copied for a in p.accesses) and any(a.refit for p in refitted for a in p.accesses)
+    for ps in (list(spec.passes), [*spec.passes, *copied, *refitted]):
+        native = trace.NATIVE.walk(ps, spec.resources, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, spec.resources)
+        assert rows(native[0]) == rows(python[0]) and native[2] == python[2]
+        assert [(n, r.usages, r.cells) for n, r in native[1].items()] == \
+            [(n, r.usages, r.cells) for n, r in python[1].items()]
+
+
 def test_the_optional_scan_agrees(tmp_path: Path) -> None:
     """``cull._has_optional``'s compiled scan answers as the Python one, with and without an
     optional access (first, last or none)."""

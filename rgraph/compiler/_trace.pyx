@@ -229,6 +229,60 @@ cdef inline bint _pair(object t, long *lo, long *hi):
     return True
 
 
+# ---- subresources by their ranges ------------------------------------------------------------
+# ``plan_values``' table of them is keyed by ((mips), (layers)): two tuples to hash and compare
+# for every image access of an unlisted pass. Ranges of C longs find them here instead (the
+# objects that table gives, kept alive while listed: ``_sub_keep``); emptied once half full.
+
+cdef struct _SubSlot:
+    long mlo, mhi, llo, lhi
+    PyObject *sub  # NULL: an empty slot
+
+cdef enum:
+    _SUB_CAP = 512  # slots (power of two): at most half used
+
+cdef _SubSlot _sub_slots[_SUB_CAP]
+cdef Py_ssize_t _sub_count = 0
+cdef list _sub_keep = []
+
+
+cdef inline _SubSlot *_sub_slot(long mlo, long mhi, long llo, long lhi):
+    """The slot of these ranges, or the empty one to list them in."""
+    cdef size_t h = <size_t> (mlo * 7 + mhi * 31 + llo * 127 + lhi * 257) & (_SUB_CAP - 1)
+    while _sub_slots[h].sub != NULL and not (_sub_slots[h].mlo == mlo and _sub_slots[h].mhi == mhi
+                                             and _sub_slots[h].llo == llo and _sub_slots[h].lhi == lhi):
+        h = (h + 1) & (_SUB_CAP - 1)
+    return &_sub_slots[h]
+
+
+cdef object _sub_of(object mips, object layers):
+    """``plan_values.subresource(mips, layers)``."""
+    global _sub_count
+    cdef long mlo, mhi, llo, lhi
+    cdef _SubSlot *slot
+    if _pair(mips, &mlo, &mhi) and _pair(layers, &llo, &lhi):
+        slot = _sub_slot(mlo, mhi, llo, lhi)
+        if slot.sub != NULL:
+            return <object> slot.sub
+    else:
+        slot = NULL
+    sub = SUBRESOURCES.get((mips, layers))
+    if sub is None:
+        sub = subresource(mips, layers)
+    if slot == NULL:
+        return sub
+    if _sub_count >= _SUB_CAP // 2:
+        memset(_sub_slots, 0, sizeof(_sub_slots))
+        _sub_count = 0
+        _sub_keep.clear()
+    slot = _sub_slot(mlo, mhi, llo, lhi)  # again: ``subresource`` may have let another thread list some
+    if slot.sub == NULL:
+        _sub_keep.append(sub)
+        slot.mlo, slot.mhi, slot.llo, slot.lhi, slot.sub = mlo, mhi, llo, lhi, <PyObject *> sub
+        _sub_count += 1
+    return sub
+
+
 cdef class _Res:
     """A resource's ``ResourceTrace`` fields during the walk, and its whole-image ranges."""
 
@@ -454,12 +508,7 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                         _scope_add(usage, kind, r.icode, refit, found)
                 scope = <tuple> found
                 mips, layers = access_field(a, 3, "mips"), access_field(a, 4, "layers")
-                if mips is None:  # buffers and accels
-                    sub = None
-                else:
-                    sub = SUBRESOURCES.get((mips, layers))
-                    if sub is None:
-                        sub = subresource(mips, layers)
+                sub = None if mips is None else _sub_of(mips, layers)  # (None: buffers and accels)
                 value = new_slots(ACCESS)
                 put(value, ACCESS, 0, name)
                 put(value, ACCESS, 1, sub)

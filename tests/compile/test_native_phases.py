@@ -251,6 +251,27 @@ def test_the_scope_table_keys_on_the_objects_alike() -> None:
             [(n, r.usages, r.cells) for n, r in python[1].items()]
 
 
+def test_the_subresource_table_gives_plan_values_alike(tmp_path: Path) -> None:
+    """The compiled walk finds an image access's subresource by its ranges as C longs
+    (``_trace.pyx``'s subresource table), and through ``plan_values`` where they are not pairs of
+    ints (here of an int subclass): both give the Python walk's values."""
+    from dataclasses import replace
+
+    class Int(int):
+        pass
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=3, passes=80)))
+    spec = frontend(path, size=(16, 16)).spec
+    odd = [replace(p, accesses=tuple(a if a.mips is None else replace(a, mips=(Int(a.mips[0]), Int(a.mips[1])))
+                                     for a in p.accesses)) for p in spec.passes]
+    assert any(type(a.mips[0]) is Int for p in odd for a in p.accesses if a.mips is not None)
+    for ps in (list(spec.passes), odd):
+        native = trace.NATIVE.walk(ps, spec.resources, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, spec.resources)
+        assert rows(native[0]) == rows(python[0])  # (subresources among the values)
+
+
 def test_the_optional_scan_agrees(tmp_path: Path) -> None:
     """``cull._has_optional``'s compiled scan answers as the Python one, with and without an
     optional access (first, last or none)."""

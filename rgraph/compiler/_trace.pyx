@@ -28,16 +28,21 @@ cdef dict SUBRESOURCES = get_subresource.__self__  # plan_values' cache (cleared
 # ---- each pass's accesses, by the pass's identity --------------------------------------------
 # A ``PassSpec`` is frozen, and so are its ``AccessSpec``s: its queue, kind and accesses, and
 # each access's fields, scope (``trace._SCOPES`` by (usage, kind, stages, code, refit)) and
-# subresource (by (mips, layers)) depend only on it and on its resource's format code. The
-# walk meets the same passes at every compile of a graph: this table finds them by the pass's
-# pointer, one probe per pass, with each access's fields read once, at the pass's first walk,
-# into a C array (``_Acc``); later walks read those instead of the cold ``AccessSpec``s and
-# look up no scope. Each object is kept alive while listed (``_table_keep``), so no pointer
-# is reused; a scope is used only where its resource's format code is the one it was found
-# for (else found again). The values are the ones the lookups give (equal ones, where those
-# tables were cleared since): the walk's results do not change. The table is emptied at a
-# walk's start once half full, and only when no other walk (another thread's) is under way:
-# while one is, what the table points at stays.
+# plan value (``pm.Access``, frozen: of its fields, the scope and the subresource by (mips,
+# layers)) depend only on it and on its resource's format code. The walk meets the same passes
+# at every compile of a graph: this table finds them by the pass's pointer, one probe per pass.
+# A pass's first walk only notes it (``_pass_mark``: a spec compiled once pays nothing more);
+# its second lists it, with each access's fields read into a C array (``_Acc``); later walks
+# read those instead of the cold ``AccessSpec``s, look up no scope and build no plan value: the
+# pass's tuple of them is the listing walk's (shared by the plans; ``patch`` copies a tuple it
+# changes). So are its uses of its cells (``Use``: the pass's index and queue, the access's
+# scope and write, and the position, which depends only on the pass's accesses) where the pass
+# has the listing walk's index. A listed pass and what its slot points at are kept alive
+# (``_table_keep``), so no pointer is reused; a scope, value or use is used only where its
+# resource's format code is the one it was found for (else found again). The values are the
+# ones the lookups give (equal ones, where those tables were cleared since): the walk's results
+# do not change. The table is emptied at a walk's start once half full, and only when no other
+# walk (another thread's) is under way: while one is, what the table points at stays.
 
 from libc.stdlib cimport malloc, free
 from cpython.exc cimport PyErr_Clear, PyErr_Occurred
@@ -48,7 +53,6 @@ cdef enum:
     _MAX_CACHED = 64  # passes of more accesses are not listed
 
 cdef struct _Acc:
-    PyObject *access
     PyObject *name
     PyObject *usage
     PyObject *write
@@ -56,8 +60,11 @@ cdef struct _Acc:
     PyObject *mips
     PyObject *layers
     PyObject *scope  # tuple: trace._SCOPES' value, for ``code``
-    PyObject *sub  # pm.Subresource or None
+    PyObject *value  # pm.Access, for ``code``
+    PyObject *uses  # the uses of its cells (all appended, none merged), for ``code`` and the pass's ``i``: the
+    # use (a tuple) where it has one cell (``one``), else a tuple of them; or NULL
     long code
+    bint one
     bint w  # ``write``'s truth
     bint ranges  # mips and layers are pairs of ints, (mlo, mhi) and (llo, lhi)
     long mlo, mhi, llo, lhi
@@ -67,8 +74,11 @@ cdef struct PassSlot:
     PyObject *queue
     PyObject *kind
     PyObject *accesses  # tuple
+    PyObject *values  # tuple: the accesses' ``value``s
+    PyObject *oi  # int: the pass's index at its listing walk, ``i``
+    Py_ssize_t i
     Py_ssize_t n
-    _Acc *accs
+    _Acc *accs  # NULL: noted, not listed (only ``pass_`` is set)
 
 cdef PassSlot _passes[_TABLE_CAP]
 cdef Py_ssize_t _pass_count = 0
@@ -86,31 +96,44 @@ cdef inline PassSlot *_pass_find(object p):
     return NULL
 
 
-cdef void _pass_add(object p, object queue, object kind, object accesses, Py_ssize_t n, _Acc *accs):
-    """List pass ``p`` with a copy of its accesses' ``accs`` (not once the table is half full,
-    nor where it is listed already: another thread's walk may have listed it meanwhile)."""
+cdef void _pass_mark(object p):
+    """Note pass ``p`` as walked once (a slot without accesses; not kept alive: a later pass at its
+    address is then listed at its first walk); not once the table is half full."""
     global _pass_count
-    cdef Py_ssize_t k
-    if _pass_count >= _TABLE_CAP // 2 or _pass_find(p) != NULL:
-        return
-    cdef _Acc *copy = <_Acc *> malloc(n * sizeof(_Acc) + 1)
-    if copy == NULL:
+    if _pass_count >= _TABLE_CAP // 2:
         return
     cdef size_t h = (<size_t> <PyObject *> p >> 4) & (_TABLE_CAP - 1)
     while _passes[h].pass_ != NULL:
         h = (h + 1) & (_TABLE_CAP - 1)
+    _passes[h].pass_ = <PyObject *> p
+    _pass_count += 1
+
+
+cdef void _pass_add(PassSlot *slot, object p, object queue, object kind, object accesses, tuple values, object oi,
+                    Py_ssize_t i, Py_ssize_t n, _Acc *accs, list held):
+    """List pass ``p`` in its ``slot`` (``_pass_mark``'s) with its index ``i`` (``oi``), its plan
+    ``values`` and a copy of its accesses' ``accs`` (``held``: their scopes and uses); not where
+    it is listed already (another thread's walk may have listed it meanwhile)."""
+    cdef Py_ssize_t k
+    if slot.pass_ != <PyObject *> p or slot.accs != NULL:
+        return
+    cdef _Acc *copy = <_Acc *> malloc(n * sizeof(_Acc) + 1)
+    if copy == NULL:
+        return
     _table_keep.append(p)  # holds its queue, kind, accesses and their fields
+    _table_keep.append(values)  # and the values their subresources
+    _table_keep.append(oi)
+    _table_keep.extend(held)
     for k in range(n):
         copy[k] = accs[k]
-        _table_keep.append(<object> accs[k].scope)
-        _table_keep.append(<object> accs[k].sub)
-    _passes[h].pass_ = <PyObject *> p
-    _passes[h].queue = <PyObject *> queue
-    _passes[h].kind = <PyObject *> kind
-    _passes[h].accesses = <PyObject *> accesses
-    _passes[h].n = n
-    _passes[h].accs = copy
-    _pass_count += 1
+    slot.queue = <PyObject *> queue
+    slot.kind = <PyObject *> kind
+    slot.accesses = <PyObject *> accesses
+    slot.values = <PyObject *> values
+    slot.oi = <PyObject *> oi
+    slot.i = i
+    slot.n = n
+    slot.accs = copy
 
 
 cdef void _table_reset():
@@ -130,6 +153,67 @@ def reset_access_table():
         _table_reset()
 
 
+# ---- scopes by their key's objects ---------------------------------------------------------
+# ``trace._SCOPES`` is keyed by a tuple (usage, kind, stages, code, refit): a tuple to build and
+# hash for every access of a pass the pass table has not listed. Accesses of no explicit stages
+# (most) find their scope here instead, by the pointers of their usage, their pass's kind and
+# their refit, and the format code: the spec's usage and kind strings are interned, so few
+# entries serve every spec. The objects are kept alive while listed (``_scope_keep``); the
+# table is emptied once half full (a scope is held by whatever uses it).
+
+cdef struct _ScopeSlot:
+    PyObject *usage
+    PyObject *kind
+    PyObject *refit
+    long code
+    PyObject *scope
+
+cdef enum:
+    _SCOPE_CAP = 512  # slots (power of two): at most half used
+
+cdef _ScopeSlot _scope_slots[_SCOPE_CAP]
+cdef Py_ssize_t _scope_count = 0
+cdef list _scope_keep = []
+
+
+cdef inline size_t _scope_hash(object usage, object kind, long code, object refit):
+    """The first slot to probe for these objects and code."""
+    return ((<size_t> <PyObject *> usage >> 4) * 3 + (<size_t> <PyObject *> kind >> 4) * 5
+            + (<size_t> <PyObject *> refit >> 4) + <size_t> code * 7) & (_SCOPE_CAP - 1)
+
+
+cdef inline object _scope_find(object usage, object kind, long code, object refit):
+    """The scope listed for these objects and code, or None."""
+    cdef size_t h = _scope_hash(usage, kind, code, refit)
+    while _scope_slots[h].usage != NULL:
+        if (_scope_slots[h].usage == <PyObject *> usage and _scope_slots[h].kind == <PyObject *> kind
+                and _scope_slots[h].code == code and _scope_slots[h].refit == <PyObject *> refit):
+            return <object> _scope_slots[h].scope
+        h = (h + 1) & (_SCOPE_CAP - 1)
+    return None
+
+
+cdef void _scope_add(object usage, object kind, long code, object refit, object scope):
+    """List ``scope`` for these objects and code (emptying the table first where half full)."""
+    global _scope_count
+    if _scope_find(usage, kind, code, refit) is not None:
+        return
+    if _scope_count >= _SCOPE_CAP // 2:
+        memset(_scope_slots, 0, sizeof(_scope_slots))
+        _scope_count = 0
+        _scope_keep.clear()
+    cdef size_t h = _scope_hash(usage, kind, code, refit)
+    while _scope_slots[h].usage != NULL:
+        h = (h + 1) & (_SCOPE_CAP - 1)
+    _scope_keep.append((usage, kind, refit, scope))
+    _scope_slots[h].usage = <PyObject *> usage
+    _scope_slots[h].kind = <PyObject *> kind
+    _scope_slots[h].refit = <PyObject *> refit
+    _scope_slots[h].code = code
+    _scope_slots[h].scope = <PyObject *> scope
+    _scope_count += 1
+
+
 cdef inline bint _pair(object t, long *lo, long *hi):
     """Whether ``t`` is a pair of ints (within a C long): then ``lo``, ``hi``."""
     if type(t) is not tuple or len(<tuple> t) != 2:
@@ -143,6 +227,60 @@ cdef inline bint _pair(object t, long *lo, long *hi):
         PyErr_Clear()
         return False
     return True
+
+
+# ---- subresources by their ranges ------------------------------------------------------------
+# ``plan_values``' table of them is keyed by ((mips), (layers)): two tuples to hash and compare
+# for every image access of an unlisted pass. Ranges of C longs find them here instead (the
+# objects that table gives, kept alive while listed: ``_sub_keep``); emptied once half full.
+
+cdef struct _SubSlot:
+    long mlo, mhi, llo, lhi
+    PyObject *sub  # NULL: an empty slot
+
+cdef enum:
+    _SUB_CAP = 512  # slots (power of two): at most half used
+
+cdef _SubSlot _sub_slots[_SUB_CAP]
+cdef Py_ssize_t _sub_count = 0
+cdef list _sub_keep = []
+
+
+cdef inline _SubSlot *_sub_slot(long mlo, long mhi, long llo, long lhi):
+    """The slot of these ranges, or the empty one to list them in."""
+    cdef size_t h = <size_t> (mlo * 7 + mhi * 31 + llo * 127 + lhi * 257) & (_SUB_CAP - 1)
+    while _sub_slots[h].sub != NULL and not (_sub_slots[h].mlo == mlo and _sub_slots[h].mhi == mhi
+                                             and _sub_slots[h].llo == llo and _sub_slots[h].lhi == lhi):
+        h = (h + 1) & (_SUB_CAP - 1)
+    return &_sub_slots[h]
+
+
+cdef object _sub_of(object mips, object layers):
+    """``plan_values.subresource(mips, layers)``."""
+    global _sub_count
+    cdef long mlo, mhi, llo, lhi
+    cdef _SubSlot *slot
+    if _pair(mips, &mlo, &mhi) and _pair(layers, &llo, &lhi):
+        slot = _sub_slot(mlo, mhi, llo, lhi)
+        if slot.sub != NULL:
+            return <object> slot.sub
+    else:
+        slot = NULL
+    sub = SUBRESOURCES.get((mips, layers))
+    if sub is None:
+        sub = subresource(mips, layers)
+    if slot == NULL:
+        return sub
+    if _sub_count >= _SUB_CAP // 2:
+        memset(_sub_slots, 0, sizeof(_sub_slots))
+        _sub_count = 0
+        _sub_keep.clear()
+    slot = _sub_slot(mlo, mhi, llo, lhi)  # again: ``subresource`` may have let another thread list some
+    if slot.sub == NULL:
+        _sub_keep.append(sub)
+        slot.mlo, slot.mhi, slot.llo, slot.lhi, slot.sub = mlo, mhi, llo, lhi, <PyObject *> sub
+        _sub_count += 1
+    return sub
 
 
 cdef class _Res:
@@ -227,19 +365,22 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     return r
 
 
-cdef inline int _add_use(list uses, Py_ssize_t i, object oi, object s, object w, object queue, Py_ssize_t pos,
-                         dict waits) except -1:
-    """Pass ``i``'s use of a cell that has ``uses`` already: 1 where appended (at ``pos``), 0 where a
-    second access of the pass to the cell merged into its last use."""
+cdef inline tuple _add_use(list uses, Py_ssize_t i, object oi, object s, object w, object queue, Py_ssize_t pos,
+                           dict waits, object use):
+    """Pass ``i``'s use of a cell that has ``uses`` already: the use appended (at ``pos``; ``use``
+    where given: the same values), or None where a second access of the pass to the cell merged
+    into its last use."""
     cdef tuple prev = <tuple> uses[len(uses) - 1]
     if <Py_ssize_t> prev[0] == i:  # a second access to the cell in this pass: one merged use
         uses[len(uses) - 1] = (oi, merge(prev[1], s), prev[2] or w, queue, prev[4])
-        return 0
+        return None
     q = prev[3]
     if q is not queue and q != queue:  # the dedicated plan waits for that use
         _wait(waits, oi, prev, q)
-    uses.append((oi, s, w, queue, pos))
-    return 1
+    if use is None:
+        use = (oi, s, w, queue, pos)
+    uses.append(use)
+    return <tuple> use
 
 
 cdef inline void _wait(dict waits, object i, tuple prev, object q):
@@ -249,6 +390,21 @@ cdef inline void _wait(dict waits, object i, tuple prev, object q):
         waits[i] = {q: prev[0]}
     elif found.get(q, -1) < prev[0]:
         found[q] = prev[0]
+
+
+cdef inline void _set(tuple t, Py_ssize_t k, object value):
+    """Item ``k`` of a new tuple ``t`` (each once)."""
+    Py_INCREF(value)
+    PyTuple_SET_ITEM(t, k, value)
+
+
+cdef tuple _prefix(tuple values, Py_ssize_t j):
+    """A new tuple as long as ``values``, with its first ``j`` items (the others to set)."""
+    cdef tuple out = PyTuple_New(len(values))
+    cdef Py_ssize_t k
+    for k in range(j):
+        _set(out, k, values[k])
+    return out
 
 
 def walk(passes, resources, dict scopes, scope_of, list moved=None):
@@ -271,45 +427,53 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
     cdef list plan_accesses = [], uses, cells
     cdef tuple values, accs
     cdef dict info = {}, timeline = {}, waits = {}
-    cdef list pending = []  # the scopes and subresources of ``fresh``
-    cdef Py_ssize_t i = -1, j, n, pos
-    cdef bint raytrace, whole, listing
+    cdef list held = []  # the scopes and uses of ``fresh`` (the caches may drop the scopes before it is listed)
+    cdef Py_ssize_t i = -1, j, n, m, pos
+    cdef bint raytrace, whole, listing, shared, same, reuse, keep
     cdef PassSlot *slot
     cdef _Acc *known  # the listed pass's accesses
     cdef _Acc fresh[_MAX_CACHED]  # an unlisted pass's, to list it
-    cdef _Acc cur
+    cdef _Acc spare  # an unlisted pass's access, not to list
+    cdef _Acc *cur
     cdef _Res r
     cdef tuple scope, prev, cs
-    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, c, q, value, a
+    cdef object oi, queue, kind, name, usage, w, s, sub, mips, layers, stages, refit, c, q, value, a, use, given, made
     for p in passes:
         i += 1
-        oi = i
         slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
-        if slot != NULL:
+        if slot != NULL and slot.accs != NULL:
             queue, kind, accs = <object> slot.queue, <object> slot.kind, <tuple> slot.accesses
             known = slot.accs
             listing = False
+            values = <tuple> slot.values  # shared: copied (``_prefix``) where a value differs
+            shared = True
+            same = slot.i == i  # the listed uses hold (their index)
+            oi = <object> slot.oi if same else i
         else:
             queue, kind = pass_field(p, 3, "queue"), pass_field(p, 2, "kind")
             accs = <tuple> pass_field(p, 7, "accesses")
             known = NULL
-            listing = type(p) is PASS_SPEC and len(accs) <= _MAX_CACHED
-            if pending:
-                pending.clear()
+            listing = slot != NULL and len(accs) <= _MAX_CACHED  # walked before: listed now
+            if slot == NULL and type(p) is PASS_SPEC:
+                _pass_mark(p)
+            if held:
+                held.clear()
+            values = PyTuple_New(len(accs))  # the plan's tuple (emit keeps it)
+            shared = same = False
+            oi = i
         raytrace = kind == "raytrace"
         n = len(accs)
-        values = PyTuple_New(n)  # the plan's tuple (emit keeps it)
         pos = 0
         for j in range(n):
             if known != NULL:
-                cur = known[j]
+                cur = &known[j]
                 name, usage, w = <object> cur.name, <object> cur.usage, <object> cur.write
             else:
                 a = accs[j]
                 if listing and type(a) is not ACCESS_SPEC:  # only AccessSpecs are frozen
                     listing = False
+                cur = &fresh[j] if listing else &spare
                 name, usage, w = access_field(a, 0, "resource"), access_field(a, 1, "usage"), access_field(a, 2, "write")
-                cur.access = <PyObject *> a
                 cur.name, cur.usage, cur.write = <PyObject *> name, <PyObject *> usage, <PyObject *> w
                 cur.w = w
                 cur.scope = NULL
@@ -326,42 +490,47 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
             if raytrace and usage == "indirect":  # vkCmdTraceRaysIndirectKHR: a device address
                 r.usages.add("trace_indirect")
                 r.last_usage = None
-            if cur.scope != NULL and cur.code == r.icode:  # listed, for this format code
+            reuse = cur.scope != NULL and cur.code == r.icode  # listed, for this format code
+            if reuse:
                 scope = <tuple> cur.scope
-                sub = <object> cur.sub
+                if not shared:
+                    _set(values, j, <object> cur.value)
             else:
                 a = accs[j]
-                key = (usage, kind, access_field(a, 5, "stages"), r.code, access_field(a, 8, "refit"))
-                found = scopes.get(key)
-                scope = <tuple> (scope_of(key) if found is None else found)
+                stages, refit = access_field(a, 5, "stages"), access_field(a, 8, "refit")
+                found = _scope_find(usage, kind, r.icode, refit) if stages is None else None
+                if found is None:
+                    key = (usage, kind, stages, r.code, refit)
+                    found = scopes.get(key)
+                    if found is None:
+                        found = scope_of(key)
+                    if stages is None:
+                        _scope_add(usage, kind, r.icode, refit, found)
+                scope = <tuple> found
                 mips, layers = access_field(a, 3, "mips"), access_field(a, 4, "layers")
-                if mips is None:  # buffers and accels
-                    sub = None
-                else:
-                    sub = SUBRESOURCES.get((mips, layers))
-                    if sub is None:
-                        sub = subresource(mips, layers)
+                sub = None if mips is None else _sub_of(mips, layers)  # (None: buffers and accels)
+                value = new_slots(ACCESS)
+                put(value, ACCESS, 0, name)
+                put(value, ACCESS, 1, sub)
+                put(value, ACCESS, 2, usage)
+                put(value, ACCESS, 3, scope[1])
+                put(value, ACCESS, 4, scope[2])
+                put(value, ACCESS, 5, scope[3])
+                put(value, ACCESS, 6, w)
+                if shared:  # the listed tuple holds another value here
+                    values = _prefix(values, j)
+                    shared = False
+                _set(values, j, value)
                 if listing:
-                    cells = None
                     c = access_field(a, 9, "cells")
                     cur.cells, cur.mips, cur.layers = <PyObject *> c, <PyObject *> mips, <PyObject *> layers
                     cur.ranges = _pair(mips, &cur.mlo, &cur.mhi) and _pair(layers, &cur.llo, &cur.lhi)
-                    cur.scope, cur.sub, cur.code = <PyObject *> scope, <PyObject *> sub, r.icode
-                    fresh[j] = cur
-                    pending.append(scope)  # (the caches may drop them before the pass is listed)
-                    pending.append(sub)
+                    cur.scope, cur.value, cur.code = <PyObject *> scope, <PyObject *> value, r.icode
+                    cur.uses = NULL
+                    cur.one = len(<tuple> c) == 1
+                    held.append(scope)
             s = scope[0]
             layout = scope[3]
-            value = new_slots(ACCESS)
-            put(value, ACCESS, 0, name)
-            put(value, ACCESS, 1, sub)
-            put(value, ACCESS, 2, usage)
-            put(value, ACCESS, 3, scope[1])
-            put(value, ACCESS, 4, scope[2])
-            put(value, ACCESS, 5, layout)
-            put(value, ACCESS, 6, w)
-            Py_INCREF(value)
-            PyTuple_SET_ITEM(values, j, value)
             if r.candidate:
                 if known != NULL and cur.ranges and r.cranges:
                     whole = cur.mlo == 0 and cur.mhi == r.cm and cur.llo == 0 and cur.lhi == r.cl
@@ -385,27 +554,56 @@ cdef tuple _walk(passes, resources, dict scopes, scope_of, list moved):
                         r.cur.append((oi, j))
                         if not r.mixed and layout is not r.lay0 and layout != r.lay0:
                             r.mixed = True
+            # the uses: the listed ones (``given``), else new ones, which a listing pass keeps (``made``)
+            given = <object> cur.uses if reuse and same and cur.uses != NULL else None
+            made = None
             if r.single:  # most resources: the one cell's uses without a lookup by cell
+                if given is not None and not cur.one:
+                    given = (<tuple> given)[0]
                 cells = r.cells
-                if not cells:  # (the cells tuple is read only here: it is cold)
+                if cells:
+                    use = _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits, given)
+                else:  # (the cells tuple is read only here: it is cold)
+                    use = (oi, s, w, queue, pos) if given is None else given
                     cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
-                    cells.append((cs[0], [(oi, s, w, queue, pos)]))
+                    cells.append((cs[0], [use]))
+                if use is not None:
                     pos += 1
-                    continue
-                pos += _add_use(<list> (<tuple> cells[0])[1], i, oi, s, w, queue, pos, waits)
-                continue
-            cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
-            for c in cs:
-                found = timeline.get(c)
-                if found is None:
-                    uses = [(oi, s, w, queue, pos)]
-                    timeline[c] = uses
-                    r.cells.append((c, uses))
+                    if listing and cur.one:
+                        made = use
+            else:
+                cs = <tuple> cur.cells if known != NULL else access_field(accs[j], 9, "cells")
+                keep = listing
+                if keep and not cur.one:
+                    made = PyTuple_New(len(cs))
+                m = -1
+                for c in cs:
+                    m += 1
+                    use = given if given is None or cur.one else (<tuple> given)[m]
+                    found = timeline.get(c)
+                    if found is None:
+                        if use is None:
+                            use = (oi, s, w, queue, pos)
+                        uses = [use]
+                        timeline[c] = uses
+                        r.cells.append((c, uses))
+                    else:
+                        use = _add_use(<list> found, i, oi, s, w, queue, pos, waits, use)
+                    if use is None:  # merged: the positions after it are others
+                        given = made = None
+                        keep = False
+                        continue
                     pos += 1
-                    continue
-                pos += _add_use(<list> found, i, oi, s, w, queue, pos, waits)
+                    if keep:
+                        if cur.one:
+                            made = use
+                        else:
+                            _set(<tuple> made, m, use)
+            if made is not None:
+                cur.uses = <PyObject *> made
+                held.append(made)
         if listing:
-            _pass_add(p, queue, kind, accs, n, fresh)
+            _pass_add(slot, p, queue, kind, accs, values, oi, i, n, fresh, held)
         plan_accesses.append(values)
     traced = {}
     for name, found in info.items():
@@ -442,6 +640,8 @@ cdef list _row(p, dict info, dict scopes, scope_of):
     _walking += 1
     try:
         slot = _pass_find(p) if type(p) is PASS_SPEC else NULL
+        if slot != NULL and slot.accs == NULL:  # walked once, not listed
+            slot = NULL
         kind = pass_field(p, 2, "kind")
         for a in <tuple> pass_field(p, 7, "accesses"):
             j += 1

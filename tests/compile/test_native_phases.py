@@ -175,7 +175,8 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
         assert [(n, r.cells) for n, r in native[1].items()] == [(n, r.cells) for n, r in python[1].items()]
 
     trace.NATIVE.reset_access_table()
-    walks_alike(passes, resources)  # fills the table
+    walks_alike(passes, resources)  # notes the passes
+    walks_alike(passes, resources)  # lists them
     swapped = [replace(p, kind="raytrace") if p.kind == "compute" else p for p in passes]
     assert swapped != passes
     walks_alike(swapped, resources)
@@ -183,6 +184,92 @@ def test_the_access_table_keys_on_pass_kind_and_format(tmp_path: Path) -> None:
     recoded = {n: replace(r, format=depth) if r.kind == "image" and r.format is not None and not r.format.has_depth
                else r for n, r in resources.items()}
     walks_alike(passes, recoded)
+
+
+def test_the_access_table_gives_a_listed_pass_s_values_and_uses_again(tmp_path: Path) -> None:
+    """A pass's first walk notes it, its second lists it: then its plan values (its tuple of them)
+    and its uses of its cells (but those merged from several accesses) are the objects of that
+    walk where its index is the same; at another index (here: the first pass left out) it gets
+    new uses; after ``reset_access_table`` all are new: every walk gives the Python walk's
+    results."""
+    from collections import Counter
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=9, passes=150)))
+    spec = frontend(path, size=(16, 16)).spec
+    passes, resources = list(spec.passes), spec.resources
+
+    def walk(ps) -> tuple:
+        native = trace.NATIVE.walk(ps, resources, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, resources)
+        assert rows(native[0]) == rows(python[0]) and native[2] == python[2] and native[3] == python[3]
+        assert [(n, r.usages, r.first, r.last, r.cells) for n, r in native[1].items()] == \
+            [(n, r.usages, r.first, r.last, r.cells) for n, r in python[1].items()]
+        return native
+
+    def uses(walked) -> list:
+        return [u for r in walked[1].values() for _, cell_uses in r.cells for u in cell_uses]
+
+    merged = {(i, c) for i, p in enumerate(passes)
+              for c, k in Counter(c for a in p.accesses for c in a.cells).items() if k > 1}
+
+    trace.NATIVE.reset_access_table()
+    noted = walk(passes)  # notes every pass
+    first = walk(passes)  # lists them
+    assert not any(a is b for a, b in zip(noted[0], first[0], strict=True))
+    again = walk(passes)
+    assert all(a is b for a, b in zip(first[0], again[0], strict=True))
+    cells = [(u[0], c) for r in first[1].values() for c, cell_uses in r.cells for u in cell_uses]
+    assert merged and [a is b for a, b in zip(uses(first), uses(again), strict=True)] == [k not in merged for k in cells]
+    shifted = walk(passes[1:])
+    assert all(a is b for a, b in zip(first[0][1:], shifted[0], strict=True))  # the values do not hold the index
+    assert not {id(u) for u in uses(first)} & {id(u) for u in uses(shifted)}
+    trace.NATIVE.reset_access_table()
+    fresh = walk(passes)
+    assert not any(a is b for a, b in zip(first[0], fresh[0], strict=True))
+
+
+def test_the_scope_table_keys_on_the_objects_alike() -> None:
+    """The compiled walk finds the scope of an access of no explicit stages by the pointers of its
+    usage, kind and refit (``_trace.pyx``'s scope table): equal usage strings that are other
+    objects, a refitted accel build after a plain one, and explicit stages give the Python
+    walk's scopes."""
+    from dataclasses import replace
+
+    spec = frontend(Path(__file__).resolve().parents[2] / "graphs" / "rt_hybrid.yaml", size=(64, 64)).spec
+    copied = [replace(p, accesses=tuple(replace(a, usage="".join(list(a.usage)),
+                                                stages=("compute",) if p.kind == "compute" else None)
+                                        for a in p.accesses)) for p in spec.passes]
+    refitted = [replace(p, accesses=tuple(replace(a, refit=a.usage == "accel_build") for a in p.accesses))
+                for p in spec.passes]
+    assert any(a.stages for p in copied for a in p.accesses) and any(a.refit for p in refitted for a in p.accesses)
+    for ps in (list(spec.passes), [*spec.passes, *copied, *refitted]):
+        native = trace.NATIVE.walk(ps, spec.resources, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, spec.resources)
+        assert rows(native[0]) == rows(python[0]) and native[2] == python[2]
+        assert [(n, r.usages, r.cells) for n, r in native[1].items()] == \
+            [(n, r.usages, r.cells) for n, r in python[1].items()]
+
+
+def test_the_subresource_table_gives_plan_values_alike(tmp_path: Path) -> None:
+    """The compiled walk finds an image access's subresource by its ranges as C longs
+    (``_trace.pyx``'s subresource table), and through ``plan_values`` where they are not pairs of
+    ints (here of an int subclass): both give the Python walk's values."""
+    from dataclasses import replace
+
+    class Int(int):
+        pass
+
+    path = tmp_path / "g.yaml"
+    path.write_text(to_yaml(random_graph(seed=3, passes=80)))
+    spec = frontend(path, size=(16, 16)).spec
+    odd = [replace(p, accesses=tuple(a if a.mips is None else replace(a, mips=(Int(a.mips[0]), Int(a.mips[1])))
+                                     for a in p.accesses)) for p in spec.passes]
+    assert any(type(a.mips[0]) is Int for p in odd for a in p.accesses if a.mips is not None)
+    for ps in (list(spec.passes), odd):
+        native = trace.NATIVE.walk(ps, spec.resources, trace._SCOPES, trace._scope)
+        python = trace.walk_python(ps, spec.resources)
+        assert rows(native[0]) == rows(python[0])  # (subresources among the values)
 
 
 def test_the_optional_scan_agrees(tmp_path: Path) -> None:

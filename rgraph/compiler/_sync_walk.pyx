@@ -1195,17 +1195,12 @@ cdef inline object _res_field(object res, Py_ssize_t k, str name):
     return getattr(res, name)
 
 
-cdef inline PyObject *_slot(PyObject *o, Slots layout, Py_ssize_t k):
-    """Field ``k`` of ``o`` (exactly ``layout``'s class), borrowed; NULL where unset."""
-    return (<PyObject **> ((<char *> o) + layout.off[k]))[0]
-
-
 cdef inline PyObject *_cells_of(list rs, Py_ssize_t k):
     """Resource ``k``'s cells list (borrowed), NULL where not an exact ``ResourceTrace``'s list."""
     cdef PyObject *o = _list_item(<PyObject *> rs, k)
     if _type(o) != <PyObject *> RESOURCE_TRACE:
         return NULL
-    o = _slot(o, TRACE, 3)
+    o = borrowed_field(o, TRACE, 3)
     if o == NULL or not PyList_CheckExact(<object> o):
         return NULL
     return o
@@ -1221,8 +1216,8 @@ cdef void _ahead(list rs, Py_ssize_t k, Py_ssize_t n):
         _prefetch(_list_item(<PyObject *> rs, k + 5))
     if k + 4 < n:
         o = _list_item(<PyObject *> rs, k + 4)
-        if _type(o) == <PyObject *> RESOURCE_TRACE and _slot(o, TRACE, 3) != NULL:
-            _prefetch(_slot(o, TRACE, 3))
+        if _type(o) == <PyObject *> RESOURCE_TRACE and borrowed_field(o, TRACE, 3) != NULL:
+            _prefetch(borrowed_field(o, TRACE, 3))
     if k + 3 < n:
         o = _cells_of(rs, k + 3)
         if o != NULL:

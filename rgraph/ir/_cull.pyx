@@ -141,17 +141,12 @@ cdef extern from "Python.h":
     void _prefetch "__builtin_prefetch" (const void *p)
 
 
-cdef inline PyObject *_slot(PyObject *o, Slots layout, Py_ssize_t k):
-    """Field ``k`` of ``o`` (exactly ``layout``'s class), borrowed; NULL where unset."""
-    return (<PyObject **> ((<char *> o) + layout.off[k]))[0]
-
-
 cdef inline PyObject *_accesses_of(list passes, Py_ssize_t x):
     """Pass ``x``'s accesses tuple (borrowed), NULL where not an exact ``PassSpec``'s tuple."""
     cdef PyObject *o = _list_item(<PyObject *> passes, x)
     if _type(o) != <PyObject *> PASS_SPEC:
         return NULL
-    o = _slot(o, PASS, 7)
+    o = borrowed_field(o, PASS, 7)
     if o == NULL or _type(o) != <PyObject *> tuple:
         return NULL
     return o
@@ -170,7 +165,7 @@ cdef void _ahead(list passes, Py_ssize_t x):
     if x >= 4:
         o = _list_item(<PyObject *> passes, x - 4)
         if _type(o) == <PyObject *> PASS_SPEC:
-            _prefetch(_slot(o, PASS, 7))
+            _prefetch(borrowed_field(o, PASS, 7))
     if x >= 3:
         o = _accesses_of(passes, x - 3)
         if o != NULL:
@@ -181,15 +176,15 @@ cdef void _ahead(list passes, Py_ssize_t x):
         if o != NULL:
             for k in range(_tuple_size(o)):
                 a = _tuple_item(o, k)
-                if _type(a) == <PyObject *> ACCESS_SPEC and _slot(a, SPEC, 9) != NULL:
-                    _prefetch(_slot(a, SPEC, 9))
+                if _type(a) == <PyObject *> ACCESS_SPEC and borrowed_field(a, SPEC, 9) != NULL:
+                    _prefetch(borrowed_field(a, SPEC, 9))
     if x >= 1:
         o = _accesses_of(passes, x - 1)
         if o != NULL:
             for k in range(_tuple_size(o)):
                 a = _tuple_item(o, k)
                 if _type(a) == <PyObject *> ACCESS_SPEC:
-                    a = _slot(a, SPEC, 9)
+                    a = borrowed_field(a, SPEC, 9)
                     if a != NULL and _type(a) == <PyObject *> tuple:
                         for j in range(_tuple_size(a)):
                             _prefetch(_tuple_item(a, j))

@@ -20,6 +20,22 @@ from libc.string cimport memcmp, memcpy, memmove
 include "_sort.pxi"
 from cpython.object cimport PyObject
 
+
+cdef Py_ssize_t *_push_pair(Py_ssize_t *pairs, Py_ssize_t *room, Py_ssize_t count, Py_ssize_t i,
+                            Py_ssize_t j) except NULL:
+    """``pairs`` (``count`` pairs, room for ``room``) with (i, j) appended: the array itself, or a
+    grown copy (``room`` doubled; the old one is freed by realloc). MemoryError leaves it as it was."""
+    cdef Py_ssize_t *grown
+    if count == room[0]:
+        grown = <Py_ssize_t *> realloc(pairs, 4 * room[0] * sizeof(Py_ssize_t))
+        if not grown:
+            raise MemoryError()
+        room[0] *= 2
+        pairs = grown
+    pairs[2 * count], pairs[2 * count + 1] = i, j
+    return pairs
+
+
 cdef extern from "Python.h":
     PyObject *PyDict_GetItemWithError(object d, object key) except? NULL
     object PyObject_GenericGetDict(object o, void *context)
@@ -392,7 +408,6 @@ def conflict_matrix(start, end, names, conflicts):
     cdef i64 *s = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef i64 *e = <i64 *> malloc(max(n, 1) * sizeof(i64))
     cdef Py_ssize_t *pairs = <Py_ssize_t *> malloc(2 * room * sizeof(Py_ssize_t))
-    cdef Py_ssize_t *grown
     cdef unsigned char[:, ::1] m
     cdef bint separable = True
     cdef dict index
@@ -418,13 +433,7 @@ def conflict_matrix(start, end, names, conflicts):
                     j = found
                     if j == i:
                         continue
-                    if count == room:
-                        room *= 2
-                        grown = <Py_ssize_t *> realloc(pairs, 2 * room * sizeof(Py_ssize_t))
-                        if not grown:
-                            raise MemoryError()
-                        pairs = grown
-                    pairs[2 * count], pairs[2 * count + 1] = i, j
+                    pairs = _push_pair(pairs, &room, count, i, j)
                     count += 1
         matrix = np.empty((n, n), dtype=np.uint8)
         if n:
@@ -832,7 +841,6 @@ cdef class Columns:
         cdef bint separable, cliqued, duplicate
         cdef int code = 0
         cdef Graph gr
-        cdef Py_ssize_t *grown
         # one buffer of i64 (``g`` each unless said): s, e, z, a, offsets, best, minus width,
         # minus area, minus contention, sorted starts and ends (2 g each: a spare), sections (4 g)
         cdef i64 *mem = NULL
@@ -917,13 +925,7 @@ cdef class Columns:
                         j = local[<Py_ssize_t> found]
                         if j < 0 or j == t:
                             continue
-                        if npairs == room:
-                            room *= 2
-                            grown = <Py_ssize_t *> realloc(pairs, 2 * room * sizeof(Py_ssize_t))
-                            if not grown:
-                                raise MemoryError()
-                            pairs = grown
-                        pairs[2 * npairs], pairs[2 * npairs + 1] = t, j
+                        pairs = _push_pair(pairs, &room, npairs, t, j)
                         npairs += 1
             with nogil:
                 separable = matrix_core(g, s, e, pairs, npairs, adj)

@@ -80,3 +80,9 @@ cdef inline object get(object o, Slots layout, Py_ssize_t k):
     if v == NULL:
         raise AttributeError(f"{type(o).__name__}: field {k} is not set")
     return <object> v
+
+
+cdef inline PyObject *borrowed_field(PyObject *o, Slots layout, Py_ssize_t k):
+    """Field ``k`` of ``o`` (exactly ``layout``'s class), borrowed; NULL where unset (for
+    walks that only follow or prefetch the pointer)."""
+    return (<PyObject **> ((<char *> o) + layout.off[k]))[0]

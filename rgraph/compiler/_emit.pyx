@@ -10,29 +10,10 @@ include "../plan/_slots.pxi"
 include "../plan/_spec_slots.pxi"
 
 from rgraph.compiler.memory import ResourceMemory
-from rgraph.spec.specialize import ResourceSpec
-
-cdef object RESOURCE_SPEC = ResourceSpec
 cdef object RESOURCE_MEMORY = ResourceMemory
-#: Every field named (only read here): name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6,
-#: samples 7, bytes 8, loc 9, geometry 10, accel 11, scratch_of 12.
-cdef Slots RES = Slots(ResourceSpec, tuple(f.name for f in _dataclasses.fields(ResourceSpec)))
-#: bytes 0, alignment 1, memory_type_bits 2, memory_class 3, usages 4, first 5, last 6.
-cdef Slots MEM = Slots(ResourceMemory, tuple(f.name for f in _dataclasses.fields(ResourceMemory)))
-cdef tuple _RES_NAMES = ("name", "kind", "lifetime", "format", "extent", "layers", "mips", "samples", "bytes", "loc",
-                         "geometry", "accel", "scratch_of")
+#: bytes 0, alignment 1, memory_type_bits 2, memory_class 3, usages 4, first 5, last 6 (every field, only read).
 cdef tuple _MEM_NAMES = ("bytes", "alignment", "memory_type_bits", "memory_class", "usages", "first", "last")
-if tuple(f.name for f in _dataclasses.fields(ResourceSpec)) != _RES_NAMES:
-    raise TypeError(f"ResourceSpec: fields {_RES_NAMES} expected")
-if tuple(f.name for f in _dataclasses.fields(ResourceMemory)) != _MEM_NAMES:
-    raise TypeError(f"ResourceMemory: fields {_MEM_NAMES} expected")
-
-
-cdef inline object res_field(object r, Py_ssize_t k):
-    """Field ``k`` of resource ``r`` (from its slot where it is a ``ResourceSpec``)."""
-    if type(r) is RESOURCE_SPEC:
-        return get(r, RES, k)
-    return getattr(r, <str> _RES_NAMES[k])
+cdef Slots MEM = Slots(ResourceMemory, _MEM_NAMES)
 
 
 cdef inline object mem_field(object m, Py_ssize_t k):
@@ -93,12 +74,12 @@ def resources(resources, memory, set outputs, initial, final, offsets, frozen_js
     for name in sorted(memory):
         res, mem = resources[name], memory[name]
         heap, offset = offsets[name]
-        lifetime = res_field(res, 2)
+        lifetime = resource_field(res, 2)
         if lifetime == "transient" and name in outputs:
             lifetime = "output"
-        fmt = res_field(res, 3)
-        accel = res_field(res, 11)
-        kind = res_field(res, 1)
+        fmt = resource_field(res, 3)
+        accel = resource_field(res, 11)
+        kind = resource_field(res, 1)
         value = new_slots(RESOURCE)
         put(value, RESOURCE, 0, name)
         put(value, RESOURCE, 1, kind)
@@ -117,18 +98,18 @@ def resources(resources, memory, set outputs, initial, final, offsets, frozen_js
         put(value, RESOURCE, 15, final.get(name))
         if kind == "image":
             put(value, RESOURCE, 4, None)
-            put(value, RESOURCE, 16, tuple(res_field(res, 4)))
-            put(value, RESOURCE, 17, res_field(res, 6))
-            put(value, RESOURCE, 18, res_field(res, 5))
-            put(value, RESOURCE, 19, res_field(res, 7))
+            put(value, RESOURCE, 16, tuple(resource_field(res, 4)))
+            put(value, RESOURCE, 17, resource_field(res, 6))
+            put(value, RESOURCE, 18, resource_field(res, 5))
+            put(value, RESOURCE, 19, resource_field(res, 7))
         else:
-            put(value, RESOURCE, 4, res_field(res, 8))
+            put(value, RESOURCE, 4, resource_field(res, 8))
             put(value, RESOURCE, 16, None)
             put(value, RESOURCE, 17, None)
             put(value, RESOURCE, 18, None)
             put(value, RESOURCE, 19, None)
         put(value, RESOURCE, 20, frozen_json(accel.as_plan()) if accel is not None else None)
-        put(value, RESOURCE, 21, res_field(res, 12))
+        put(value, RESOURCE, 21, resource_field(res, 12))
         out.append(value)
     return tuple(out)
 

@@ -180,11 +180,11 @@ from rgraph.compiler.alias_starts import with_partial_handoffs
 from rgraph.compiler.plan_values import names as _sorted_names, subresource as _subresource
 from rgraph.compiler.sync_types import SyncResult
 from rgraph.compiler.trace import ResourceTrace
-from rgraph.spec.specialize import ResourceSpec
 from rgraph.plan import model as pm
 from rgraph.plan.builders import builder
 
 include "../plan/_slots.pxi"
+include "../plan/_spec_slots.pxi"
 
 cdef Slots BARRIER = Slots(pm.Barrier, ("resource", "subresource", "src", "dst", "aliases"))
 cdef Slots WAIT = Slots(pm.Wait, ("queue", "value", "stages"))  # ``device``: its default
@@ -1172,12 +1172,9 @@ cdef object _gather_c(_Sink sink, passes, dict final, dict initial):
 
 # ---- the resources' fields ------------------------------------------------------------------
 
-cdef object RESOURCE_TRACE = ResourceTrace, RESOURCE_SPEC = ResourceSpec
+cdef object RESOURCE_TRACE = ResourceTrace
 #: Field positions: usages 0, first 1, last 2, cells 3 (the fields without a default named).
 cdef Slots TRACE = Slots(ResourceTrace, ("usages", "first", "last", "cells", "code", "group"))
-#: Field positions: name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6 (as ``TRACE``).
-cdef Slots RESOURCE = Slots(ResourceSpec, ("name", "kind", "lifetime", "format", "extent", "layers", "mips", "samples",
-                                           "bytes", "loc"))
 
 
 cdef inline object _trace_field(object r, Py_ssize_t k, str name):
@@ -1186,13 +1183,6 @@ cdef inline object _trace_field(object r, Py_ssize_t k, str name):
     if type(r) is RESOURCE_TRACE:
         return get(r, TRACE, k)
     return getattr(r, name)
-
-
-cdef inline object _res_field(object res, Py_ssize_t k, str name):
-    """Field ``k`` (named ``name``) of a ``ResourceSpec`` (as ``_trace_field``)."""
-    if type(res) is RESOURCE_SPEC:
-        return get(res, RESOURCE, k)
-    return getattr(res, name)
 
 
 cdef inline PyObject *_cells_of(list rs, Py_ssize_t k):
@@ -1286,11 +1276,11 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
         name = names[ri]
         r = rs[ri]
         res = resources[name]
-        image = _res_field(res, 1, "kind") == "image"
+        image = resource_field(res, 1) == "image"
         cells = _trace_field(r, 3, "cells")
         ncell = len(cells)
         preds = sources.get(name)
-        lifetime = _res_field(res, 2, "lifetime")
+        lifetime = resource_field(res, 2)
         persistent = lifetime == "persistent" or lifetime == "imported"
         want = name in wanted
         layout = "UNDEFINED" if image else None
@@ -1355,7 +1345,7 @@ cdef object _synchronize(passes, resources, trace, alias_sources, ranges, output
                     _end_masks(&st, &es, &ea)
                     kept.append((es, ea, <object> st.cq, st.last_pass))
         if ncell > 1:
-            _rect_groups(sink, g0, name, _res_field(res, 6, "mips"), _res_field(res, 5, "layers"))
+            _rect_groups(sink, g0, name, resource_field(res, 6), resource_field(res, 5))
         per_cell = lifetime != "transient" or name in kept_outputs
         initial[name] = _end_state_c(per_cell, cells, starts)
         final[name] = _end_state_c(per_cell, cells, finals)

@@ -318,30 +318,14 @@ cdef inline void _close(_Res r):
         r.mixed = False
 
 
-from rgraph.spec.specialize import ResourceSpec
-
-cdef object RESOURCE_SPEC = ResourceSpec
-#: Field positions: name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6 (every field
-#: named: only read, never built here).
-cdef Slots RES = Slots(ResourceSpec, tuple(f.name for f in _dataclasses.fields(ResourceSpec)))
-if tuple(f.name for f in _dataclasses.fields(ResourceSpec))[:7] != (
-        "name", "kind", "lifetime", "format", "extent", "layers", "mips"):
-    raise TypeError("ResourceSpec: fields name, kind, lifetime, format, extent, layers, mips expected first")
-
-
-cdef inline object res_field(object r, Py_ssize_t k, str name):
-    """Field ``k`` (named ``name``) of resource ``r``."""
-    if type(r) is RESOURCE_SPEC:
-        return get(r, RES, k)
-    return getattr(r, name)
 
 
 cdef _Res _start(res, Py_ssize_t i, usage):
     """``trace._start``: a resource's trace at its first use."""
     cdef _Res r = _Res.__new__(_Res)
-    cdef bint image = res_field(res, 1, "kind") == "image", depth = False, stencil = False
+    cdef bint image = resource_field(res, 1) == "image", depth = False, stencil = False
     cdef long lo
-    fmt = res_field(res, 3, "format")
+    fmt = resource_field(res, 3)
     if fmt is not None:
         depth, stencil = bool(fmt.has_depth), bool(fmt.has_stencil)
     r.usages = {usage}
@@ -352,8 +336,8 @@ cdef _Res _start(res, Py_ssize_t i, usage):
     r.code = r.icode
     mips = layers = None  # (read for images only, as trace._start does)
     if image:
-        mips, layers = res_field(res, 6, "mips"), res_field(res, 5, "layers")
-    if image and res_field(res, 2, "lifetime") == "transient" and fmt is not None and not depth and not stencil:
+        mips, layers = resource_field(res, 6), resource_field(res, 5)
+    if image and resource_field(res, 2) == "transient" and fmt is not None and not depth and not stencil:
         r.group = []
         r.candidate = True
         r.mips, r.layers = (0, mips), (0, layers)

@@ -114,15 +114,6 @@ from cpython.dict cimport PyDict_GetItem
 from cpython.exc cimport PyErr_Clear, PyErr_Occurred
 from cpython.long cimport PyLong_AsSsize_t
 
-from rgraph.spec.specialize import ResourceSpec
-
-cdef object RESOURCE_SPEC = ResourceSpec
-#: Field positions: name 0, kind 1, lifetime 2, format 3, extent 4, layers 5, mips 6.
-#: (Every field named: only read, never built here.)
-cdef Slots RES = Slots(ResourceSpec, tuple(f.name for f in _dataclasses.fields(ResourceSpec)))
-if tuple(f.name for f in _dataclasses.fields(ResourceSpec))[:7] != (
-        "name", "kind", "lifetime", "format", "extent", "layers", "mips"):
-    raise TypeError("ResourceSpec: fields name, kind, lifetime, format, extent, layers, mips expected first")
 
 cdef enum:
     _KEEP = 1  # resource flags
@@ -188,13 +179,6 @@ cdef void _ahead(list passes, Py_ssize_t x):
                     if a != NULL and _type(a) == <PyObject *> tuple:
                         for j in range(_tuple_size(a)):
                             _prefetch(_tuple_item(a, j))
-
-
-cdef inline object res_field(object r, Py_ssize_t k, str name):
-    """Field ``k`` (named ``name``) of resource ``r``."""
-    if type(r) is RESOURCE_SPEC:
-        return get(r, RES, k)
-    return getattr(r, name)
 
 
 cdef struct _Acc:
@@ -277,12 +261,12 @@ def plain(spec, list passes, frozenset rw, culled_class):
             raise MemoryError()
         for name, r in resources.items():
             index[name] = k
-            lifetime = res_field(r, 2, "lifetime")
+            lifetime = resource_field(r, 2)
             if lifetime == "persistent" or lifetime == "imported" or lifetime == "output":
                 t.flags[k] = _KEEP
-            mips, layers = res_field(r, 6, "mips"), res_field(r, 5, "layers")
+            mips, layers = resource_field(r, 6), resource_field(r, 5)
             t.base[k] = total
-            if res_field(r, 1, "kind") != "image" or mips * layers == 1:
+            if resource_field(r, 1) != "image" or mips * layers == 1:
                 t.flags[k] |= _SINGLE
                 t.mips[k] = t.layers[k] = 1
                 total += 1

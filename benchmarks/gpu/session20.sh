@@ -1,0 +1,24 @@
+#!/bin/bash
+# Session 20 (issues 15 and 18): the figures of the code as it stands, on whatever card the call
+# gets. PART=rt: Table 3 (benchmarks.hybrid_rt, --no-raster, 10 frames), one process per scene,
+# SM clocks logged around each. PART=vr: benchmarks.vr_tests at 1920x1080, GPU-driven and
+# --naive-cpu, mono and stereo, logic at 60 Hz, one VkQueue, each row its own process.
+# Run from a checkout: source .gl/enter.sh first. Writes under $OUT.
+set -u
+clocks() { nvidia-smi --query-gpu=name,clocks.sm,clocks.max.sm,temperature.gpu,power.draw --format=csv,noheader >> $1 2>&1; }
+case ${PART-rt} in
+rt)
+  mkdir -p $OUT/rt
+  for s in ${SCENES-rt_living_room rt_conference rt_gallery}; do
+    clocks $OUT/rt/clocks.txt
+    timeout ${SCENE_TIMEOUT-150} python3 -m benchmarks.hybrid_rt --scenes $s --frames ${FRAMES-10} --no-raster \
+      --json $OUT/rt/table_$s.jsonl > $OUT/rt/table_$s.md 2>$OUT/rt/table_$s.err; echo "table $s rc=$?"
+  done
+  clocks $OUT/rt/clocks.txt ;;
+vr)
+  mkdir -p $OUT/vr
+  clocks $OUT/vr/clocks.txt; uptime > $OUT/vr/load.txt
+  timeout ${VR_TIMEOUT-420} python3 -m benchmarks.vr_tests --size 1920x1080 --frames ${FRAMES-120} --warmup 0.3 \
+    --logic-hz 60 --modes ${MODES-gpu,naive} --queues one --json $OUT/vr/vr.json > $OUT/vr/vr.txt 2>&1
+  echo "vr rc=$?"; clocks $OUT/vr/clocks.txt; uptime >> $OUT/vr/load.txt ;;
+esac

@@ -26,7 +26,9 @@ the share of pixels that traced secondary rays (the pixel list's length / pixels
 each wavefront level (``level_rays``; ``level_overflow``: a list was full and its rays walked
 in-thread, correct but slower). ``--first`` adds benchmarks/graphs/rt_hybrid_first.yaml in the same
 alternation (``first`` columns; a compute pass shades every pixel that needs no ray and lists the
-others, the shade pass traces only those; ``first listed``: the share it listed).
+others, the shade pass traces only those; ``first listed``: the share it listed). ``--lean`` adds
+benchmarks/graphs/rt_hybrid_lean.yaml (``lean`` columns: the bundled graph without the wavefront's
+passes, which run empty every frame at the bundled ``rt.wavefront: 0``).
 Output: a Markdown table on stdout and JSON lines (``--json``).
 """
 
@@ -51,6 +53,9 @@ CHUNK = 5       # frames per timed run; the plans alternate run by run
 WAVE_LEVELS = 3  # the wavefront ray lists of graphs/rt_hybrid.yaml (rays_1 .. rays_3)
 ASYNC_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_async.yaml"  # --async: matte pixels on the async queue
 FIRST_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_first.yaml"  # --first: the compute shading pass
+LEAN_GRAPH = ROOT / "benchmarks" / "graphs" / "rt_hybrid_lean.yaml"  # --lean: no wavefront passes
+#: the hybrid variants' column groups in the table: (row key prefix, label)
+VARIANTS = (("async_", "async"), ("traced_", "traced"), ("first_", "first"), ("lean_", "lean"))
 
 
 def _run(graph: str, scene: Path, camera: int, size: tuple[int, int], frames: int, params: dict[str, str],
@@ -131,14 +136,16 @@ def _hybrid_columns(timings: dict[str, Any], T: float | None, outputs: dict[str,
 def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: int, depth: int, *,
             warmup_s: float = WARMUP_S, chunk: int = CHUNK, raster: bool = True,
             hybrid_params: dict[str, str] | None = None, async_shade: bool = False,
-            dump: Path | None = None, every_shadow_ray: bool = False, first: bool = False) -> dict[str, Any]:
+            dump: Path | None = None, every_shadow_ray: bool = False, first: bool = False,
+            lean: bool = False) -> dict[str, Any]:
     """One table row: stand-alone, the hybrid (compute visibility buffer; ``hybrid_params`` are
     its extra params) and, with ``raster``, the hybrid with the hardware-raster visibility buffer,
     side by side on ``gpu``; with ``async_shade`` also benchmarks/graphs/rt_hybrid_async.yaml
     (level 0 split, the matte pixels shaded on the async compute queue: ``async_`` columns);
     with ``every_shadow_ray`` also the hybrid with ``rt.light_maps: 0`` (every shadow ray traced: ``traced_``);
     with ``first`` also benchmarks/graphs/rt_hybrid_first.yaml (a compute pass shades the pixels that need
-    no ray, the shade pass traces the listed rest: ``first_``).
+    no ray, the shade pass traces the listed rest: ``first_``); with ``lean`` also
+    benchmarks/graphs/rt_hybrid_lean.yaml (no wavefront passes: ``lean_``).
     ``dump``: a folder for ``SCENE_CAMERA.npz`` (the colour images as float16, the visibility ids)."""
     from rgraph.passes.raytrace_hybrid import prim_bits
 
@@ -158,8 +165,10 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         graphs["traced"] = ("rt_hybrid", ())
     if first:
         graphs["first"] = (str(FIRST_GRAPH), ("first_args",))
+    if lean:
+        graphs["lean"] = (str(LEAN_GRAPH), ())
     own = {"hybrid": {**params, **(hybrid_params or {})}, "traced": {**params, **(hybrid_params or {}), "rt.light_maps": "0"},
-           "first": {**params, **(hybrid_params or {})}}
+           "first": {**params, **(hybrid_params or {})}, "lean": {**params, **(hybrid_params or {})}}
     plans = {name: compile_graph(graph, scene_path=path, size=size, camera=camera, params=own.get(name, params),
                                  extra_outputs=list(extra), memory=gpu.memory_requirements())
              for name, (graph, extra) in graphs.items()}
@@ -195,6 +204,8 @@ def measure(gpu: Any, scene: str, camera: int, size: tuple[int, int], frames: in
         listed = runs["first"]["outputs"]["first_args"].tobytes()[:4]  # pixels handed to the shade pass's trace
         row.update(_hybrid_columns(runs["first"]["timings"], T, runs["first"]["outputs"], alone["outputs"], "first_"),
                    first_listed_share=int(np.frombuffer(listed, dtype=np.uint32)[0]) / (size[0] * size[1]))
+    if lean:
+        row.update(_hybrid_columns(runs["lean"]["timings"], T, runs["lean"]["outputs"], alone["outputs"], "lean_"))
     if raster:
         raster_out = runs["raster"]["outputs"]
         row.update(_hybrid_columns(runs["raster"]["timings"], T, raster_out, alone["outputs"], "raster_"))
@@ -264,17 +275,14 @@ def _levels(row: dict[str, Any]) -> str:
 
 def table(rows: list[dict[str, Any]]) -> str:
     raster = any("raster_t_ms" in r for r in rows)
-    extra = any("async_t_ms" in r for r in rows)
-    traced = any("traced_t_ms" in r for r in rows)
+    variants = [(prefix, label) for prefix, label in VARIANTS if any(f"{prefix}t_ms" in r for r in rows)]
     first = any("first_t_ms" in r for r in rows)
     head = ("| scene | camera | T (ms) | t_a (ms) | t_a/T | t_b (ms) | t (ms) | t/T | PSNR (dB) | SSIM | FLIP "
             "| traced | rays per level | primary traced |" + (" raster t_b (ms) | raster t (ms) | raster t/T | raster PSNR (dB) |" if raster else "")
-            + (" async t (ms) | async t/T | async PSNR (dB) |" if extra else "")
-            + (" traced t (ms) | traced t/T | traced PSNR (dB) |" if traced else "")
-            + (" first t (ms) | first t/T | first PSNR (dB) | first listed |" if first else "")
+            + "".join(f" {label} t (ms) | {label} t/T | {label} PSNR (dB) |" for _p, label in variants)
+            + (" first listed |" if first else "")
             + "\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|---:|---:|" if raster else "")
-            + ("---:|---:|---:|" if extra else "") + ("---:|---:|---:|" if traced else "")
-            + ("---:|---:|---:|---:|" if first else ""))
+            + "---:|---:|---:|" * len(variants) + ("---:|" if first else ""))
     lines = [head]
     for r in rows:
         line = (f"| {r['scene']} | {r['camera']} | {r['T_ms']:.3f} | {r['t_a_ms']:.3f} | {r['t_a_over_T']:.2f} "
@@ -284,15 +292,11 @@ def table(rows: list[dict[str, Any]]) -> str:
         if raster:
             line += (f" {r['raster_t_b_ms']:.3f} | {r['raster_t_ms']:.3f} | {r['raster_t_over_T']:.2f} "
                      f"| {_fmt(r['raster_psnr_db'], '.1f')} |") if "raster_t_ms" in r else " - | - | - | - |"
-        if extra:
-            line += (f" {r['async_t_ms']:.3f} | {r['async_t_over_T']:.2f} | {_fmt(r['async_psnr_db'], '.1f')} |"
-                     if "async_t_ms" in r else " - | - | - |")
-        if traced:
-            line += (f" {r['traced_t_ms']:.3f} | {r['traced_t_over_T']:.2f} | {_fmt(r['traced_psnr_db'], '.1f')} |"
-                     if "traced_t_ms" in r else " - | - | - |")
+        for prefix, _label in variants:
+            line += (f" {r[prefix + 't_ms']:.3f} | {r[prefix + 't_over_T']:.2f} | {_fmt(r[prefix + 'psnr_db'], '.1f')} |"
+                     if f"{prefix}t_ms" in r else " - | - | - |")
         if first:
-            line += (f" {r['first_t_ms']:.3f} | {r['first_t_over_T']:.2f} | {_fmt(r['first_psnr_db'], '.1f')} "
-                     f"| {r['first_listed_share']:.1%} |" if "first_t_ms" in r else " - | - | - | - |")
+            line += f" {r['first_listed_share']:.1%} |" if "first_listed_share" in r else " - |"
         lines.append(line)
     return "\n".join(lines)
 
@@ -330,6 +334,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--depth-sweep", action="store_true", help="rt.max_depth 1..8 vs depth 16 (camera 0)")
     parser.add_argument("--traced", action="store_true",
                         help="also time the hybrid with rt.light_maps=0 (every shadow ray traced)")
+    parser.add_argument("--lean", action="store_true",
+                        help="also benchmarks/graphs/rt_hybrid_lean.yaml (the hybrid without its wavefront passes)")
     parser.add_argument("--first", action="store_true",
                         help="also the hybrid with a compute pass shading the pixels that need no ray")
     parser.add_argument("--json", type=Path, help="also write JSON lines here")
@@ -355,7 +361,7 @@ def main(argv: list[str] | None = None) -> int:
                     rows.append(measure(gpu, scene, camera, size, frames, args.max_depth, warmup_s=warmup,
                                         chunk=max(1, args.chunk), raster=raster, hybrid_params=hybrid_params,
                                         async_shade=args.async_shade, dump=args.dump, every_shadow_ray=args.traced,
-                                        first=args.first))
+                                        first=args.first, lean=args.lean))
                     print(json.dumps(rows[-1]), file=sys.stderr)
     if args.json:
         args.json.write_text("".join(json.dumps(r) + "\n" for r in rows))

@@ -11,7 +11,7 @@ rt)
   mkdir -p $OUT/rt
   for s in ${SCENES-rt_living_room rt_conference rt_gallery}; do
     clocks $OUT/rt/clocks.txt
-    timeout ${SCENE_TIMEOUT-150} python3 -m benchmarks.hybrid_rt --scenes $s --frames ${FRAMES-10} --no-raster \
+    timeout ${SCENE_TIMEOUT-150} python3 -m benchmarks.hybrid_rt --scenes $s --frames ${FRAMES-10} --no-raster ${RT_FLAGS-} \
       --json $OUT/rt/table_$s.jsonl > $OUT/rt/table_$s.md 2>$OUT/rt/table_$s.err; echo "table $s rc=$?"
   done
   clocks $OUT/rt/clocks.txt ;;

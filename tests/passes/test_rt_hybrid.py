@@ -135,3 +135,18 @@ def test_visibility_ids_round_trip_and_oversized_scenes_are_refused():
     assert inst.tolist() == [-1, 4, 0] and prim.tolist() == [-1, 131071, 0]
     with pytest.raises(ValueError, match="32-bit visibility id"):
         prim_bits(scene([1 << 20], [1 << 12]))
+
+
+@pytest.mark.vulkan
+@pytest.mark.parametrize("scene", [SCENE, ROOT / "tests" / "data" / "rt" / "wave_tir.yaml"])
+def test_lean_variant_renders_the_bundled_hybrid_image(scene):
+    """benchmarks/graphs/rt_hybrid_lean.yaml (no wavefront passes) shades with the same in-thread
+    walk as the bundled graph at ``rt.wavefront: 0``: the same image, bit for bit, with none of the
+    passes that run empty there."""
+    lean_graph = str(ROOT / "benchmarks" / "graphs" / "rt_hybrid_lean.yaml")
+    lean_plan, lean = _run(lean_graph, 24, scene=scene)
+    _plan, bundled = _run("rt_hybrid", 24, scene=scene)
+    assert np.isfinite(lean["color"]).all()
+    assert np.array_equal(lean["color"], bundled["color"])
+    names = {p["name"] for p in lean_plan["passes"]}
+    assert not names & {"wave_1", "wave_2", "wave_3", "resolve"} and "shade" in names

@@ -78,3 +78,15 @@ def test_stereo_hbao_layers_equal_mono_runs_on_each_eye():
     assert_layers_are_mono_runs(stereo, mono, ("depth_quarter", "ao_quarter", "ao"))
     for k in (0, 1):  # not vacuous: real occlusion and sky in each eye
         assert stereo["ao"][k].min() < 0.8 and (stereo["ao"][k][eyes[k] == 0] == 1.0).all()
+
+
+@pytest.mark.vulkan
+def test_stereo_bloom_layers_equal_mono_runs_on_each_eye():
+    eyes = [hdr_image(1), hdr_image(2)]
+    knobs = {"bloom.intensity": 0.5}  # a visible bloom in the combined hdr
+    stereo = run("stereo_bloom.yaml", {"hdr": np.stack(eyes)}, {"views": 2, **knobs})
+    mono = [run("bloom_chain.yaml", {"hdr": e}, knobs) for e in eyes]
+    assert_layers_are_mono_runs(stereo, mono, ("bloom_a", "bloom_b", "hdr"))
+    for k in (0, 1):  # not vacuous: the bright pass keeps something and the combine adds it
+        assert (stereo["bloom_a"][k][..., :3] > 0).any()
+        assert (stereo["hdr"][k][..., :3] > eyes[k][..., :3]).any()

@@ -90,3 +90,14 @@ def test_stereo_bloom_layers_equal_mono_runs_on_each_eye():
     for k in (0, 1):  # not vacuous: the bright pass keeps something and the combine adds it
         assert (stereo["bloom_a"][k][..., :3] > 0).any()
         assert (stereo["hdr"][k][..., :3] > eyes[k][..., :3]).any()
+
+
+@pytest.mark.vulkan
+def test_views_2_with_an_image_of_one_layer_is_a_clear_error():
+    from rgraph.compiler.pipeline import compile_graph
+    from rgraph.vk.errors import ExecutionError
+    from rgraph.vk.executor import execute_plan
+
+    plan = compile_graph(GRAPHS / "stereo_bloom_unlayered.yaml", size=(W, H))
+    with pytest.raises(ExecutionError, match=r"views=2 needs bloom_a with a layer per view .*it has 1"):
+        execute_plan(plan, validate=True, inputs={"hdr": np.stack([hdr_image(1), hdr_image(2)])})

@@ -101,3 +101,16 @@ def test_views_2_with_an_image_of_one_layer_is_a_clear_error():
     plan = compile_graph(GRAPHS / "stereo_bloom_unlayered.yaml", size=(W, H))
     with pytest.raises(ExecutionError, match=r"views=2 needs bloom_a with a layer per view .*it has 1"):
         execute_plan(plan, validate=True, inputs={"hdr": np.stack([hdr_image(1), hdr_image(2)])})
+
+
+@pytest.mark.vulkan
+def test_stereo_hbao_after_a_multiview_depth_prepass_equals_mono_hbao_on_each_eye():
+    """The graph-level path: a multiview depth prepass over a scene (where the scene's shader
+    defines carry RGRAPH_VIEWS too) on the graphics queue, HBAO on the async compute queue."""
+    stereo = run("stereo_scene_hbao.yaml", {}, {"views": 2})
+    depth = stereo["depth"]
+    assert depth.shape == (2, H, W, 1) and not np.array_equal(depth[0], depth[1])
+    knobs = {"hbao.radius": 0.6, "hbao.strength": 1.5}
+    mono = [run("hbao.yaml", {"depth": depth[k]}, knobs) for k in (0, 1)]
+    assert_layers_are_mono_runs(stereo, mono, ("ao",))
+    assert stereo["ao"][0].min() < 0.9 and stereo["ao"][1].min() < 0.9  # some occlusion in each eye

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from rgraph.scene.animation import Animator
-from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
+from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj, unit_or
 from rgraph.scene.character import build_rig
 from rgraph.scene.deform import FRAME_SECONDS, Deformer
 from rgraph.scene.generate import expand_lights
@@ -311,9 +311,7 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
     lights, layer = [], 0
     for li in expand_lights(model.lights):
         kind = LIGHT_TYPES[li.type]
-        direction = _vec(li.direction if li.direction is not None else (0, -1, 0))
-        norm = np.linalg.norm(direction)
-        direction = direction / norm if norm > 0 else np.array([0.0, -1.0, 0.0])
+        direction = unit_or(_vec(li.direction if li.direction is not None else (0, -1, 0)), (0.0, -1.0, 0.0))
         shadow = -1
         if li.type == "directional" and li.shadows:
             shadow, layer = layer, layer + 1

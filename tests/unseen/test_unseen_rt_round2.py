@@ -10,6 +10,8 @@ Each test pins a bug these inputs found:
   instance spacing of 1e300, a light of 3e38 or colour 1e300): tracebacks (``struct.pack``
   OverflowError in the ray tracing tables, the camera basis) or inf pixels; the scene now
   limits coordinates to 1e18 m (a mesh's reach included) and radiance to 1e30, located;
+- an accel that only culled passes touch was never sized: the plan's ``culled`` entries reported
+  it as 1 byte (the saved memory understated); now its real size, and never an error.
 """
 
 from __future__ import annotations
@@ -106,3 +108,22 @@ def test_a_scene_at_the_limits_renders_finite(capsys) -> None:
     rc = main(["run", "clustered", "--scene", _s("at_the_limits"), "--size", "8x5", "--validate"])
     err = capsys.readouterr().err
     assert rc == 0 and "0 validation message(s)" in err, err
+
+
+@pytest.mark.parametrize("scene", ["opaque_only", "no_meshes"])
+def test_a_culled_accel_reports_the_bytes_it_would_have_taken(scene, tmp_path):
+    """rt_culled_opaque culls the build and the trace of ``tlas`` on an opaque scene: their
+    ``culled`` entries report the accel at the size it has when kept (probe geometry), with the
+    scene's meshes or without any (sizing a culled accel never raises)."""
+    from rgraph.compiler.pipeline import compile_graph
+
+    graph = FIXTURES / "graphs" / "rt_culled_opaque.yaml"
+    kept = compile_graph(str(graph), scene_path=GRAPHS / "scenes" / "rt_tiny.yaml", size=(16, 16))
+    tlas = next(r["bytes"] for r in kept["resources"] if r["name"] == "tlas")
+    assert tlas > 64 and not kept["culled"]
+    plan = compile_graph(str(graph), scene_path=_s(scene), size=(16, 16))
+    culled = {c["pass"]: c for c in plan["culled"]}
+    assert set(culled) == {"build", "reflect"} and "tlas" not in {r["name"] for r in plan["resources"]}
+    assert culled["build"]["resources"] == ["tlas"] and culled["build"]["bytes"] == tlas
+    refl = next(c for c in plan["culled"] if c["pass"] == "reflect")
+    assert refl["bytes"] > tlas  # refl (an image) and tlas

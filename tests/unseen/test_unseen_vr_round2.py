@@ -7,7 +7,11 @@ vr_scenes and scenes/). Each bug these inputs found stays fixed:
   like the graph's, and each is a located error;
 - a worktree run with ``PYTHONPATH`` (the README's way to run a checkout) took its graphs,
   shaders and pass implementations from whichever checkout an editable install maps
-  ``rgraph.<name>`` to: a fix to a shader or a pass was never run. A checkout's own data wins.
+  ``rgraph.<name>`` to: a fix to a shader or a pass was never run. A checkout's own data wins;
+- draw_cull and light_setup dispatched one workgroup row: past 65,535 groups (17 meshes at the
+  per-mesh instance limit, five light generators at theirs) the dispatch was invalid;
+- ``--naive-cpu`` on a graph without ``draw.mode`` (surgery, async_overlap) said "unknown param
+  'draw.mode'" (a param the user never gave), and on a plan file "-p only applies ...".
 """
 
 from __future__ import annotations
@@ -94,3 +98,20 @@ def test_culling_and_light_setup_in_rows_of_groups_equal_one_row(tmp_path: Path,
     counts = [int(np.frombuffer(bytes(o["draw_args"]), dtype=np.uint32)[0]) for o in (one, rows)]
     assert counts[0] > 256 and counts[0] == counts[1]
     assert np.array_equal(np.asarray(one["color"]), np.asarray(rows["color"]))
+
+
+@pytest.mark.parametrize("target, message", [
+    ("surgery", "--naive-cpu needs a graph with param 'draw.mode' (graphs/clustered.yaml); surgery has none"),
+    ("async_overlap", "--naive-cpu needs a graph with param 'draw.mode' (graphs/clustered.yaml); async_overlap "
+                      "has none"),
+    ("plan", "--naive-cpu (-p draw.mode=naive) only applies when compiling a graph, not to a plan file"),
+])
+def test_naive_cpu_on_a_graph_without_draw_modes_names_the_flag(target: str, message: str, tmp_path: Path,
+                                                                  capsys) -> None:
+    from rgraph.cli import main
+
+    if target == "plan":
+        target = str(tmp_path / "plan.json")
+        assert main(["compile", "clustered", "--size", "16x8", "-o", target]) == 0
+    rc, diags = _diagnostics(capsys, ["run", target, "--naive-cpu"])
+    assert rc == 2 and [(d["file"], d["message"]) for d in diags] == [("<command line>", message)]

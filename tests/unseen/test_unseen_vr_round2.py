@@ -11,7 +11,10 @@ vr_scenes and scenes/). Each bug these inputs found stays fixed:
 - draw_cull and light_setup dispatched one workgroup row: past 65,535 groups (17 meshes at the
   per-mesh instance limit, five light generators at theirs) the dispatch was invalid;
 - ``--naive-cpu`` on a graph without ``draw.mode`` (surgery, async_overlap) said "unknown param
-  'draw.mode'" (a param the user never gave), and on a plan file "-p only applies ...".
+  'draw.mode'" (a param the user never gave), and on a plan file "-p only applies ...";
+- 730,000 instances (under the per-mesh limit) made a 140 MB instance table, bound past the
+  device's maxStorageBufferRange (128 MiB on lavapipe): two validation errors, undefined reads
+  without the layer. It is refused before binding, with the size, the limit and what fits.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ import pytest
 from locations import ROOT, TESTS
 from test_unseen_inputs import _diagnostics
 
+vulkan = pytest.mark.vulkan
 BAD = TESTS / "fixtures" / "unseen" / "bad" / "vr_scenes"
 SCENES = TESTS / "fixtures" / "unseen" / "scenes"
 
@@ -115,3 +119,15 @@ def test_naive_cpu_on_a_graph_without_draw_modes_names_the_flag(target: str, mes
         assert main(["compile", "clustered", "--size", "16x8", "-o", target]) == 0
     rc, diags = _diagnostics(capsys, ["run", target, "--naive-cpu"])
     assert rc == 2 and [(d["file"], d["message"]) for d in diags] == [("<command line>", message)]
+
+
+@vulkan
+def test_an_instance_table_over_the_storage_range_is_refused_not_bound(capsys) -> None:
+    from rgraph.cli import main
+
+    capsys.readouterr()
+    rc = main(["run", "clustered", "--scene", str(BAD / "over_storage_range.yaml"), "--size", "8x8", "--validate"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "Traceback" not in err and "validation message" not in err, err
+    assert ("the scene's instance (draw) table is 140,160,000 bytes (730,000 draws), over this device's "
+            "maxStorageBufferRange of 134,217,728 bytes: use fewer instances or lights (about 699,050 draws fit)") in err

@@ -6,6 +6,14 @@ average), ``bloom.radius`` (16, truncation radius in HDR pixels: round(radius / 
 side at reduction factor f, at most 28), ``bloom.sigma`` (radius/2, HDR pixels),
 ``bloom.direction`` (``h`` or ``v``; pass-level, required by ``bloom_blur``),
 ``bloom.intensity`` (0.05). Reference and the non-finite rule: ``bloom_ref``.
+
+Stereo: with the graph param ``views`` = 2 every image these passes touch (``hdr``,
+``bloom_a``, ``bloom_b``) must have a layer per eye (``layers: "${params.views}"``). The
+compute passes bind them as 2D arrays (``RGRAPH_VIEWS``) and dispatch z = views, one layer
+per z; ``bloom_combine`` draws one full-screen instance per layer into the layered ``hdr``
+framebuffer (``lib/fullscreen.vert`` ``FULLSCREEN_LAYERS``, as ``tonemap_filmic``; not
+VK_KHR_multiview, which lavapipe crashes on with only a colour attachment) and samples the
+bloom layer of its own layer. Layer k is exactly the views=1 result on layer k.
 """
 
 from __future__ import annotations
@@ -34,6 +42,24 @@ def _groups(extent: tuple[int, int]) -> tuple[int, int]:
     return -(-extent[0] // 8), -(-extent[1] // 8)
 
 
+def _views(setup, resources: tuple[str, ...]) -> int:
+    """The param ``views`` (1 or 2), checking that each of ``resources`` has a layer per view."""
+    views = int(setup.param("views", 1))
+    if not 1 <= views <= 2:
+        raise ExecutionError(f"pass {setup.name!r}: views must be 1 or 2, got {views}")
+    for name in resources:
+        layers = int(setup.resource_plan(name).get("layers", 1))
+        if layers != views:
+            raise ExecutionError(f"pass {setup.name!r}: views={views} needs {name} with a layer per view "
+                                 f"(layers: \"${{params.views}}\"), it has {layers}")
+    return views
+
+
+def _stereo(views: int) -> dict[str, int]:
+    """Shader defines for ``views`` (none at views=1: the mono SPIR-V is unchanged)."""
+    return {"RGRAPH_VIEWS": views} if views > 1 else {}
+
+
 @register("bloom_bright")
 class BloomBright(PassImpl):
     """Reads its sampled source (``hdr``), writes its storage image (``bloom_a``) at reduced size."""
@@ -54,15 +80,17 @@ class BloomBright(PassImpl):
             raise ExecutionError(f"pass {setup.name!r}: bloom.threshold and bloom.knee must be >= 0 and "
                                  f"bloom.clamp > 0 (got {threshold}, {knee}, {clamp})")
         self.push = pack("2i3f", fx, fy, threshold, knee, clamp)
-        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest"),
-                                       Binding(1, "storage_image", dst)])
+        self.views = _views(setup, (src, dst))
+        arr = self.views > 1
+        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest", array=arr),
+                                       Binding(1, "storage_image", dst, array=arr)])
         self.pipeline = setup.compute_pipeline("post/bloom_bright.comp", [self.sets.layout],
-                                               push_constant_bytes=len(self.push))
+                                               push_constant_bytes=len(self.push), defines=_stereo(self.views))
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
         rec.push(self.pipeline, self.push)
-        rec.dispatch(*_groups(self.extent))
+        rec.dispatch(*_groups(self.extent), self.views)
 
 
 @register("bloom_blur")
@@ -92,15 +120,17 @@ class BloomBlur(PassImpl):
             raise ExecutionError(f"pass {setup.name!r}: {exc} (at reduction factor {factor})") from None
         padded = list(weights) + [0.0] * (MAX_RADIUS + 1 - len(weights))
         self.push = pack("3i29f", *((1, 0) if direction == "h" else (0, 1)), radius, *padded)
-        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest"),
-                                       Binding(1, "storage_image", dst)])
+        self.views = _views(setup, (src, dst))
+        arr = self.views > 1
+        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest", array=arr),
+                                       Binding(1, "storage_image", dst, array=arr)])
         self.pipeline = setup.compute_pipeline("post/bloom_blur.comp", [self.sets.layout],
-                                               push_constant_bytes=len(self.push))
+                                               push_constant_bytes=len(self.push), defines=_stereo(self.views))
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
         rec.push(self.pipeline, self.push)
-        rec.dispatch(*_groups(self.extent))
+        rec.dispatch(*_groups(self.extent), self.views)
 
 
 @register("bloom_combine")
@@ -111,15 +141,19 @@ class BloomCombine(PassImpl):
     def __init__(self, setup):
         super().__init__(setup)
         src = _one(setup, "sampled")
-        _one(setup, "color_attachment_blend")
+        dst = _one(setup, "color_attachment_blend")
         bw, bh = setup.extent_of(src)
         fx, fy = _factor(setup.extent, (bw, bh))
         self.push = pack("3f", 1.0 / (fx * bw), 1.0 / (fy * bh), float(setup.param("bloom.intensity", 0.05)))
-        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="linear")])
+        self.views = _views(setup, (src, dst))
+        stereo = self.views > 1
+        self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="linear", array=stereo)])
+        # views=2: one full-screen instance per layer of the layered hdr framebuffer (gl_Layer)
+        defines = {"FULLSCREEN_LAYERS": self.views, **_stereo(self.views)} if stereo else None
         self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "post/bloom_combine.frag", [self.sets.layout],
-                                                push_constant_bytes=len(self.push), blend=["add"])
+                                                push_constant_bytes=len(self.push), blend=["add"], defines=defines)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
         rec.push(self.pipeline, self.push)
-        rec.draw(3)
+        rec.draw(3, self.views)

@@ -16,6 +16,12 @@ Params: ``hbao.directions``, ``hbao.steps`` (compile-time loop counts), ``hbao.r
 (world units), ``hbao.angle_bias``, ``hbao.strength``, ``hbao.max_radius_px`` (full-res px),
 ``hbao.upsample_sharpness``; the camera from ``passes.screenspace_ref.screen_camera``.
 What each computes, exactly: ``passes/hbao_ref.py``.
+
+Stereo: with the graph param ``views`` = 2 every image above must have a layer per eye
+(``layers: "${params.views}"``); each pass binds them as 2D arrays (``RGRAPH_VIEWS`` in
+``shaders/hbao``) and dispatches z = views, invocation z working on layer z alone. Both eyes
+use the one projection (``rgraph.scene.instances.eye_view_projs``: the eyes differ by a
+translation), so layer k is exactly the views=1 result on layer k.
 """
 
 from __future__ import annotations
@@ -54,6 +60,24 @@ def _settings(setup) -> HBAOSettings:
     return s
 
 
+def _views(setup, resources: tuple[str, ...]) -> int:
+    """The param ``views`` (1 or 2), checking that each of ``resources`` has a layer per view."""
+    views = int(setup.param("views", 1))
+    if not 1 <= views <= 2:
+        raise ValueError(f"pass {setup.name!r}: views must be 1 or 2, got {views}")
+    for name in resources:
+        layers = int(setup.resource_plan(name).get("layers", 1))
+        if layers != views:
+            raise ValueError(f"pass {setup.name!r}: views={views} needs {name} with a layer per view "
+                             f"(layers: \"${{params.views}}\"), it has {layers}")
+    return views
+
+
+def _stereo(views: int) -> dict[str, int]:
+    """Shader defines for ``views`` (none at views=1: the mono SPIR-V is unchanged)."""
+    return {"RGRAPH_VIEWS": views} if views > 1 else {}
+
+
 def _proj(setup) -> bytes:
     cam = screen_camera(setup.plan, setup.params, setup.size)
     return pack("4f", cam.p00, cam.p11, cam.near, 0.0)
@@ -67,11 +91,13 @@ class HBAODownsample(PassImpl):
     def __init__(self, setup):
         super().__init__(setup)
         self.push = pack("i", _settings(setup).factor)
-        self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest"),
-                                       Binding(1, "storage_image", "depth_quarter")])
+        views = _views(setup, ("depth", "depth_quarter"))
+        arr = views > 1
+        self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest", array=arr),
+                                       Binding(1, "storage_image", "depth_quarter", array=arr)])
         self.pipeline = setup.compute_pipeline("hbao/downsample.comp", [self.sets.layout],
-                                               push_constant_bytes=len(self.push))
-        self.groups = _groups(setup.extent_of("depth_quarter"))
+                                               push_constant_bytes=len(self.push), defines=_stereo(views))
+        self.groups = (*_groups(setup.extent_of("depth_quarter")), views)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
@@ -89,12 +115,15 @@ class HBAO(PassImpl):
         s = _settings(setup)
         if s.directions < 1 or s.steps < 1:
             raise ValueError(f"pass {setup.name!r}: hbao.directions and hbao.steps must be >= 1")
-        self.sets = setup.descriptors([Binding(0, "sampled", "depth_quarter", sampler="nearest"),
-                                       Binding(1, "storage_image", "ao_quarter")])
+        views = _views(setup, ("depth_quarter", "ao_quarter"))
+        arr = views > 1
+        self.sets = setup.descriptors([Binding(0, "sampled", "depth_quarter", sampler="nearest", array=arr),
+                                       Binding(1, "storage_image", "ao_quarter", array=arr)])
         self.pipeline = setup.compute_pipeline("hbao/hbao.comp", [self.sets.layout], push_constant_bytes=32,
-                                               defines={"DIRECTIONS": s.directions, "STEPS": s.steps})
+                                               defines={"DIRECTIONS": s.directions, "STEPS": s.steps,
+                                                        **_stereo(views)})
         self.push = _proj(setup) + pack("4f", s.radius, s.angle_bias, s.strength, s.max_radius_px * s.scale)
-        self.groups = _groups(setup.extent_of("ao_quarter"))
+        self.groups = (*_groups(setup.extent_of("ao_quarter")), views)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
@@ -110,13 +139,16 @@ class HBAOUpsample(PassImpl):
     def __init__(self, setup):
         super().__init__(setup)
         s = _settings(setup)
-        self.sets = setup.descriptors([Binding(0, "sampled", "ao_quarter", sampler="nearest"),
-                                       Binding(1, "sampled", "depth", sampler="nearest"),
-                                       Binding(2, "storage_image", "depth_quarter"),
-                                       Binding(3, "storage_image", "ao")])
-        self.pipeline = setup.compute_pipeline("hbao/upsample.comp", [self.sets.layout], push_constant_bytes=32)
+        views = _views(setup, ("ao_quarter", "depth", "depth_quarter", "ao"))
+        arr = views > 1
+        self.sets = setup.descriptors([Binding(0, "sampled", "ao_quarter", sampler="nearest", array=arr),
+                                       Binding(1, "sampled", "depth", sampler="nearest", array=arr),
+                                       Binding(2, "storage_image", "depth_quarter", array=arr),
+                                       Binding(3, "storage_image", "ao", array=arr)])
+        self.pipeline = setup.compute_pipeline("hbao/upsample.comp", [self.sets.layout], push_constant_bytes=32,
+                                               defines=_stereo(views))
         self.push = _proj(setup) + pack("4f", s.upsample_sharpness, 0.0, 0.0, 0.0)
-        self.groups = _groups(setup.extent_of("ao"))
+        self.groups = (*_groups(setup.extent_of("ao")), views)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])

@@ -12,8 +12,8 @@
 #endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0) uniform sampler2D depth_quarter;
-layout(set = 0, binding = 1, r8) uniform writeonly image2D ao_quarter;
+layout(set = 0, binding = 0) uniform HBAO_SAMPLER depth_quarter;
+layout(set = 0, binding = 1, r8) uniform writeonly HBAO_IMAGE ao_quarter;
 layout(push_constant) uniform Push {
     vec4 proj;   // P00, P11, near, -
     vec4 knobs;  // radius (world), angle bias (rad), strength, max radius (working-res px)
@@ -24,7 +24,7 @@ const float BAYER[16] = float[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7,
 
 ivec2 qsize;
 
-float fetch(ivec2 p) { return texelFetch(depth_quarter, p, 0).r; }
+float fetch(ivec2 p) { return texelFetch(depth_quarter, EYE(p), 0).r; }
 
 vec3 pos_at(ivec2 p, float d) { return view_position(d, (vec2(p) + 0.5) / vec2(qsize), pc.proj); }
 
@@ -44,10 +44,10 @@ vec3 axis_diff(ivec2 q, vec3 p, ivec2 step, vec3 fallback) {
 
 void main() {
     ivec2 q = ivec2(gl_GlobalInvocationID.xy);
-    qsize = textureSize(depth_quarter, 0);
+    qsize = XY(textureSize(depth_quarter, 0));
     if (any(greaterThanEqual(q, qsize))) return;
     float d = fetch(q);
-    if (d <= 0.0) { imageStore(ao_quarter, q, vec4(1.0)); return; }  // sky: no occlusion
+    if (d <= 0.0) { imageStore(ao_quarter, EYE(q), vec4(1.0)); return; }  // sky: no occlusion
     vec3 p = pos_at(q, d);
     vec3 ddx = axis_diff(q, p, ivec2(1, 0), vec3(1, 0, 0));
     vec3 ddy = axis_diff(q, p, ivec2(0, 1), vec3(0, -1, 0));
@@ -87,5 +87,5 @@ void main() {
         }
         total += acc;
     }
-    imageStore(ao_quarter, q, vec4(clamp(1.0 - pc.knobs.z * total / float(DIRECTIONS), 0.0, 1.0)));
+    imageStore(ao_quarter, EYE(q), vec4(clamp(1.0 - pc.knobs.z * total / float(DIRECTIONS), 0.0, 1.0)));
 }

@@ -6,10 +6,10 @@
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0) uniform sampler2D ao_quarter;
-layout(set = 0, binding = 1) uniform sampler2D depth;
-layout(set = 0, binding = 2, r32f) uniform readonly image2D depth_quarter;
-layout(set = 0, binding = 3, r8) uniform writeonly image2D ao;
+layout(set = 0, binding = 0) uniform HBAO_SAMPLER ao_quarter;
+layout(set = 0, binding = 1) uniform HBAO_SAMPLER depth;
+layout(set = 0, binding = 2, r32f) uniform readonly HBAO_IMAGE depth_quarter;
+layout(set = 0, binding = 3, r8) uniform writeonly HBAO_IMAGE ao;
 layout(push_constant) uniform Push {
     vec4 proj;   // P00, P11, near, -
     vec4 knobs;  // sharpness, -, -, -
@@ -17,13 +17,13 @@ layout(push_constant) uniform Push {
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    ivec2 size = imageSize(ao);
+    ivec2 size = XY(imageSize(ao));
     if (any(greaterThanEqual(p, size))) return;
-    float d = texelFetch(depth, p, 0).r;
-    if (d <= 0.0) { imageStore(ao, p, vec4(1.0)); return; }
+    float d = texelFetch(depth, EYE(p), 0).r;
+    if (d <= 0.0) { imageStore(ao, EYE(p), vec4(1.0)); return; }
     float near = pc.proj.z;
     float zf = near / d;
-    ivec2 qsize = imageSize(depth_quarter);
+    ivec2 qsize = XY(imageSize(depth_quarter));
     vec2 f = (vec2(p) + 0.5) * vec2(qsize) / vec2(size) - 0.5;
     vec2 b = floor(f);
     vec2 a = f - b;
@@ -33,11 +33,11 @@ void main() {
     for (int i = 0; i < 4; ++i) {
         ivec2 o = ivec2(i & 1, i >> 1);
         ivec2 t = clamp(ivec2(b) + o, ivec2(0), qsize - 1);
-        float dq = imageLoad(depth_quarter, t).r;
+        float dq = imageLoad(depth_quarter, EYE(t)).r;
         wb[i] = (o.x == 1 ? a.x : 1.0 - a.x) * (o.y == 1 ? a.y : 1.0 - a.y);
         valid[i] = dq > 0.0;
         rel[i] = valid[i] ? abs(zf - near / dq) / zf : 0.0;
-        val[i] = texelFetch(ao_quarter, t, 0).r;
+        val[i] = texelFetch(ao_quarter, EYE(t), 0).r;
         if (valid[i]) rel_min = min(rel_min, rel[i]);
     }
     float sum_w = 0.0, sum = 0.0;
@@ -47,5 +47,5 @@ void main() {
         sum_w += w;
         sum += w * val[i];
     }
-    imageStore(ao, p, vec4(sum_w > 0.0 ? sum / sum_w : 1.0));
+    imageStore(ao, EYE(p), vec4(sum_w > 0.0 ? sum / sum_w : 1.0));
 }

@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 from rgraph.impl import PassImpl, register
+from rgraph.vk import dispatch
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, PassSetup, pack
 
@@ -80,7 +81,7 @@ class _DrawArgsPass(PassImpl):
             return
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
         rec.push(self.pipeline, pack("2I", self.scene.draw_count, self.capacity))
-        rec.dispatch(1 if self.reset else max(1, -(-self.scene.draw_count // GROUP)), 1, 1)
+        rec.dispatch(*((1, 1) if self.reset else dispatch.groups_2d(self.scene.draw_count, GROUP)), 1)
 
 
 @register("draw_reset")

@@ -9,6 +9,7 @@ reversed-Z infinite projection, reversed orthographic shadow depth). NumPy refer
 from __future__ import annotations
 
 from rgraph.impl import Param, PassImpl, register
+from rgraph.vk import dispatch
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
@@ -101,4 +102,4 @@ class LightSetup(PassImpl):
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
         rec.push(self.pipeline, pack("4i", self.count, 0, 0, 0))
-        rec.dispatch(max(1, -(-self.count // 64)), 1, 1)
+        rec.dispatch(*dispatch.groups_2d(self.count, 64), 1)

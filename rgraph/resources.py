@@ -15,11 +15,22 @@ from types import ModuleType
 _PACKAGE = Path(__file__).resolve().parent
 
 
+def _checkout_dir(name: str) -> Path | None:
+    """``name`` beside the package when the package is a source checkout's (``pyproject.toml``
+    beside it): that checkout's own data, even where an editable install maps ``rgraph.<name>``
+    to another checkout (a worktree run with ``PYTHONPATH``)."""
+    beside = _PACKAGE.parent / name
+    return beside if (_PACKAGE.parent / "pyproject.toml").is_file() and beside.is_dir() else None
+
+
 def data_dir(name: str) -> Path:
     """``graphs``, ``shaders`` or ``passes``: inside the package, else beside it."""
     inside = _PACKAGE / name
     if inside.is_dir():
         return inside
+    checkout = _checkout_dir(name)
+    if checkout is not None:
+        return checkout
     spec = importlib.util.find_spec(f"rgraph.{name}")
     if spec and spec.submodule_search_locations:
         return Path(next(iter(spec.submodule_search_locations)))
@@ -66,9 +77,10 @@ def builtin_passes() -> ModuleType:
     """Import ``rgraph.passes`` (the built-in implementations), from a wheel or a checkout."""
     if "rgraph.passes" in sys.modules:
         return sys.modules["rgraph.passes"]
-    if importlib.util.find_spec("rgraph.passes") is not None:
+    checkout = _checkout_dir("passes")
+    if checkout is None and importlib.util.find_spec("rgraph.passes") is not None:
         return importlib.import_module("rgraph.passes")
-    init = _PACKAGE.parent / "passes" / "__init__.py"
+    init = (checkout or _PACKAGE.parent / "passes") / "__init__.py"
     spec = importlib.util.spec_from_file_location("rgraph.passes", init, submodule_search_locations=[str(init.parent)])
     assert spec and spec.loader
     module = importlib.util.module_from_spec(spec)

@@ -201,6 +201,18 @@ def _params_view(args: argparse.Namespace) -> dict:
     return params_view(front.spec, args.graph)
 
 
+def _has_param(graph: str, name: str) -> bool:
+    """Whether ``graph`` (a file or bundled name) declares param ``name``; a graph that does not
+    load answers True, so the usual located error reports it."""
+    from rgraph.resources import resolve_graph
+    from rgraph.spec.loader import load_graph
+
+    try:
+        return name in load_graph(resolve_graph(graph)).params
+    except RGraphError:
+        return True
+
+
 def _is_multi_plan(target: str) -> bool:
     try:
         return is_plan_file(target) and bool(json.loads(Path(target).read_text()).get("multi_device"))
@@ -277,6 +289,12 @@ def run(args: argparse.Namespace) -> int:
         print("rgraph: error: --frames must be at least 1", file=sys.stderr)
         return 2
     if getattr(args, "naive_cpu", False):
+        if is_plan_file(args.graph):
+            raise RGraphError.in_file("<command line>", "--naive-cpu (-p draw.mode=naive) only applies when "
+                                                        "compiling a graph, not to a plan file")
+        if not _has_param(args.graph, "draw.mode"):
+            raise RGraphError.in_file("<command line>", f"--naive-cpu needs a graph with param 'draw.mode' "
+                                                        f"(graphs/clustered.yaml); {args.graph} has none")
         args.param = [*(args.param or []), "draw.mode=naive"]
     for flag, target in (("--out", args.out), ("--timings", args.timings), ("--trace", args.trace),
                          ("--heatmap", args.heatmap)):

@@ -115,6 +115,25 @@ def check_geometry(spec: Spec, passes: list[PassSpec]) -> None:
         _geometry(res, spec, passes)
 
 
+def size_culled_accels(spec: Spec, kept: list[PassSpec], culled: list[PassSpec], provider) -> None:
+    """Size (in place) each accel that only culled passes touch, so that the plan's ``culled``
+    entries report the memory its culling saved (the structure's bytes; its build scratch, a
+    transient that would alias, is not counted). Best effort: an accel that cannot be sized
+    (no geometry, no provider sizes) keeps its placeholder size, since nothing builds it."""
+    if not hasattr(provider, "accel_sizes"):
+        return
+    kept_names = {r.name for r in used_accels(spec, kept)}
+    for res in used_accels(spec, culled):
+        if res.name in kept_names or res.accel is not None:
+            continue
+        try:
+            geometry, counts, instances = _geometry(res, spec, culled)
+            layout = layout_of(res, geometry, counts, instances, refits(res, spec.features), provider)
+        except RGraphError:
+            continue
+        spec.resources[res.name] = replace(res, bytes=layout.bytes, accel=layout)
+
+
 def size_accels(spec: Spec, passes: list[PassSpec], provider) -> list[PassSpec]:
     """Size every used accel of ``spec`` (in place) and add its scratch buffer; returns
     ``passes`` with each build pass also writing its accel's scratch, and refits reading."""

@@ -102,7 +102,14 @@ def size_accels(c: Compilation) -> Compilation:
     else:
         return replace(c)
     spec = replace(c.spec, resources=dict(c.spec.resources))
-    return replace(c, spec=spec, passes=tuple(size(spec, list(c.passes), c.provider)))
+    kept = list(c.passes)
+    passes = size(spec, kept, c.provider)
+    if c.culling is not None and c.culling.culled:
+        from rgraph.compiler.accel import size_culled_accels
+
+        names = {x.pass_name for x in c.culling.culled}
+        size_culled_accels(spec, kept, [p for p in spec.passes if p.name in names], c.provider)
+    return replace(c, spec=spec, passes=tuple(passes))
 
 
 def trace(c: Compilation) -> Compilation:

@@ -13,12 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from rgraph.scene.animation import Animator
-from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj
+from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj, unit_or
 from rgraph.scene.character import build_rig
 from rgraph.scene.deform import FRAME_SECONDS, Deformer
 from rgraph.scene.generate import expand_lights
 from rgraph.scene.shapes import MeshData, make_shape
-from rgraph.spec.scene import Material, SceneFile, load_scene
+from rgraph.spec.scene import MAX_COORDINATE, Material, SceneFile, load_scene
 
 MAX_SHADOW_LIGHTS = 4
 LIGHT_TYPES = {"directional": 0, "point": 1, "spot": 2}
@@ -311,9 +311,7 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
     lights, layer = [], 0
     for li in expand_lights(model.lights):
         kind = LIGHT_TYPES[li.type]
-        direction = _vec(li.direction if li.direction is not None else (0, -1, 0))
-        norm = np.linalg.norm(direction)
-        direction = direction / norm if norm > 0 else np.array([0.0, -1.0, 0.0])
+        direction = unit_or(_vec(li.direction if li.direction is not None else (0, -1, 0)), (0.0, -1.0, 0.0))
         shadow = -1
         if li.type == "directional" and li.shadows:
             shadow, layer = layer, layer + 1
@@ -325,8 +323,20 @@ def build_scene(model: SceneFile, extent: tuple[int, int] = (64, 64), name: str 
     decals = [DecalData(_vec(d.position), _vec(d.size), tuple(d.rotation), pool[d.material]) for d in model.decals]
     corners = (np.concatenate([m.world_corners() for m in meshes]) if meshes
                else np.zeros((1, 3)) + _vec(model.camera.look_at))
+    _check_reach(meshes, corners)
     return SceneData(name or model.name or "scene", model, extent, meshes, material_names, materials, lights,
                      decals, corners)
+
+
+def _check_reach(meshes: list[SceneMesh], corners: np.ndarray) -> None:
+    """A mesh whose instances (scale, size and spacing applied) reach past ``MAX_COORDINATE``
+    is refused at the mesh, as a position past it is by the scene model."""
+    if np.abs(corners).max() <= MAX_COORDINATE:
+        return
+    mesh = next(m for m in meshes if not np.abs(m.world_corners()).max() <= MAX_COORDINATE)
+    index, shape = mesh.name.split(":", 1)
+    raise SceneBuildError(("meshes", int(index)), f"mesh {index} ({shape.split('#')[0]}) reaches past "
+                                                  f"{MAX_COORDINATE:g} m from the origin (the limit of coordinates)")
 
 
 def load_scene_data(path: str | Path, extent: tuple[int, int] = (64, 64), camera: int = 0) -> SceneData:

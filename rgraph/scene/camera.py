@@ -18,10 +18,23 @@ WORLD_UP = np.array([0.0, 1.0, 0.0])
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    n = float(np.linalg.norm(v))
-    if not np.isfinite(n) or n < 1e-300:
+    """``v / |v|``, scaled by its largest component first: a vector the scene validator accepts
+    (finite, nonzero ``math.hypot``) normalizes even where its squared norm over- or underflows
+    (a camera 1e300 m out, a look_at 1e-200 m away)."""
+    v = np.asarray(v, dtype=np.float64)
+    m = float(np.max(np.abs(v))) if v.size else 0.0
+    if not np.isfinite(m) or m == 0.0:
         raise ValueError(f"cannot normalize {v}")
-    return np.asarray(v, dtype=np.float64) / n
+    w = v / m
+    return w / float(np.linalg.norm(w))
+
+
+def unit_or(v: np.ndarray, fallback) -> np.ndarray:
+    """:func:`_unit` of ``v``, or ``fallback`` (a unit vector) where ``v`` is zero or not finite."""
+    try:
+        return _unit(v)
+    except ValueError:
+        return np.asarray(fallback, dtype=np.float64)
 
 
 def orthonormal_basis(forward, up=WORLD_UP) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -18,6 +18,13 @@ SCENE_VERSION = 1
 LARGE_WORLD_METERS = 1e5
 
 Vec3 = list[float | int]
+#: Coordinates (metres) and light radiance (colour x intensity) end up as float32 on the GPU,
+#: camera-relative: beyond these they overflow it (inf transforms and tables, inf pixels), and
+#: float64 itself resolves 1e18 m only to 128 m.
+MAX_COORDINATE = 1e18
+MAX_RADIANCE = 1e30
+Coord = Annotated[float | int, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+Point3 = list[Coord]
 
 
 # Limits on generated geometry: a scene is procedural, so its size is a few numbers.
@@ -30,12 +37,12 @@ _COUNT_PARAMS = ("count", "lobes")
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
 
 class Camera(_Strict):
-    position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 1.0], min_length=3, max_length=3)
-    look_at: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+    position: Point3 = Field(default_factory=lambda: [0.0, 0.0, 1.0], min_length=3, max_length=3)
+    look_at: Point3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
     up: Vec3 = Field(default_factory=lambda: [0.0, 1.0, 0.0], min_length=3, max_length=3)
     fov_y: float = Field(45.0, gt=0, lt=180)
     near: float = Field(0.01, gt=0)
@@ -54,7 +61,7 @@ class Camera(_Strict):
 class Light(_Strict):
     type: Literal["directional", "point", "spot"]
     direction: Vec3 | None = Field(None, min_length=3, max_length=3)
-    position: Vec3 | None = Field(None, min_length=3, max_length=3)
+    position: Point3 | None = Field(None, min_length=3, max_length=3)
     color: Vec3 = Field(default_factory=lambda: [1.0, 1.0, 1.0], min_length=3, max_length=3)
     intensity: float = Field(1.0, ge=0)
     radius: float = Field(1.0, ge=0)  # metres: the light reaches exactly zero here (0: no reach)
@@ -66,6 +73,10 @@ class Light(_Strict):
         inner, outer = self.cone
         if not 0 <= inner <= outer <= 90:
             raise ValueError(f"cone must be [inner, outer] degrees with 0 <= inner <= outer <= 90, got {self.cone}")
+        radiance = max((abs(c) for c in self.color), default=0.0) * self.intensity
+        if radiance > MAX_RADIANCE:
+            raise ValueError(f"radiance (color x intensity) {radiance:.3g} is above {MAX_RADIANCE:g} "
+                             "(it would overflow the GPU's float32 shading)")
         return self
 
 
@@ -75,9 +86,10 @@ class LightGenerator(_Strict):
     generate: Literal["point"]
     count: int = Field(ge=0, le=1 << 20)
     seed: int = 0
-    bounds: list[Vec3] = Field(min_length=2, max_length=2)
+    bounds: list[Point3] = Field(min_length=2, max_length=2)
     radius: list[float] = Field(default_factory=lambda: [1.0, 1.0], min_length=2, max_length=2)
-    intensity: list[float] = Field(default_factory=lambda: [1.0, 1.0], min_length=2, max_length=2)
+    intensity: list[Annotated[float, Field(le=MAX_RADIANCE)]] = Field(default_factory=lambda: [1.0, 1.0],
+                                                                      min_length=2, max_length=2)
     color: Vec3 | None = Field(None, min_length=3, max_length=3)  # omitted: seeded random colours
 
     @model_validator(mode="after")
@@ -122,7 +134,7 @@ class Instances(_Strict):
     spacing: float = 1.0
     count: int | None = Field(None, ge=1, le=MAX_INSTANCES)
     seed: int = 0
-    bounds: list[Vec3] | None = Field(None, min_length=2, max_length=2)
+    bounds: list[Point3] | None = Field(None, min_length=2, max_length=2)
 
     @model_validator(mode="after")
     def _bounded(self) -> Instances:
@@ -159,7 +171,7 @@ class Mesh(_Strict):
     params: dict[str, float | int | list[float | int]] = Field(default_factory=dict)
     material: str
     deformable: bool = False
-    position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
+    position: Point3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
     rotation: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
     scale: float | Vec3 = 1.0
     instances: Instances | None = None
@@ -180,7 +192,7 @@ class Mesh(_Strict):
 
 class Decal(_Strict):
     material: str
-    position: Vec3 = Field(min_length=3, max_length=3)
+    position: Point3 = Field(min_length=3, max_length=3)
     size: Vec3 = Field(min_length=3, max_length=3)
     rotation: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], min_length=3, max_length=3)
 

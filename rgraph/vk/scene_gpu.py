@@ -33,6 +33,7 @@ from rgraph.memory.tlsf import Tlsf
 from rgraph.scene import instances as scene_instances
 from rgraph.scene import packing
 from rgraph.scene.build import SceneData, load_scene_data
+from rgraph.vk.buffer_ranges import check_ranges
 from rgraph.vk.device import Device
 from rgraph.vk.device_local import DeviceBuffer, DeviceLocal
 from rgraph.vk.errors import ExecutionError
@@ -44,6 +45,11 @@ from rgraph.vk.skin_gpu import BINDING_BONES, BINDING_SKIN_FRAME, BINDING_SKIN_V
 
 (BINDING_FRAME, BINDING_DRAWS, BINDING_MATERIALS, BINDING_SCENE_LIGHTS, BINDING_DECALS, BINDING_VIEWS,
  BINDING_MESHES) = range(7)
+_BINDING_NAMES = {BINDING_FRAME: "frame uniform", BINDING_DRAWS: "instance (draw) table",
+                  BINDING_MATERIALS: "material table", BINDING_SCENE_LIGHTS: "light table",
+                  BINDING_DECALS: "decal table", BINDING_VIEWS: "views uniform", BINDING_MESHES: "mesh table",
+                  BINDING_SKIN_VERTICES: "skinned vertex table", BINDING_BONES: "bone table",
+                  BINDING_SKIN_FRAME: "skinning frame uniform"}
 
 
 @dataclass(frozen=True)
@@ -267,6 +273,11 @@ class SceneGPU:
                        (BINDING_MESHES, ssbo, self.meshes_buffer.handle, meshes_size)]
             skin = [*self.skin.descriptors(), self.skin.frame_descriptor(s)]
             sources += [(b, ubo if kind == "uniform" else ssbo, buf.handle, size) for b, kind, buf, size in skin]
+            if s == 0:
+                limits = self.device.properties.limits
+                check_ranges([(_BINDING_NAMES.get(b, f"binding {b}"), t == ubo, size) for b, t, _h, size in sources],
+                             int(limits.maxStorageBufferRange), int(limits.maxUniformBufferRange),
+                             self.data.draw_count)
             infos = [v.VkDescriptorBufferInfo(buffer=h, offset=0, range=size) for _b, _t, h, size in sources]
             writes = [v.VkWriteDescriptorSet(dstSet=self._sets[s], dstBinding=b, descriptorCount=1, descriptorType=t,
                                              pBufferInfo=[info])

@@ -22,7 +22,6 @@ shadow an already-resolved ``#include`` in an earlier include directory is not n
 from __future__ import annotations
 
 import hashlib
-import importlib.resources
 import json
 import math
 import os
@@ -91,16 +90,12 @@ def shader_dirs() -> list[Path]:
 
 
 def _bundled_shader_dir() -> Path | None:
-    try:
-        resource = importlib.resources.files("rgraph.shaders")
-    except ModuleNotFoundError:
-        resource = None
-    if resource is not None and isinstance(resource, Path) and resource.is_dir():
-        return resource
-    import rgraph
+    """``rgraph.resources.data_dir("shaders")``: the package's, a checkout's own ``shaders/``
+    (even where an editable install maps ``rgraph.shaders`` to another checkout), else the mapped one."""
+    from rgraph.resources import data_dir
 
-    checkout = Path(rgraph.__file__).resolve().parent.parent / "shaders"
-    return checkout if checkout.is_dir() else None
+    bundled = data_dir("shaders")
+    return bundled if bundled.is_dir() else None
 
 
 def find_shader(name: str) -> Path:

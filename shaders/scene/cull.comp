@@ -80,7 +80,8 @@ void main() {
     if (t < BUCKETS) words[5u * pc.capacity + t] = 0u;
 #endif
 #else
-    uint i = gl_GlobalInvocationID.x;
+    // groups fold into rows (rgraph/vk/dispatch.py): more than 65,535 groups of instances
+    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * GROUP + t;
     bool keep = false;
     vec3 c = vec3(0.0);
     float r = 0.0;
@@ -108,7 +109,7 @@ void main() {
     // available before their groups_done increment; coherent buffer).
     memoryBarrierBuffer();
     barrier();
-    if (t == 0u) last_group = atomicAdd(groups_done, 1u) == gl_NumWorkGroups.x - 1u;
+    if (t == 0u) last_group = atomicAdd(groups_done, 1u) == gl_NumWorkGroups.x * gl_NumWorkGroups.y - 1u;
     barrier();
     if (last_group) {
         memoryBarrierBuffer();

@@ -12,7 +12,8 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    // groups fold into rows (rgraph/vk/dispatch.py): more than 65,535 groups of lights
+    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 64u + gl_LocalInvocationIndex;
     if (i >= uint(pc.count.x)) {
         return;
     }

@@ -6,7 +6,9 @@ sss_blur h, v -> composite (with light_setup, a shadow-casting sun and IBL) at 4
 scene of our own: a skin sphere (SSS) carrying a blood decal, a steel box, a drape behind, a
 sun and two point lights. ``ao`` is imported with a different pattern per layer (a gradient
 along x for the left eye, along y for the right; ``forward.ao_combine`` 2 multiplies it in), so
-an eye reading the other eye's layer shows.
+an eye reading the other eye's layer shows. Every test runs on that graph and on
+stereo_forward_post_clustered.yaml (forward_pbr over the froxel lights lists of cluster_build and
+light_assign, as graphs/surgery_clustered.yaml wires it).
 
 The oracle (as tests/passes/test_pass_vr_draw.py::test_stereo_layers_equal_mono_images_from_each_eye):
 with ``views=2`` layer k of every per-eye output (hdr, diffuse, specular, normal_sss, sss_tmp,
@@ -29,7 +31,8 @@ import numpy as np
 import pytest
 from locations import TESTS
 
-GRAPH = TESTS / "pass_graphs" / "stereo_forward_post.yaml"
+GRAPHS = {"uniform": TESTS / "pass_graphs" / "stereo_forward_post.yaml",
+          "clustered": TESTS / "pass_graphs" / "stereo_forward_post_clustered.yaml"}
 SIZE = (48, 32)
 IPD = 0.064
 CAMERA = (np.array([0.0, 0.05, 0.3]), np.array([0.0, 0.0, 0.0]))  # position, look_at
@@ -73,29 +76,31 @@ def _ao() -> np.ndarray:
     return np.stack([0.4 + 0.6 * xs / w, 0.4 + 0.6 * ys / h])[..., None].astype(np.float32)
 
 
-def _run(scene_path, views: int, ao: np.ndarray) -> dict:
+def _run(graph, scene_path, views: int, ao: np.ndarray) -> dict:
     from rgraph.compiler.pipeline import compile_graph
     from rgraph.vk.executor import execute_plan
 
-    plan = compile_graph(GRAPH, scene_path=scene_path, size=SIZE, params={"views": str(views), "views.ipd": str(IPD)})
+    plan = compile_graph(graph, scene_path=scene_path, size=SIZE, params={"views": str(views), "views.ipd": str(IPD)})
     result = execute_plan(plan, validate=True, frames=1, inputs={"ao": ao}, read_outputs=True)
     assert [m.text for m in result.messages] == []
     return result.outputs
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """(stereo outputs, [mono outputs of eye 0, eye 1], eye offsets, scene data of the centre camera)."""
+@pytest.fixture(scope="module", params=sorted(GRAPHS))
+def runs(request, tmp_path_factory):
+    """(stereo outputs, [mono outputs of eye 0, eye 1], eye offsets, scene data of the centre camera)
+    of the graph with forward_pbr's uniform light loop, or its clustered froxel lists."""
+    graph = GRAPHS[request.param]
     from rgraph.scene.build import load_scene_data
     from rgraph.scene.instances import eye_offsets
 
     tmp_path = tmp_path_factory.mktemp("stereo_forward_post")
     centre = _scene(tmp_path, "centre")
     ao = _ao()
-    stereo = _run(centre, 2, ao)
+    stereo = _run(graph, centre, 2, ao)
     scene = load_scene_data(centre, SIZE)
     offsets = eye_offsets(scene, 0, 2, IPD)
-    mono = [_run(_scene(tmp_path, f"eye{k}", offsets[k]), 1, ao[k]) for k in range(2)]
+    mono = [_run(graph, _scene(tmp_path, f"eye{k}", offsets[k]), 1, ao[k]) for k in range(2)]
     return stereo, mono, offsets, scene
 
 
@@ -142,3 +147,8 @@ def test_every_pass_has_work_in_both_eyes(runs):
         assert inside.sum() >= 4, f"eye {eye}: the decal covers {int(inside.sum())} pixels"
         sss = np.asarray(stereo["normal_sss"][eye][..., 3]) > 0.5
         assert sss.sum() >= 20, f"eye {eye}: {int(sss.sum())} SSS pixels"
+    if "cluster_stats" in stereo:  # clustered: real lists (no froxel fell back to every light)
+        from rgraph.passes.cluster_report import stats_of
+
+        stats = stats_of(stereo["cluster_stats"])
+        assert stats["overflowed_froxels"] == 0 and stats["references"] > 0, stats

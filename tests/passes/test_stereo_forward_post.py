@@ -60,12 +60,12 @@ TOLERANCE = {"depth": (1e-5, 0.0), "normal_sss": (0.0, 1.0 / 255 + 1e-6)}  # (rt
 DEFAULT_TOLERANCE = (2e-3, 2e-3)
 
 
-def _scene(tmp_path, name: str, offset=np.zeros(3)):
+def _scene(tmp_path, name: str, offset=(0.0, 0.0, 0.0)):
     def text(v):
         return ", ".join(repr(float(x)) for x in v)
 
     p = tmp_path / f"{name}.yaml"
-    p.write_text(SCENE.format(name=name, position=text(CAMERA[0] + offset), look_at=text(CAMERA[1] + offset)))
+    p.write_text(SCENE.format(name=name, position=text(CAMERA[0] + np.asarray(offset)), look_at=text(CAMERA[1] + np.asarray(offset))))
     return p
 
 

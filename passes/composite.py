@@ -1,4 +1,11 @@
-"""``composite``: hdr = diffuse + specular (full-screen raster). Reference: ``composite_ref``."""
+"""``composite``: hdr = diffuse + specular (full-screen raster). Reference: ``composite_ref``.
+
+Stereo (graph param ``views`` = 2, issue 18): ``diffuse``, ``specular`` and ``hdr`` have a layer
+per eye; like passes/tonemap.py one layered framebuffer (not VK_KHR_multiview, which lavapipe
+crashes on with colour attachments only), one full-screen instance per layer
+(``FULLSCREEN_LAYERS``, ``gl_Layer``), the inputs as 2D-array views read at the fragment's layer.
+With ``views`` = 1 nothing changes.
+"""
 
 from __future__ import annotations
 
@@ -14,10 +21,15 @@ class Composite(PassImpl):
 
     def __init__(self, setup):
         super().__init__(setup)
-        self.sets = setup.descriptors([Binding(0, "sampled", "diffuse", sampler="nearest"),
-                                       Binding(1, "sampled", "specular", sampler="nearest")])
-        self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "post/composite.frag", [self.sets.layout])
+        views = int(setup.param("views", 1))
+        stereo = views > 1
+        self.layers = views if stereo else 1
+        self.sets = setup.descriptors([Binding(0, "sampled", "diffuse", sampler="nearest", array=stereo),
+                                       Binding(1, "sampled", "specular", sampler="nearest", array=stereo)])
+        defines = {"FULLSCREEN_LAYERS": self.layers} if stereo else None
+        self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "post/composite.frag", [self.sets.layout],
+                                                defines=defines)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
-        rec.draw(3)
+        rec.draw(3, self.layers)

@@ -15,6 +15,13 @@ Clustered: when the pass reads ``light_grid`` and ``light_indices`` (graphs/surg
 Optional reads: without ``ao`` (HBAO culled) the screen-space AO is 1.0, without
 ``shadow_maps`` (no shadow lights) lights are unshadowed, both by compile-time defines.
 
+Stereo (graph param ``views`` = 2, issue 18): one VK_KHR_multiview render pass draws both eyes
+(``multiview``; ``diffuse``, ``specular``, ``normal_sss`` and ``depth`` have a layer per eye);
+the shaders take the eye's camera from the scene's Views uniform (``scene_eye(gl_ViewIndex)``:
+the view vector, and the froxel depth when clustered) and sample ``ao`` (a 2D-array view, a
+layer per eye) at layer ``gl_ViewIndex``. With ``views`` = 1 nothing changes (same defines, same
+SPIR-V).
+
 Params: ``forward.ibl_intensity`` (scale of the environment, default 0.5),
 ``forward.ao_combine`` (0 min (default), 1 max, 2 multiply), ``shadow.pcf_taps`` (PCF taps,
 default 16), ``depth_prepass.cull`` (shared with the prepass so both rasterize the same
@@ -68,6 +75,7 @@ class ForwardPBR(PassImpl):
 
     clear_values = {"diffuse": (0.0, 0.0, 0.0, 0.0), "specular": (0.0, 0.0, 0.0, 0.0),
                     "normal_sss": (0.5, 0.5, 0.5, 0.0)}
+    multiview = True  # views=2: both eyes in one pass (gl_ViewIndex, RGRAPH_VIEWS)
 
     def __init__(self, setup: PassSetup) -> None:
         super().__init__(setup)
@@ -75,6 +83,7 @@ class ForwardPBR(PassImpl):
         loc = color_locations(setup, COLOR_OUTPUTS)
         _handle, light_bytes = setup.buffer("lights", 0)
         self.has_ao = setup.has("ao")
+        stereo = int(setup.param("views", 1)) > 1
         self.has_shadows = setup.has("shadow_maps") and scene.shadow_lights > 0
         env_mips = int(setup.resource_plan("env_map")["mips"])
         self.clustered = setup.has("light_grid")
@@ -84,7 +93,7 @@ class ForwardPBR(PassImpl):
             bindings += [Binding(5, "storage_image", "light_grid", array=True),
                          Binding(6, "storage_buffer", "light_indices")]
         if self.has_ao:
-            bindings.append(Binding(3, "sampled", "ao"))
+            bindings.append(Binding(3, "sampled", "ao", array=stereo))  # views=2: a layer per eye
         if self.has_shadows:
             bindings.append(Binding(4, "sampled", "shadow_maps", array=True, sampler="nearest"))
         self.sets = setup.descriptors(bindings)

@@ -14,6 +14,13 @@ copies ``sss_tmp`` to ``diffuse``, so graph and synchronization stay identical. 
 ``sss.follow_depth`` (world depth difference that fully rejects a tap). The SSS strength is
 ``normal_sss.a``; the camera projection comes from ``passes.screenspace_ref.screen_camera``.
 What it computes, exactly: ``passes/sss_ref.py``.
+
+Stereo (graph param ``views`` = 2, issue 18): every image has a layer per eye. A full-screen
+pass, so not VK_KHR_multiview (lavapipe crashes executing a multiview render pass with colour
+attachments only; passes/tonemap.py): one layered framebuffer, one full-screen instance per
+layer (``FULLSCREEN_LAYERS``, ``gl_Layer``), the inputs bound as 2D-array views and read at the
+fragment's layer. Both eyes share the projection, so the kernel is the same. With ``views`` = 1
+nothing changes.
 """
 
 from __future__ import annotations
@@ -74,14 +81,19 @@ class SSSBlur(PassImpl):
             data = np.concatenate([taps.reshape(-1), params]).tobytes()
         self.uniform = setup.host_buffer(len(data))
         self.uniform.write(data)
+        views = int(setup.param("views", 1))
+        stereo = views > 1
+        self.layers = views if stereo else 1
+        if stereo:
+            defines["FULLSCREEN_LAYERS"] = self.layers
         self.sets = setup.descriptors([
-            Binding(0, "sampled", source, sampler="linear"),
-            Binding(1, "sampled", "depth", sampler="nearest"),
-            Binding(2, "sampled", "normal_sss", sampler="nearest"),
+            Binding(0, "sampled", source, sampler="linear", array=stereo),
+            Binding(1, "sampled", "depth", sampler="nearest", array=stereo),
+            Binding(2, "sampled", "normal_sss", sampler="nearest", array=stereo),
             Binding(3, "uniform_buffer", buffers=((self.uniform.handle, len(data)),))])
         self.pipeline = setup.graphics_pipeline(
             "lib/fullscreen.vert", "sss/blur.frag", [self.sets.layout], defines=defines)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
-        rec.draw(3)
+        rec.draw(3, self.layers)

@@ -8,20 +8,35 @@
 layout(location = 0) in vec2 uv;
 layout(location = LOC_DIFFUSE) out vec4 out_diffuse;
 layout(location = LOC_SPECULAR) out vec4 out_specular;
+#if defined(FULLSCREEN_LAYERS) && FULLSCREEN_LAYERS > 1
+// views=2 (passes/decals.py): a layer per eye, this fragment's eye from lib/fullscreen.vert
+layout(location = 1) flat in int in_layer;
+layout(set = 1, binding = 0) uniform sampler2DArray depth_tex;   // nearest
+layout(set = 1, binding = 1) uniform sampler2DArray normal_sss;  // nearest; rgb = 0.5 n + 0.5 (world)
+#define TEXEL(t, p) texelFetch(t, ivec3(p, in_layer), 0)
+#define EYE scene_eye(uint(in_layer))
+#else
 layout(set = 1, binding = 0) uniform sampler2D depth_tex;   // nearest
 layout(set = 1, binding = 1) uniform sampler2D normal_sss;  // nearest; rgb = 0.5 n + 0.5 (world)
+#define TEXEL(t, p) texelFetch(t, p, 0)
+#endif
 
 const float PI = 3.14159265358979;
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    float d = texelFetch(depth_tex, p, 0).r;
+    float d = TEXEL(depth_tex, p).r;
     out_diffuse = vec4(0.0);
     out_specular = vec4(0.0);
     if (d <= 0.0) return;  // sky: nothing to project onto
     vec2 suv = (vec2(p) + 0.5) * frame.viewport.zw;
+#if defined(FULLSCREEN_LAYERS) && FULLSCREEN_LAYERS > 1
+    // the eye's inverse view-projection is the centre's followed by a move by the eye's offset
+    vec3 world = scene_world_from_depth(suv, d) + EYE;
+#else
     vec3 world = scene_world_from_depth(suv, d);
-    vec3 n = texelFetch(normal_sss, p, 0).rgb * 2.0 - 1.0;
+#endif
+    vec3 n = TEXEL(normal_sss, p).rgb * 2.0 - 1.0;
     float len = length(n);
     n = len > 1e-3 ? n / len : vec3(0.0);
     vec3 light = frame.ambient.rgb + frame.sun_radiance.rgb * max(dot(n, frame.sun_direction.xyz), 0.0) / PI;

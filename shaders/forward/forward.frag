@@ -1,5 +1,13 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#if defined(RGRAPH_VIEWS) && RGRAPH_VIEWS > 1
+// views=2 (passes/forward.py, multiview): this eye's camera position and its layer of `ao`.
+#extension GL_EXT_multiview : require
+#define FORWARD_STEREO 1
+#define EYE scene_eye(uint(gl_ViewIndex))
+#else
+#define FORWARD_STEREO 0
+#endif
 // Forward PBR: GGX direct lighting (directional with PCF shadows, point, spot), split-sum IBL, AO.
 // Set 0: the scene (scene.glsl); set 1: this pass. Defines (passes/forward.py):
 // LOC_DIFFUSE/LOC_SPECULAR/LOC_NORMAL_SSS, LIGHT_COUNT, ENV_MIPS, HAS_AO, HAS_SHADOWS,
@@ -32,7 +40,11 @@ layout(set = 1, binding = 0, std140) uniform LightsBlock { Light lights[LIGHT_CO
 layout(set = 1, binding = 1) uniform sampler2D brdf_lut;
 layout(set = 1, binding = 2) uniform sampler2D env_map;
 #if HAS_AO
+#if FORWARD_STEREO
+layout(set = 1, binding = 3) uniform sampler2DArray ao_map;  // a layer per eye
+#else
 layout(set = 1, binding = 3) uniform sampler2D ao_map;
+#endif
 #endif
 #if HAS_SHADOWS
 layout(set = 1, binding = 4) uniform sampler2DArray shadow_maps;
@@ -69,7 +81,11 @@ void add_light(int i, Surface s, inout vec3 diffuse, inout vec3 specular) {
 }
 
 void main() {
+#if FORWARD_STEREO
+    vec3 to_view = EYE - in_world;  // this eye's position (camera-relative)
+#else
     vec3 to_view = -in_world;  // the camera is at the origin
+#endif
     // Geometric normal from screen derivatives (the fallback for a zero shading normal), facing the viewer.
     vec3 geo = cross(dFdx(in_world), dFdy(in_world));
     geo = dot(geo, to_view) < 0.0 ? -geo : geo;
@@ -84,7 +100,11 @@ void main() {
 #if ALL_LIGHTS
     for (int i = 0; i < count; ++i) add_light(i, s, diffuse, specular);
 #else
+#if FORWARD_STEREO
+    float view_distance = -dot(vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]), in_world - EYE);
+#else
     float view_distance = -dot(vec3(frame.view[0][2], frame.view[1][2], frame.view[2][2]), in_world);
+#endif
     uvec4 cell = imageLoad(light_grid, cluster_of(gl_FragCoord.xy, view_distance));
     if (cell.y == CLUSTER_OVERFLOW) {
         for (int i = 0; i < count; ++i) add_light(i, s, diffuse, specular);
@@ -107,7 +127,11 @@ void main() {
 #endif
 
 #if HAS_AO
+#if FORWARD_STEREO
+    float screen_ao = texture(ao_map, vec3(gl_FragCoord.xy * frame.viewport.zw, float(gl_ViewIndex))).r;
+#else
     float screen_ao = texture(ao_map, gl_FragCoord.xy * frame.viewport.zw).r;
+#endif
 #else
     float screen_ao = 1.0;
 #endif

@@ -22,9 +22,23 @@
 
 layout(location = 0) in vec2 uv;
 layout(location = 0) out vec4 result;
+#if defined(FULLSCREEN_LAYERS) && FULLSCREEN_LAYERS > 1
+// views=2 (passes/sss.py): a layer per eye, this fragment's eye from lib/fullscreen.vert
+layout(location = 1) flat in int in_layer;
+layout(set = 0, binding = 0) uniform sampler2DArray color_tex;   // linear, clamp to edge
+layout(set = 0, binding = 1) uniform sampler2DArray depth_tex;   // nearest
+layout(set = 0, binding = 2) uniform sampler2DArray normal_sss;  // nearest; .a = SSS strength
+#define TEXEL(t, p) texelFetch(t, ivec3(p, in_layer), 0)
+#define COLOR_AT(uv) texture(color_tex, vec3(uv, float(in_layer)))
+#define COLOR_SIZE() textureSize(color_tex, 0).xy
+#else
 layout(set = 0, binding = 0) uniform sampler2D color_tex;   // linear, clamp to edge
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;   // nearest
 layout(set = 0, binding = 2) uniform sampler2D normal_sss;  // nearest; .a = SSS strength
+#define TEXEL(t, p) texelFetch(t, p, 0)
+#define COLOR_AT(uv) texture(color_tex, uv)
+#define COLOR_SIZE() textureSize(color_tex, 0)
+#endif
 #if KERNEL_2D
 layout(set = 0, binding = 3) uniform Kernel {
     vec4 taps[2 * TAPS];  // [2i] rgb weight, [2i + 1] xy offset in [-R, R]^2; tap 0 is the centre
@@ -40,9 +54,9 @@ layout(set = 0, binding = 3) uniform Kernel {
 
 // The tap's colour lerped toward the centre's by the depth difference (follow-surface).
 vec3 follow(vec2 pos, ivec2 size, float z, vec3 centre) {
-    vec3 tap = texture(color_tex, pos / vec2(size)).rgb;
+    vec3 tap = COLOR_AT(pos / vec2(size)).rgb;
     ivec2 t = clamp(ivec2(floor(pos)), ivec2(0), size - 1);
-    float dt = texelFetch(depth_tex, t, 0).r;
+    float dt = TEXEL(depth_tex, t).r;
     float s = dt > 0.0 ? clamp(abs(z - kern.params.w / dt) / kern.params.y, 0.0, 1.0) : 1.0;
     return mix(tap, centre, s);
 }
@@ -50,12 +64,12 @@ vec3 follow(vec2 pos, ivec2 size, float z, vec3 centre) {
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
 #if COPY
-    result = texelFetch(color_tex, p, 0);
+    result = TEXEL(color_tex, p);
 #else
-    ivec2 size = textureSize(color_tex, 0);
-    vec4 centre = texelFetch(color_tex, p, 0);
-    float d = texelFetch(depth_tex, p, 0).r;
-    float a = texelFetch(normal_sss, p, 0).a;
+    ivec2 size = COLOR_SIZE();
+    vec4 centre = TEXEL(color_tex, p);
+    float d = TEXEL(depth_tex, p).r;
+    float a = TEXEL(normal_sss, p).a;
     float width = kern.params.x;
     if (a <= 0.0 || d <= 0.0 || width <= 0.0) { result = centre; return; }  // exact identity
     float z = kern.params.w / d;

@@ -5,7 +5,8 @@ and age, velocity) in place: ``particles.substeps`` steps (4) of ``particles.dt`
 through a vortex field with gravity and drag; a particle respawns at a hashed position when
 its age (``particles.lifetime``, 2 s) runs out or its state is not a live finite one, so
 any initial contents work. ``particles_draw`` adds one point per particle to its blended
-colour attachment (orthographic x-y), reading the buffer in the vertex shader.
+colour attachment (orthographic x-y), reading the buffer in the vertex shader; with the graph
+param ``views`` > 1 one instance per layer of the layered attachment (the same points in each).
 """
 
 from __future__ import annotations
@@ -54,9 +55,11 @@ class ParticlesDraw(PassImpl):
         super().__init__(setup)
         name, self.count = _buffer(setup, "storage_read")
         self.sets = setup.descriptors([Binding(0, "storage_buffer", name)])
+        self.layers = max(1, int(setup.param("views", 1)))
         self.pipeline = setup.graphics_pipeline("particles/draw.vert", "particles/draw.frag", [self.sets.layout],
-                                                topology="POINT_LIST", blend=["add"])
+                                                topology="POINT_LIST", blend=["add"],
+                                                defines={"PARTICLE_LAYERS": self.layers} if self.layers > 1 else None)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
-        rec.draw(self.count)
+        rec.draw(self.count, self.layers)

@@ -24,6 +24,7 @@ from rgraph.vk.passkit import Binding, pack
 
 from .bloom_ref import MAX_RADIUS, gaussian_weights, working_blur
 from .post_common_ref import HALF_MAX
+from .stereo import checked_views, stereo_defines
 
 
 def _one(setup, usage: str) -> str:
@@ -41,23 +42,6 @@ def _factor(big: tuple[int, int], small: tuple[int, int]) -> tuple[int, int]:
 def _groups(extent: tuple[int, int]) -> tuple[int, int]:
     return -(-extent[0] // 8), -(-extent[1] // 8)
 
-
-def _views(setup, resources: tuple[str, ...]) -> int:
-    """The param ``views`` (1 or 2), checking that each of ``resources`` has a layer per view."""
-    views = int(setup.param("views", 1))
-    if not 1 <= views <= 2:
-        raise ExecutionError(f"pass {setup.name!r}: views must be 1 or 2, got {views}")
-    for name in resources:
-        layers = int(setup.resource_plan(name).get("layers", 1))
-        if layers != views:
-            raise ExecutionError(f"pass {setup.name!r}: views={views} needs {name} with a layer per view "
-                                 f"(layers: \"${{params.views}}\"), it has {layers}")
-    return views
-
-
-def _stereo(views: int) -> dict[str, int]:
-    """Shader defines for ``views`` (none at views=1: the mono SPIR-V is unchanged)."""
-    return {"RGRAPH_VIEWS": views} if views > 1 else {}
 
 
 @register("bloom_bright")
@@ -80,12 +64,12 @@ class BloomBright(PassImpl):
             raise ExecutionError(f"pass {setup.name!r}: bloom.threshold and bloom.knee must be >= 0 and "
                                  f"bloom.clamp > 0 (got {threshold}, {knee}, {clamp})")
         self.push = pack("2i3f", fx, fy, threshold, knee, clamp)
-        self.views = _views(setup, (src, dst))
+        self.views = checked_views(setup, (src, dst))
         arr = self.views > 1
         self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest", array=arr),
                                        Binding(1, "storage_image", dst, array=arr)])
         self.pipeline = setup.compute_pipeline("post/bloom_bright.comp", [self.sets.layout],
-                                               push_constant_bytes=len(self.push), defines=_stereo(self.views))
+                                               push_constant_bytes=len(self.push), defines=stereo_defines(self.views))
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
@@ -120,12 +104,12 @@ class BloomBlur(PassImpl):
             raise ExecutionError(f"pass {setup.name!r}: {exc} (at reduction factor {factor})") from None
         padded = list(weights) + [0.0] * (MAX_RADIUS + 1 - len(weights))
         self.push = pack("3i29f", *((1, 0) if direction == "h" else (0, 1)), radius, *padded)
-        self.views = _views(setup, (src, dst))
+        self.views = checked_views(setup, (src, dst))
         arr = self.views > 1
         self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="nearest", array=arr),
                                        Binding(1, "storage_image", dst, array=arr)])
         self.pipeline = setup.compute_pipeline("post/bloom_blur.comp", [self.sets.layout],
-                                               push_constant_bytes=len(self.push), defines=_stereo(self.views))
+                                               push_constant_bytes=len(self.push), defines=stereo_defines(self.views))
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.sets[frame_set]])
@@ -145,11 +129,11 @@ class BloomCombine(PassImpl):
         bw, bh = setup.extent_of(src)
         fx, fy = _factor(setup.extent, (bw, bh))
         self.push = pack("3f", 1.0 / (fx * bw), 1.0 / (fy * bh), float(setup.param("bloom.intensity", 0.05)))
-        self.views = _views(setup, (src, dst))
+        self.views = checked_views(setup, (src, dst))
         stereo = self.views > 1
         self.sets = setup.descriptors([Binding(0, "sampled", src, sampler="linear", array=stereo)])
         # views=2: one full-screen instance per layer of the layered hdr framebuffer (gl_Layer)
-        defines = {"FULLSCREEN_LAYERS": self.views, **_stereo(self.views)} if stereo else None
+        defines = {"FULLSCREEN_LAYERS": self.views, **stereo_defines(self.views)} if stereo else None
         self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "post/bloom_combine.frag", [self.sets.layout],
                                                 push_constant_bytes=len(self.push), blend=["add"], defines=defines)
 

@@ -31,6 +31,7 @@ from rgraph.vk.passkit import Binding, pack
 
 from .hbao_ref import HBAOSettings, quarter_extent
 from .screenspace_ref import screen_camera
+from .stereo import checked_views, stereo_defines
 
 HBAO_PARAMS = {
     "hbao.directions": Param(int, 1, 64), "hbao.steps": Param(int, 1, 64),
@@ -60,23 +61,6 @@ def _settings(setup) -> HBAOSettings:
     return s
 
 
-def _views(setup, resources: tuple[str, ...]) -> int:
-    """The param ``views`` (1 or 2), checking that each of ``resources`` has a layer per view."""
-    views = int(setup.param("views", 1))
-    if not 1 <= views <= 2:
-        raise ValueError(f"pass {setup.name!r}: views must be 1 or 2, got {views}")
-    for name in resources:
-        layers = int(setup.resource_plan(name).get("layers", 1))
-        if layers != views:
-            raise ValueError(f"pass {setup.name!r}: views={views} needs {name} with a layer per view "
-                             f"(layers: \"${{params.views}}\"), it has {layers}")
-    return views
-
-
-def _stereo(views: int) -> dict[str, int]:
-    """Shader defines for ``views`` (none at views=1: the mono SPIR-V is unchanged)."""
-    return {"RGRAPH_VIEWS": views} if views > 1 else {}
-
 
 def _proj(setup) -> bytes:
     cam = screen_camera(setup.plan, setup.params, setup.size)
@@ -91,12 +75,12 @@ class HBAODownsample(PassImpl):
     def __init__(self, setup):
         super().__init__(setup)
         self.push = pack("i", _settings(setup).factor)
-        views = _views(setup, ("depth", "depth_quarter"))
+        views = checked_views(setup, ("depth", "depth_quarter"))
         arr = views > 1
         self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest", array=arr),
                                        Binding(1, "storage_image", "depth_quarter", array=arr)])
         self.pipeline = setup.compute_pipeline("hbao/downsample.comp", [self.sets.layout],
-                                               push_constant_bytes=len(self.push), defines=_stereo(views))
+                                               push_constant_bytes=len(self.push), defines=stereo_defines(views))
         self.groups = (*_groups(setup.extent_of("depth_quarter")), views)
 
     def record(self, rec, frame_set):
@@ -115,13 +99,13 @@ class HBAO(PassImpl):
         s = _settings(setup)
         if s.directions < 1 or s.steps < 1:
             raise ValueError(f"pass {setup.name!r}: hbao.directions and hbao.steps must be >= 1")
-        views = _views(setup, ("depth_quarter", "ao_quarter"))
+        views = checked_views(setup, ("depth_quarter", "ao_quarter"))
         arr = views > 1
         self.sets = setup.descriptors([Binding(0, "sampled", "depth_quarter", sampler="nearest", array=arr),
                                        Binding(1, "storage_image", "ao_quarter", array=arr)])
         self.pipeline = setup.compute_pipeline("hbao/hbao.comp", [self.sets.layout], push_constant_bytes=32,
                                                defines={"DIRECTIONS": s.directions, "STEPS": s.steps,
-                                                        **_stereo(views)})
+                                                        **stereo_defines(views)})
         self.push = _proj(setup) + pack("4f", s.radius, s.angle_bias, s.strength, s.max_radius_px * s.scale)
         self.groups = (*_groups(setup.extent_of("ao_quarter")), views)
 
@@ -139,14 +123,14 @@ class HBAOUpsample(PassImpl):
     def __init__(self, setup):
         super().__init__(setup)
         s = _settings(setup)
-        views = _views(setup, ("ao_quarter", "depth", "depth_quarter", "ao"))
+        views = checked_views(setup, ("ao_quarter", "depth", "depth_quarter", "ao"))
         arr = views > 1
         self.sets = setup.descriptors([Binding(0, "sampled", "ao_quarter", sampler="nearest", array=arr),
                                        Binding(1, "sampled", "depth", sampler="nearest", array=arr),
                                        Binding(2, "storage_image", "depth_quarter", array=arr),
                                        Binding(3, "storage_image", "ao", array=arr)])
         self.pipeline = setup.compute_pipeline("hbao/upsample.comp", [self.sets.layout], push_constant_bytes=32,
-                                               defines=_stereo(views))
+                                               defines=stereo_defines(views))
         self.push = _proj(setup) + pack("4f", s.upsample_sharpness, 0.0, 0.0, 0.0)
         self.groups = (*_groups(setup.extent_of("ao")), views)
 

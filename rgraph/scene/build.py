@@ -13,7 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from rgraph.scene.animation import Animator
-from rgraph.scene.camera import CameraState, camera_state, model_matrix, normal_matrix, shadow_view_proj, unit_or
+from rgraph.scene.camera import (
+    CameraState,
+    camera_state,
+    model_matrix,
+    normal_matrix,
+    shadow_view_proj,
+    unit_or,
+)
 from rgraph.scene.character import build_rig
 from rgraph.scene.deform import FRAME_SECONDS, Deformer
 from rgraph.scene.generate import expand_lights

@@ -170,8 +170,8 @@ def test_barriers_are_reused_across_compiles(tmp_path: Path) -> None:
         same(again, python)
         for kind in ("barriers", "releases"):
             old, new = getattr(first, kind), getattr(again, kind)
-            assert all(a is b for olds, news in zip(old, new) for a, b in zip(olds, news)), kind
-        assert all(a is b for a, b in zip(first.barriers, again.barriers))  # each pass's tuple too
+            assert all(a is b for olds, news in zip(old, new, strict=True) for a, b in zip(olds, news, strict=True)), kind
+        assert all(a is b for a, b in zip(first.barriers, again.barriers, strict=True))  # each pass's tuple too
     assert any(first.releases)
 
 

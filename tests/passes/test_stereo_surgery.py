@@ -19,6 +19,7 @@ from rgraph.resources import builtin_passes
 
 builtin_passes()
 from rgraph.passes.tonemap_ref import srgb_codes  # noqa: E402
+
 from rgraph.scene.build import load_scene_data  # noqa: E402
 from rgraph.scene.instances import eye_offsets  # noqa: E402
 

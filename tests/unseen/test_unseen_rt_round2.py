@@ -16,28 +16,17 @@ Each test pins a bug these inputs found:
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 from locations import ROOT, TESTS
 from rt_helpers import run_rt
+from test_unseen_inputs import _diagnostics, _s  # the first round's fixture helpers
 
 from rgraph.cli import main
 
 FIXTURES = TESTS / "fixtures" / "unseen"
 GRAPHS = ROOT / "graphs"
 vulkan = pytest.mark.vulkan
-
-
-def _s(name: str) -> str:
-    return str(FIXTURES / "scenes" / f"{name}.yaml")
-
-
-def _diagnostics(capsys, argv: list[str]) -> tuple[int, list[dict]]:
-    capsys.readouterr()
-    rc = main([*argv, "--json"])
-    return rc, json.loads(capsys.readouterr().out)["diagnostics"]
 
 
 # ------------------------------------------------------------------ device-free

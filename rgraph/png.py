@@ -83,7 +83,8 @@ def first_output_image(plan: dict) -> dict | None:
 
 
 def write_output_png(plan: dict, data: dict[tuple, bytes], path: Path) -> None:
-    """Write the plan's first output image from read-back bytes (``read_back``) as a PNG."""
+    """Write the plan's first output image from read-back bytes (``read_back``) as a PNG: mip 0,
+    its layers side by side, left to right (``views=2``: the left eye, then the right)."""
     from rgraph.probe.semantics import mip_extent
 
     res = first_output_image(plan)
@@ -91,4 +92,6 @@ def write_output_png(plan: dict, data: dict[tuple, bytes], path: Path) -> None:
         raise ValueError("the plan has no output image")
     w, h = mip_extent(res, 0)
     implemented = any(p.get("impl") for p in plan["passes"])
-    write_png(Path(path), output_rgba(res, data[(res["name"], 0, 0)], w, h, implemented))
+    layers = [k for k in range(int(res.get("layers", 1))) if (res["name"], 0, k) in data]
+    tiles = [output_rgba(res, data[(res["name"], 0, k)], w, h, implemented) for k in layers or [0]]
+    write_png(Path(path), tiles[0] if len(tiles) == 1 else np.concatenate(tiles, axis=1))

@@ -65,11 +65,15 @@ void push_children(Ray r, vec3 p, vec3 ngf, vec3 nsf, bool entering, uint m, flo
     vec3 reflect_w = r.w * k.x;
     if (k.y > 0.0) {
         float eta = entering ? 1.0 / k.z : k.z;
-        float cos_i = -dot(r.d, nsf);
-        float kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        // sin^2 of the incidence angle and the tangential part of r.d from cross products, not
+        // 1 - cos^2 and r.d + cos * n: those cancel near normal incidence, where a large eta
+        // (glass of index 1000 seen from inside) needs sin^2 to float32 precision to tell
+        // total internal reflection from refraction
+        vec3 side = cross(r.d, nsf);
+        float kk = 1.0 - eta * eta * dot(side, side);
         if (kk < 0.0) reflect_w += r.w * k.y;  // total internal reflection
         else {
-            vec3 t = eta * r.d + (eta * cos_i - sqrt(kk)) * nsf;
+            vec3 t = eta * cross(nsf, side) - sqrt(kk) * nsf;
             stack[top++] = Ray(offset_ray(p, -ngf), safe_normalize(t, r.d), r.w * k.y * mat[2u * m].rgb, r.depth + 1u, path);
         }
     }

@@ -12,6 +12,8 @@ from __future__ import annotations
 from rgraph.impl import PassImpl, register
 from rgraph.vk.passkit import Binding
 
+from .stereo import view_layers
+
 
 @register("composite")
 class Composite(PassImpl):
@@ -21,9 +23,8 @@ class Composite(PassImpl):
 
     def __init__(self, setup):
         super().__init__(setup)
-        views = int(setup.param("views", 1))
-        stereo = views > 1
-        self.layers = views if stereo else 1
+        self.layers = view_layers(setup)
+        stereo = self.layers > 1
         self.sets = setup.descriptors([Binding(0, "sampled", "diffuse", sampler="nearest", array=stereo),
                                        Binding(1, "sampled", "specular", sampler="nearest", array=stereo)])
         defines = {"FULLSCREEN_LAYERS": self.layers} if stereo else None

@@ -20,6 +20,8 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding
 
+from .stereo import view_layers
+
 
 def _locations(setup) -> dict[str, int]:
     colors = [a["resource"] for a in setup.plan_pass["accesses"] if a["usage"].startswith("color_attachment")]
@@ -36,9 +38,8 @@ class Decals(PassImpl):
         super().__init__(setup)
         self.scene = setup.scene
         loc = _locations(setup)
-        views = int(setup.param("views", 1))
-        stereo = views > 1
-        self.layers = views if stereo else 1
+        self.layers = view_layers(setup)
+        stereo = self.layers > 1
         self.sets = setup.descriptors([Binding(0, "sampled", "depth", sampler="nearest", array=stereo),
                                        Binding(1, "sampled", "normal_sss", sampler="nearest", array=stereo)])
         blend = ["premultiplied", "premultiplied"]

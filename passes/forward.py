@@ -34,6 +34,8 @@ from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, PassSetup
 
+from .stereo import view_layers
+
 COLOR_OUTPUTS = ("diffuse", "specular", "normal_sss")
 LIGHT_BYTES = 64
 
@@ -83,7 +85,7 @@ class ForwardPBR(PassImpl):
         loc = color_locations(setup, COLOR_OUTPUTS)
         _handle, light_bytes = setup.buffer("lights", 0)
         self.has_ao = setup.has("ao")
-        stereo = int(setup.param("views", 1)) > 1
+        stereo = view_layers(setup) > 1
         self.has_shadows = setup.has("shadow_maps") and scene.shadow_lights > 0
         env_mips = int(setup.resource_plan("env_map")["mips"])
         self.clustered = setup.has("light_grid")

@@ -75,13 +75,15 @@ class _DrawArgsPass(PassImpl):
         self.pipeline = setup.compute_pipeline("scene/cull.comp", [self.scene.set_layout, self.sets.layout],
                                                defines={"RESET": self.reset, "ORDERED": int(order != "none")},
                                                push_constant_bytes=8)
+        self.push = pack("2I", self.scene.draw_count, self.capacity)
+        self.groups = (1, 1) if self.reset else dispatch.groups_2d(self.scene.draw_count, GROUP)
 
     def record(self, rec, frame_set: int) -> None:
         if not self.active:
             return
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
-        rec.push(self.pipeline, pack("2I", self.scene.draw_count, self.capacity))
-        rec.dispatch(*((1, 1) if self.reset else dispatch.groups_2d(self.scene.draw_count, GROUP)), 1)
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*self.groups, 1)
 
 
 @register("draw_reset")

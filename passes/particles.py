@@ -15,6 +15,8 @@ from rgraph.impl import PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
+from .stereo import view_layers
+
 PARTICLE_BYTES = 32
 
 
@@ -55,7 +57,7 @@ class ParticlesDraw(PassImpl):
         super().__init__(setup)
         name, self.count = _buffer(setup, "storage_read")
         self.sets = setup.descriptors([Binding(0, "storage_buffer", name)])
-        self.layers = max(1, int(setup.param("views", 1)))
+        self.layers = view_layers(setup)
         self.pipeline = setup.graphics_pipeline("particles/draw.vert", "particles/draw.frag", [self.sets.layout],
                                                 topology="POINT_LIST", blend=["add"],
                                                 defines={"PARTICLE_LAYERS": self.layers} if self.layers > 1 else None)

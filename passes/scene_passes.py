@@ -98,8 +98,10 @@ class LightSetup(PassImpl):
         self.sets = setup.descriptors([Binding(0, "storage_buffer", "lights")])
         self.pipeline = setup.compute_pipeline("scene/light_setup.comp", [self.scene.set_layout, self.sets.layout],
                                                push_constant_bytes=16)
+        self.push = pack("4i", self.count, 0, 0, 0)
+        self.groups = dispatch.groups_2d(self.count, 64)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set), self.sets[frame_set]])
-        rec.push(self.pipeline, pack("4i", self.count, 0, 0, 0))
-        rec.dispatch(*dispatch.groups_2d(self.count, 64), 1)
+        rec.push(self.pipeline, self.push)
+        rec.dispatch(*self.groups, 1)

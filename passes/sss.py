@@ -32,6 +32,7 @@ from rgraph.vk.passkit import Binding
 
 from .screenspace_ref import screen_camera
 from .sss_ref import SSSSettings, kernel, kernel_2d
+from .stereo import view_layers
 
 
 def direction_of(setup) -> str:
@@ -81,9 +82,8 @@ class SSSBlur(PassImpl):
             data = np.concatenate([taps.reshape(-1), params]).tobytes()
         self.uniform = setup.host_buffer(len(data))
         self.uniform.write(data)
-        views = int(setup.param("views", 1))
-        stereo = views > 1
-        self.layers = views if stereo else 1
+        self.layers = view_layers(setup)
+        stereo = self.layers > 1
         if stereo:
             defines["FULLSCREEN_LAYERS"] = self.layers
         self.sets = setup.descriptors([

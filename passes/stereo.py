@@ -1,11 +1,17 @@
-"""The graph param ``views`` for the screen-space compute passes (issue 18 stereo): how many
-eyes, checked against the layers of the images a pass touches, and the shader defines for it."""
+"""The graph param ``views`` for the screen-space passes (issue 18 stereo): how many eyes (for
+the compute passes checked against the layers of the images they touch), and the shader defines."""
 
 from __future__ import annotations
 
 from typing import Any
 
 from rgraph.vk.errors import ExecutionError
+
+
+def view_layers(setup: Any) -> int:
+    """Layers a pass draws or dispatches over: the param ``views``, at least 1 (a full-screen or
+    layered pass draws one instance per layer)."""
+    return max(1, int(setup.param("views", 1)))
 
 
 def checked_views(setup: Any, resources: tuple[str, ...]) -> int:

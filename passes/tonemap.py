@@ -10,6 +10,7 @@ from rgraph.impl import Param, PassImpl, register
 from rgraph.vk.errors import ExecutionError
 from rgraph.vk.passkit import Binding, pack
 
+from .stereo import view_layers
 from .tonemap_ref import X_CAP, hable
 
 
@@ -31,9 +32,9 @@ class TonemapFilmic(PassImpl):
         if not white > 0:
             raise ExecutionError(f"pass {setup.name!r}: tonemap.white must be > 0, got {white}")
         self.inv_white_mapped = float(1.0 / hable(min(white, X_CAP)))
-        stereo = int(setup.param("views", 1)) > 1
+        self.layers = view_layers(setup)
+        stereo = self.layers > 1
         self.sets = setup.descriptors([Binding(0, "sampled", "hdr", sampler="nearest", array=stereo)])
-        self.layers = int(setup.param("views", 1)) if stereo else 1
         self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "post/tonemap_filmic.frag", [self.sets.layout],
                                                 push_constant_bytes=8, defines={"FULLSCREEN_LAYERS": self.layers})
 

@@ -75,7 +75,8 @@ class ShadowMap(PassImpl):
         self.pipeline = setup.graphics_pipeline(
             "scene/shadow_map.vert", None, [self.scene.set_layout], vertex_input=self.scene.position_input,
             push_constant_bytes=16, cull="NONE", depth_test=True, depth_write=True,
-            depth_compare="GREATER_OR_EQUAL", depth_bias=bias)
+            depth_compare="GREATER_OR_EQUAL", depth_bias=bias,
+            defines={"SHADOW_LAYERED": 1} if len(self.layers) > 1 else None)
 
     def record(self, rec, frame_set):
         rec.bind(self.pipeline, [self.scene.descriptor_set(frame_set)])

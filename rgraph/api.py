@@ -66,7 +66,6 @@ class Gpu:
                  ray_tracing: bool | None = None, one_queue: bool = False) -> None:
         from rgraph.vk.device import choose_physical_device, create_device, list_physical_devices
         from rgraph.vk.instance import create_instance
-        from rgraph.vk.probe_rt import layer_crashes
         from rgraph.vk.rt_device import supported
 
         self.validate = validate
@@ -76,7 +75,6 @@ class Gpu:
             if ray_tracing is None:  # the plans are not known yet: ray tracing whenever the device has it
                 ray_tracing = supported(choose_physical_device(list_physical_devices(self.instance), device).handle)
             self.device = create_device(self.instance, device, verbose=verbose, ray_tracing=ray_tracing,
-                                        rt_pipelines=ray_tracing and not (validate and layer_crashes()),
                                         one_queue=one_queue)
         except BaseException:
             self.instance.destroy()

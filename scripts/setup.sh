@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Idempotent setup for a Debian 12 machine: Vulkan (Mesa lavapipe from bookworm-backports,
 # validation layers, glslc, spirv-tools, graphviz, headless chromium for the HTML report's
-# screenshot test) when missing, then .venv with rgraph editable.
+# screenshot test) when missing, then .venv with rgraph editable, then Debian 13's validation
+# layer made to load on Debian 12 in .venv (scripts/validation_layer.py).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -36,3 +37,6 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ] || [ setup.py -nt "$stam
   .venv/bin/python -m pip install -q -e ".[dev,ray]"  # ray: the tests of rgraph sweep --ray
   touch "$stamp"
 fi
+# a current Khronos validation layer in the venv (Debian 12's 1.3.239 crashes on ray tracing
+# pipelines); on failure --validate keeps the system layer
+.venv/bin/python scripts/validation_layer.py || true

@@ -12,13 +12,13 @@ from rgraph.vk.errors import VulkanUnavailable
 
 def run_rt(graph: str, scene: Any, size: tuple[int, int], params: dict | None = None, extra=(),
            frames: int = 1) -> tuple[dict, dict]:
-    """(plan, outputs) of ``frames`` frames of ``graph`` on ``scene``; skipped without Vulkan, and
-    no validation message allowed."""
+    """(plan, outputs) of ``frames`` frames of ``graph`` on ``scene`` under validation and
+    synchronization validation; skipped without Vulkan, and no validation message allowed."""
     from rgraph.vk.executor import execute_plan
 
     plan = compile_graph(graph, scene_path=scene, size=size, params=params or {}, extra_outputs=list(extra))
     try:
-        result = execute_plan(plan, frames=frames, read_outputs=True)
+        result = execute_plan(plan, validate=True, frames=frames, read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
     assert result.messages == []

@@ -31,6 +31,7 @@ from rgraph.commands.outputs import (
     write_output,
 )
 from rgraph.errors import RGraphError
+from rgraph.vk.instance import validation_summary
 
 COMMAND_LINE = "<command line>"
 
@@ -368,7 +369,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.layer_workarounds:
         print("rgraph: recorded without the validation-layer workarounds", file=sys.stderr)
     if args.validate:
-        print(f"rgraph: {len(result.messages)} validation message(s)", file=sys.stderr)
+        print(validation_summary(len(result.messages)), file=sys.stderr)
         if result.messages:
             status = 1
     print(render_thread_line(result.timings), file=sys.stderr)

@@ -13,6 +13,7 @@ import sys
 from typing import Any
 
 from rgraph.commands.common import parse_params, parse_size
+from rgraph.vk.instance import validation_summary
 
 
 def _runtime_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -90,7 +91,7 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
     for message in messages:
         print(str(message), file=sys.stderr)
     if args.validate:
-        print(f"rgraph: {len(messages)} validation message(s)", file=sys.stderr)
+        print(validation_summary(len(messages)), file=sys.stderr)
         status = 1 if messages else 0
     if verdict is not None and verdict.ok is not None:
         for mismatch in verdict.mismatches:

@@ -9,6 +9,7 @@ from pathlib import Path
 from rgraph.commands.common import add_graph_arguments, parse_params, parse_size
 from rgraph.commands.outputs import warmup_seconds
 from rgraph.errors import RGraphError
+from rgraph.vk.instance import validation_summary
 
 PLOT_METRICS = ("flip", "ssim", "psnr", "hdr_flip", "hdr_rel_mse", "hdr_log_psnr")
 
@@ -98,5 +99,5 @@ def run(args: argparse.Namespace) -> int:
     for label, why in result.failures.items():
         print(f"rgraph: error: setting {label} failed: {why}", file=sys.stderr)
     if args.validate:
-        print(f"rgraph: {len(messages)} validation message(s)", file=sys.stderr)
+        print(validation_summary(len(messages)), file=sys.stderr)
     return 1 if result.failures or (args.validate and messages) else 0

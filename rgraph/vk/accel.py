@@ -281,14 +281,14 @@ class AccelSet:
             destroy(self.device.handle, t, None)
 
     def _build_barrier(self, cb: Any) -> None:
-        """Inside a build: structures written -> read by the next build/copy, scratch reused."""
+        """Inside a build: structures written -> read by the next build/copy, scratch reused.
+        Copies (compaction) run in the build stage: the copy stage is VK_KHR_ray_tracing_maintenance1's,
+        which the device does not enable."""
         v = vk()
         barrier = v.VkMemoryBarrier2(
-            srcStageMask=(v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR
-                          | v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_COPY_BIT_KHR),
+            srcStageMask=v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
             srcAccessMask=v.VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
-            dstStageMask=(v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR
-                          | v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_COPY_BIT_KHR),
+            dstStageMask=v.VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
             dstAccessMask=(v.VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR
                            | v.VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR))
         dependency = v.VkDependencyInfo(memoryBarrierCount=1, pMemoryBarriers=[barrier])

@@ -187,7 +187,7 @@ def offered_extensions(physical: Any) -> set[str]:
 
 
 def create_device(instance: Instance, device_index: int | None = None, verbose: bool = True,
-                  ray_tracing: bool = False, rt_pipelines: bool = False, one_queue: bool = False) -> Device:
+                  ray_tracing: bool = False, one_queue: bool = False) -> Device:
     """Choose a physical device, check required features, create the queues. ``ray_tracing``
     enables acceleration structures, ray tracing pipelines and buffer device addresses
     (``rgraph.vk.rt_device``). ``one_queue``: every plan queue on the graphics+compute family's
@@ -228,7 +228,7 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
     if ray_tracing:
         from rgraph.vk import rt_device
 
-        head, extensions = rt_device.chain(physical.handle, physical.name, e12, bind2=rt_pipelines)
+        head, extensions = rt_device.chain(physical.handle, physical.name, e12)
     extensions = extensions + [e for e in OPTIONAL_EXTENSIONS if e in offered_extensions(physical.handle)]
     enabled = v.VkPhysicalDeviceFeatures2(pNext=head, features=core_features)
     info = v.VkDeviceCreateInfo(

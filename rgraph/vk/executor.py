@@ -24,7 +24,7 @@ from rgraph.vk.errors import ExecutionError
 from rgraph.vk.impl_pass import ImplPass
 from rgraph.vk.instance import Instance, ValidationMessage, batch_cuts, create_instance, submit_per_pass
 from rgraph.vk.lower import LAYER_WORKAROUNDS, LoweringError, Recording, from_device, lower
-from rgraph.vk.probe_rt import has_raytrace, layer_crashes, needs_ray_tracing, refuse_layer_for_ray_tracing
+from rgraph.vk.probe_rt import needs_ray_tracing, refuse_layer_for_ray_tracing
 from rgraph.vk.record import BarrierBatch
 from rgraph.vk.resources import HostBuffer, ResourceSet
 from rgraph.vk.runtime import frames as _frames
@@ -113,8 +113,7 @@ class Executor:
                 refuse_layer_for_ray_tracing(plan)
             if self.device is None:
                 self.device = create_device(self.instance, device_index, verbose=verbose,
-                                            ray_tracing=needs_ray_tracing(plan),
-                                            rt_pipelines=has_raytrace(plan) and not (validate and layer_crashes()))
+                                            ray_tracing=needs_ray_tracing(plan))
             elif needs_ray_tracing(plan) and "accelerationStructure" not in self.device.enabled_features:
                 raise ExecutionError(f"{self.device.name} was opened without ray tracing (the plan has accels or "
                                      "raytrace passes): open_device(ray_tracing=True)")

@@ -11,6 +11,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from rgraph.vk.bundled_layer import point_loader_at_bundled_layer
 from rgraph.vk.errors import INSTALL_HINT, ExecutionError, VulkanUnavailable
 from rgraph.vk.loader import vk
 
@@ -18,14 +19,17 @@ _PASS_IN_TEXT = re.compile(r"\[pass (\S+) \(set \d+\)\]")
 
 VALIDATION_LAYER = "VK_LAYER_KHRONOS_validation"
 
-#: Layer settings through the environment (validation layer 1.3.239 reads these at load time).
-#: Submit-time synchronization checks only run when enabled this way.
+#: Layer settings through the environment (read at load time). Layer 1.3.239 runs submit-time
+#: synchronization checks only when enabled this way; 1.4 layers run them by default.
 VALIDATION_ENV = {
     "VK_LAYER_ENABLES": (
         "VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT:"
         "VALIDATION_CHECK_ENABLE_SYNCHRONIZATION_VALIDATION_QUEUE_SUBMIT"
     ),
     "VK_LAYER_DUPLICATE_MESSAGE_LIMIT": "1000",
+    # layers since 1.3.290 validate shader (descriptor) accesses only with this heuristic on; 1.3.239
+    # always did, by descriptor type. Off, a dropped barrier between two dispatches goes unseen.
+    "VK_KHRONOS_VALIDATION_SYNCVAL_SHADER_ACCESSES_HEURISTIC": "true",
 }
 
 #: ``RGRAPH_GPU_AV=1`` with validation: GPU-assisted validation (shader instrumentation:
@@ -146,6 +150,7 @@ def _make_callback(log: MessageLog):
 
 
 def available_layers() -> set[str]:
+    point_loader_at_bundled_layer()
     v = vk()
     return {p.layerName for p in v.vkEnumerateInstanceLayerProperties()}
 
@@ -207,10 +212,18 @@ def create_instance(validate: bool, app_name: str = "rgraph") -> Instance:
 
 
 def validation_layer_version() -> tuple[int, int, int] | None:
-    """The installed Khronos validation layer's spec version, or None."""
+    """The Khronos validation layer's spec version (the venv's, else the system's), or None."""
+    point_loader_at_bundled_layer()
     v = vk()
     for p in v.vkEnumerateInstanceLayerProperties():
         if p.layerName == VALIDATION_LAYER:
             s = p.specVersion
             return (s >> 22, (s >> 12) & 0x3FF, s & 0xFFF)
     return None
+
+
+def validation_summary(count: int) -> str:
+    """The closing line of a validated run: the message count and the layer that checked."""
+    version = validation_layer_version()
+    layer = f" (Khronos validation layer {'.'.join(map(str, version))})" if version else ""
+    return f"rgraph: {count} validation message(s){layer}"

@@ -26,19 +26,13 @@ def needs_ray_tracing(plan: dict) -> bool:
             or any(p["kind"] == "raytrace" for p in plan["passes"]))
 
 
-def has_raytrace(plan: dict) -> bool:
-    """Whether a plan has raytrace passes (the device then also enables VK_KHR_maintenance6)."""
-    return any(p["kind"] == "raytrace" for p in plan["passes"])
-
-
 #: The newest Khronos validation layer known to crash inside vkCreateRayTracingPipelinesKHR
 #: (Debian's 1.3.239 on lavapipe: even a raygen-only pipeline; core checks off, it crashes at bind).
 CRASHING_LAYER = (1, 3, 239)
 
 
 def layer_crashes() -> bool:
-    """Whether the installed validation layer is one that crashes on ray tracing pipelines (it
-    also predates VK_KHR_maintenance6, so a validated device is created without it)."""
+    """Whether the validation layer in use is one that crashes on ray tracing pipelines."""
     from rgraph.vk.instance import validation_layer_version
 
     version = validation_layer_version()

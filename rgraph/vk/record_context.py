@@ -39,13 +39,7 @@ class RecordContext(RayTracingCommands):
         """Bind a ``rgraph.vk.passkit.Pipeline`` and descriptor sets from ``first_set``."""
         v = vk()
         v.vkCmdBindPipeline(self._cb, pipeline.bind_point, pipeline.pipeline)
-        if descriptor_sets and pipeline.bind_point == v.VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR:
-            from rgraph.vk.rt_device import bind_descriptor_sets
-            from rgraph.vk.rt_pipeline import all_rt_stages
-
-            bind_descriptor_sets(self._device, self._cb, pipeline.layout, all_rt_stages(), list(descriptor_sets),
-                                 first_set)
-        elif descriptor_sets:
+        if descriptor_sets:
             v.vkCmdBindDescriptorSets(self._cb, pipeline.bind_point, pipeline.layout, first_set,
                                       len(descriptor_sets), list(descriptor_sets), 0, None)
 

@@ -16,7 +16,6 @@ from rgraph.vk.errors import VulkanUnavailable
 from rgraph.vk.loader import vk
 
 EXTENSIONS = ("VK_KHR_acceleration_structure", "VK_KHR_ray_tracing_pipeline", "VK_KHR_deferred_host_operations")
-MAINTENANCE6 = "VK_KHR_maintenance6"
 RAY_QUERY = "VK_KHR_ray_query"
 
 
@@ -36,7 +35,7 @@ def supported(physical: Any) -> bool:
     return all(e in names for e in EXTENSIONS)
 
 
-def chain(physical: Any, device_name: str, next_struct: Any, bind2: bool = False) -> tuple[Any, list[str]]:
+def chain(physical: Any, device_name: str, next_struct: Any) -> tuple[Any, list[str]]:
     """Feature structs enabling acceleration structures and ray tracing pipelines, chained in
     front of ``next_struct``, and the extensions to enable. Raises when the device lacks them."""
     v = vk()
@@ -50,9 +49,6 @@ def chain(physical: Any, device_name: str, next_struct: Any, bind2: bool = False
     extensions = list(EXTENSIONS)
     head = next_struct
     names = {e.extensionName for e in v.vkEnumerateDeviceExtensionProperties(physical, None)}
-    if bind2 and MAINTENANCE6 in names:  # vkCmdBindDescriptorSets2KHR: see bind_descriptor_sets
-        head = v.VkPhysicalDeviceMaintenance6FeaturesKHR(pNext=head, maintenance6=v.VK_TRUE)
-        extensions.append(MAINTENANCE6)
     if RAY_QUERY in names:
         q_rq = v.VkPhysicalDeviceRayQueryFeaturesKHR()
         v.vkGetPhysicalDeviceFeatures2(physical, v.VkPhysicalDeviceFeatures2(pNext=q_rq))
@@ -97,22 +93,7 @@ def device_address(device: Any, command: str, info: Any) -> int:
     return int(fns[command](device.handle, v.ffi.addressof(info)))
 
 
-def bind_descriptor_sets(device: Any, cb: Any, layout: Any, stages: int, sets: list[Any], first_set: int = 0) -> None:
-    """Bind descriptor sets for a ray tracing pipeline. With VK_KHR_maintenance6 through
-    vkCmdBindDescriptorSets2KHR naming the ray tracing stages: Mesa 25.0's lavapipe drops sets
-    bound with vkCmdBindDescriptorSets at the ray tracing bind point (shaders then read null
-    descriptors)."""
+def bind_descriptor_sets(cb: Any, layout: Any, sets: list[Any], first_set: int = 0) -> None:
+    """Bind descriptor sets at the ray tracing bind point."""
     v = vk()
-    if MAINTENANCE6 not in device.__dict__.get("extensions", ()):
-        v.vkCmdBindDescriptorSets(cb, v.VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, layout, first_set, len(sets), sets,
-                                  0, None)
-        return
-    fns = device.__dict__.setdefault("_rt_raw", {})
-    if "bind2" not in fns:
-        fns["bind2"] = v.ffi.cast("PFN_vkCmdBindDescriptorSets2KHR",
-                                  v.lib.vkGetDeviceProcAddr(device.handle, b"vkCmdBindDescriptorSets2KHR"))
-    handles = v.ffi.new("VkDescriptorSet[]", sets)
-    info = v.ffi.new("VkBindDescriptorSetsInfoKHR*", {
-        "sType": v.VK_STRUCTURE_TYPE_BIND_DESCRIPTOR_SETS_INFO_KHR, "stageFlags": stages, "layout": layout,
-        "firstSet": first_set, "descriptorSetCount": len(sets), "pDescriptorSets": handles})
-    fns["bind2"](cb, info)
+    v.vkCmdBindDescriptorSets(cb, v.VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, layout, first_set, len(sets), sets, 0, None)

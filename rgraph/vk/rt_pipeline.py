@@ -96,8 +96,8 @@ def create_rt_pipeline(device: Device, shaders: dict[str, list[bytes]], set_layo
                                                              closestHitShader=unused, anyHitShader=unused,
                                                              intersectionShader=unused))
     for n in range(len(shaders["closest_hit"])):
-        groups.append(v.VkRayTracingShaderGroupCreateInfoKHR(
-            type=v.VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR, generalShader=unused,
+        groups.append(_group(
+            v, type=v.VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR, generalShader=unused,
             closestHitShader=index[("closest_hit", n)], anyHitShader=index.get(("any_hit", n), unused),
             intersectionShader=unused))
     owned = layout is None
@@ -109,18 +109,12 @@ def create_rt_pipeline(device: Device, shaders: dict[str, list[bytes]], set_layo
     # arrays made here and kept alive over the call (the binding frees inline-built ones early)
     stage_array = v.ffi.new("VkPipelineShaderStageCreateInfo[]", stages)
     group_array = v.ffi.new("VkRayTracingShaderGroupCreateInfoKHR[]", groups)
-    libraries = v.ffi.new("VkPipelineLibraryCreateInfoKHR*", {
-        "sType": v.VK_STRUCTURE_TYPE_PIPELINE_LIBRARY_CREATE_INFO_KHR, "libraryCount": 0})
-    interface = v.ffi.new("VkRayTracingPipelineInterfaceCreateInfoKHR*", {
-        "sType": v.VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_INTERFACE_CREATE_INFO_KHR,
-        "maxPipelineRayPayloadSize": 64, "maxPipelineRayHitAttributeSize": 8})
     dynamic = v.ffi.new("VkPipelineDynamicStateCreateInfo*", {
         "sType": v.VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO, "dynamicStateCount": 0})
     info = v.ffi.new("VkRayTracingPipelineCreateInfoKHR*", {
         "sType": v.VK_STRUCTURE_TYPE_RAY_TRACING_PIPELINE_CREATE_INFO_KHR, "stageCount": len(stages),
         "pStages": stage_array, "groupCount": len(groups), "pGroups": group_array,
-        "maxPipelineRayRecursionDepth": max_depth, "layout": layout, "pLibraryInfo": libraries,
-        "pLibraryInterface": interface, "pDynamicState": dynamic})
+        "maxPipelineRayRecursionDepth": max_depth, "layout": layout, "pDynamicState": dynamic})
     create = proc(device, "vkCreateRayTracingPipelinesKHR")
     out = v.ffi.new("VkPipeline[1]")
     create(device.handle, None, None, 1, info, None, out)

@@ -51,7 +51,7 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
     return float("inf") if mse == 0 else 10 * np.log10(1.0 / mse)
 
 
-def _run(graph, frame: int, extra=(), params=None, validate: bool = False, refit: bool = True) -> dict:
+def _run(graph, frame: int, extra=(), params=None, validate: bool = True, refit: bool = True) -> dict:
     """Outputs of content frame ``frame`` (the last of ``frame + 1`` frames); ``refit``: the
     plan's accel is persistent and refitted."""
     from rgraph.vk.executor import execute_plan
@@ -201,7 +201,7 @@ def test_a_scene_without_deformable_meshes_keeps_the_static_tables(tmp_path):
     for scene, deformed in ((static, False), (SCENE, True)):
         plan = compile_graph("rt_standalone", scene_path=scene, size=SIZE)
         try:
-            with open_device(validate=False, verbose=False, ray_tracing=True) as gpu:
+            with open_device(validate=True, verbose=False, ray_tracing=True) as gpu:
                 accels = gpu.load(plan).executor.accels
                 assert (accels.deformed is not None) == deformed
                 assert accels.deforming == ({"scene_as"} if deformed else set())

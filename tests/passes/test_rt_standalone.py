@@ -34,7 +34,7 @@ def gpu_image(size: int, depth: int = 4, scene=SCENE) -> np.ndarray:
 
     plan = compile_graph("rt_standalone", scene_path=scene, size=(size, size), params={"rt.max_depth": str(depth)})
     try:
-        result = execute_plan(plan, frames=1, read_outputs=True)
+        result = execute_plan(plan, validate=True, frames=1, read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
     assert result.messages == []

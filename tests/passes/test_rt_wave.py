@@ -46,7 +46,7 @@ def _run(graph: str, **params: str) -> dict:
                          params={"rt.max_depth": str(DEPTH), **wave, **params},
                          extra_outputs=["ray_args", *LISTS] if graph != "rt_standalone" else [])
     try:
-        result = execute_plan(plan, frames=1, read_outputs=True)
+        result = execute_plan(plan, validate=True, frames=1, read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
     assert result.messages == []

@@ -1,7 +1,8 @@
 """Ray tracing pipelines and the recording context's trace calls on lavapipe: a raygen shader
 sees the launch size of ``trace_rays`` and of ``trace_rays_indirect`` (arguments read from a
-device address), and descriptor sets reach ray tracing shaders (Mesa 25.0 drops legacy binds
-at the RT bind point: ``rt_device.bind_descriptor_sets``). Which SBT group a ray selects is
+device address), and descriptor sets bound at the ray tracing bind point reach ray tracing
+shaders (with the binding's wrong bind point value they read null descriptors on lavapipe:
+``rgraph.vk.enum_fixes``). Which SBT group a ray selects is
 data-checked by the probe (tests/vk/test_rt_runtime.py)."""
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ def rt_device():
 
     try:
         instance = create_instance(False)
-        device = create_device(instance, None, verbose=False, ray_tracing=True, rt_pipelines=True)
+        device = create_device(instance, None, verbose=False, ray_tracing=True)
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
     yield device

@@ -28,7 +28,8 @@ def _run(plan, **kw):
 @pytest.mark.parametrize("name", ["rt_probe", "rt_refit", "rt_rebuild", "rt_static", "rt_indirect"])
 def test_probe_traces_match_the_simulation(name, memory):
     plan = compile_graph(RT / f"{name}.yaml", size=(32, 32), memory=memory)
-    result = _run(plan, frames=3, check_data=True)
+    result = _run(plan, validate=True, frames=3, check_data=True)
+    assert result.messages == []
     assert result.data_ok, [str(m) for m in result.mismatches]
     assert not result.unchecked
 

@@ -1,7 +1,6 @@
 """Every bundled graph split across two logical devices of one physical device (lavapipe):
 the composited output equals the one-device output bit for bit, for both splits, with zero
-validation messages (the ray tracing graphs without validation: layer 1.3.239 crashes on RT
-pipelines, see rgraph/vk/rt_device.py)."""
+validation messages (the ray tracing graphs too, since session 21's validation layer)."""
 
 from __future__ import annotations
 
@@ -9,13 +8,11 @@ import numpy as np
 import pytest
 from multi_helpers import outputs_one_and_split, validated_pair
 
-from rgraph.api import open_device
 from rgraph.resources import bundled_graphs
 
 SIZE = (32, 24)
 COVERED_ELSEWHERE = {"surgery"}  # tests/vk/test_multi_device.py
-RAY_TRACING = {"rt_standalone", "rt_hybrid", "rt_hybrid_raster"}
-VALIDATED = sorted(set(bundled_graphs()) - COVERED_ELSEWHERE - RAY_TRACING)
+VALIDATED = sorted(set(bundled_graphs()) - COVERED_ELSEWHERE)
 MODES = ["sort-first", "sort-last"]
 
 
@@ -24,18 +21,8 @@ def gpus():
     yield from validated_pair()
 
 
-@pytest.fixture(scope="module")
-def rt_gpus():
-    devices = [open_device(validate=False, device=0, verbose=False) for _ in range(2)]
-    try:
-        yield devices
-    finally:
-        for d in devices:
-            d.close()
-
-
-def test_every_bundled_graph_is_listed():
-    assert set(bundled_graphs()) <= set(VALIDATED) | COVERED_ELSEWHERE | RAY_TRACING
+def test_the_ray_tracing_graphs_are_split_under_validation_too():
+    assert {"rt_standalone", "rt_hybrid", "rt_hybrid_raster"} <= set(VALIDATED)
 
 
 def _assert_equal_outputs(plan, one, out):
@@ -51,9 +38,3 @@ def test_bundled_graph_split_equals_one_device(gpus, graph, mode):
     plan, one, out = outputs_one_and_split(gpus, graph, mode, SIZE)
     _assert_equal_outputs(plan, one, out)
     assert [str(m) for g in gpus for m in g.instance.log.messages] == []
-
-
-@pytest.mark.parametrize("mode", MODES)
-@pytest.mark.parametrize("graph", sorted(RAY_TRACING & set(bundled_graphs())))
-def test_ray_tracing_graph_split_equals_one_device(rt_gpus, graph, mode):
-    _assert_equal_outputs(*outputs_one_and_split(rt_gpus, graph, mode, SIZE))

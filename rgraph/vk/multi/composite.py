@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from rgraph.formats import lookup
 from rgraph.impl import PassImpl, register
 from rgraph.plan.devices import COMPOSITE_IMPL
 from rgraph.vk.errors import ExecutionError
@@ -33,11 +34,21 @@ class DepthComposite(PassImpl):
         bindings += [Binding(1 + i, "sampled", remote[c], sampler="nearest", array=layered)
                      for i, c in enumerate(colors)]
         self.sets = setup.descriptors(bindings)
+        defines: dict[str, Any] = {"COLORS": len(colors), "LAYERED": int(layered)}
+        for i, color in enumerate(colors):  # sampler and output of the colour's numeric type
+            prefix = numeric_prefix(setup.resource_plan(color)["format"])
+            defines[f"SAMPLER{i}"] = f"{prefix}sampler2D{'Array' if layered else ''}"
+            defines[f"OUT{i}"] = f"{prefix}vec4"
         self.pipeline = setup.graphics_pipeline("lib/fullscreen.vert", "multi/depth_composite.frag",
-                                                [self.sets.layout],
-                                                defines={"COLORS": len(colors), "LAYERED": int(layered)},
+                                                [self.sets.layout], defines=defines,
                                                 depth_test=True, depth_write=True, depth_compare="GREATER")
 
     def record(self, rec: Any, frame_set: int) -> None:
         rec.bind(self.pipeline, [self.sets[frame_set]])
         rec.draw(3)
+
+
+def numeric_prefix(format_name: str) -> str:
+    """The GLSL type prefix of a colour format's numeric type: ``u`` (UINT), ``i`` (SINT) or ``""``."""
+    numeric = lookup(format_name).numeric
+    return {"UINT": "u", "SINT": "i"}.get(numeric, "")

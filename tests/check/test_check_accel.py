@@ -1,7 +1,7 @@
 """``rgraph check`` on acceleration structures (FORMAT.md 5): plans of build -> trace,
 refit -> trace and trace -> rebuild are clean, and dropping (or weakening) any barrier of an
-accel or its build scratch is reported with the hazard it opens. The 1.3.239 layer tracks
-no AS/RT accesses, so check is the oracle here."""
+accel or its build scratch is reported with the hazard it opens. rgraph mutate on a ray tracing
+graph has syncval beside check and the data check since session 21's layer."""
 
 from __future__ import annotations
 

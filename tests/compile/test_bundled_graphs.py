@@ -1,8 +1,8 @@
 """Every bundled graph, as shipped (its own default scene), runs clean under validation on
-lavapipe at a small size: zero validation or synchronization-validation messages. Graphs with
-raytrace passes run without the layer where it crashes creating ray tracing pipelines
-(1.3.239: docs/raytracing.md); their images are checked against NumPy references in
-tests/passes/test_rt_*.py."""
+lavapipe at a small size: zero validation or synchronization-validation messages (graphs with
+raytrace passes too, under the layer setup installs; under Debian 12's 1.3.239, which crashes
+creating ray tracing pipelines, they run without it); their images are checked against NumPy
+references in tests/passes/test_rt_*.py."""
 
 from __future__ import annotations
 

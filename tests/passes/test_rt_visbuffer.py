@@ -1,6 +1,6 @@
 """The compute visibility buffer (passes/raytrace_visbuffer.py) on lavapipe under validation and
 synchronization validation (tests/pass_graphs/rt_visbuffer.yaml: its passes without the ray
-tracing ones, which the 1.3.239 layer cannot validate), data-checked against the NumPy float64
+tracing ones, which tests/passes/test_rt_hybrid.py runs), data-checked against the NumPy float64
 reference of the camera rays (passes/rt_vis_ref.py): equal ids on >= 99% of the pixels, every
 mismatch on a triangle or silhouette edge. Hard cases: tests/data/rt/vis_hard.yaml (1e6 m from
 the origin, triangles crossing the camera plane or behind it, degenerate, sub-pixel and

@@ -12,8 +12,7 @@ lists (levels 4 and 5 are walked in-thread by the last list's rays):
 - ``rt.wave_subgroup: 1`` (subgroup appends where the device has them): same lists and image;
 - benchmarks/graphs/rt_hybrid_async.yaml (matte pixels on the async queue): same lists and image;
 - the fixed-point accumulation is order-independent: two runs are bit-identical.
-Ray tracing passes run without the validation layer (docs/raytracing.md: the 1.3.239 layer
-crashes on ray tracing pipelines); the run's message log must still be empty.
+Every run is validated (validation + synchronization validation) and must log no message.
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
 """Ray tracing on lavapipe (FORMAT.md 5): the probe builds its test geometry and traces real
 rays; the read-back data equals the CPU simulation's prediction over several frames (build ->
-trace, refit -> trace, rebuild between traces); a wrong ray is caught by the data check; accel
-builds run clean under validation; --validate is refused for raytrace passes with the 1.3.239
-layer (it crashes creating ray tracing pipelines)."""
+trace, refit -> trace, rebuild between traces) under validation and synchronization validation;
+a wrong ray is caught by the data check; accel builds run clean under validation; --validate is
+refused for raytrace passes under Debian 12's 1.3.239 layer (it crashes creating ray tracing
+pipelines; setup installs a current one)."""
 
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rgraph.vk.errors import INSTALL_HINT, VulkanUnavailable
-from rgraph.vk.instance import Instance
+from rgraph.vk.instance import Instance, gpu_assisted
 from rgraph.vk.loader import vk
 
 PLAN_QUEUES = ("graphics", "compute", "transfer")
@@ -175,6 +175,9 @@ def _query_features(handle: Any) -> tuple[Any, Any, Any, Any]:
     return f2, f12, (f11, f13), f2.features
 
 
+#: Vulkan 1.2 features GPU-assisted validation's shader instrumentation uses (layer 1.4.309)
+GPU_AV_FEATURES_12 = ("vulkanMemoryModel", "vulkanMemoryModelDeviceScope", "uniformAndStorageBuffer8BitAccess")
+
 #: enabled whenever offered: the shared host allocation between devices (rgraph.vk.multi.host_memory)
 OPTIONAL_EXTENSIONS = ("VK_EXT_external_memory_host",)
 
@@ -223,6 +226,9 @@ def create_device(instance: Instance, device_index: int | None = None, verbose: 
         bufferDeviceAddress=v.VK_TRUE if ray_tracing else v.VK_FALSE,
         shaderBufferInt64Atomics=v.VK_TRUE if int64_atomics else v.VK_FALSE,
     )
+    if instance.validate and gpu_assisted():  # what GPU-assisted validation's instrumentation needs
+        for name in GPU_AV_FEATURES_12:  # (the layer would force them on, with a warning each)
+            setattr(e12, name, getattr(f12, name))
     extensions: list[str] = []
     head: Any = e12
     if ray_tracing:

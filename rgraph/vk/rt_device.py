@@ -91,9 +91,3 @@ def device_address(device: Any, command: str, info: Any) -> int:
             raise VulkanUnavailable(f"{command} is not available")
         fns[command] = v.ffi.cast(f"PFN_{command}", ptr)
     return int(fns[command](device.handle, v.ffi.addressof(info)))
-
-
-def bind_descriptor_sets(cb: Any, layout: Any, sets: list[Any], first_set: int = 0) -> None:
-    """Bind descriptor sets at the ray tracing bind point."""
-    v = vk()
-    v.vkCmdBindDescriptorSets(cb, v.VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, layout, first_set, len(sets), sets, 0, None)

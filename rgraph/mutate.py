@@ -403,7 +403,7 @@ def mutation_report(plan: dict, *, oracles: Iterable[str] = ORACLES, kinds: Iter
         if runner is not None and baseline.error is None:
             device_name = gpu.name
         outcomes = []
-        todo = mutants(plan, kinds)
+        todo = mutants(plan, kinds) if baseline.error is None else []  # nothing to compare against
         for n, m in enumerate(todo):
             outcome = run_oracles(m, oracles, runner)
             explain(plan, outcome, oracles, same_family)

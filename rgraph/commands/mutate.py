@@ -149,8 +149,13 @@ def run(args: argparse.Namespace) -> int:
     except (VulkanUnavailable, ExecutionError) as exc:
         print(f"rgraph: error: {exc}", file=sys.stderr)
         return 2
+    base = report.baseline
+    if base is not None and base.error is not None:
+        print(f"rgraph: error: the unmutated plan fails, so no mutant was run (every pass runs as the "
+              f"probe): {base.error}", file=sys.stderr)
+        return 1
     print_report(report)
     if args.json:
         args.json.write_text(json.dumps(report.as_json(), indent=1) + "\n")
         print(f"rgraph: wrote {args.json}", file=sys.stderr)
-    return 0
+    return 1 if base is not None and base.caught_by else 0

@@ -157,3 +157,19 @@ def test_surgery_every_mutant_caught_or_explained():
 @pytest.mark.vulkan
 def test_surgery_aliased_every_drop_caught_or_explained():
     _assert_all_explained(_report(surgery("aliased"), kinds=["drop"]))
+
+
+@pytest.mark.vulkan
+def test_a_plan_the_probe_cannot_run_stops_before_any_mutant(tmp_path):
+    """rt_hybrid's 16-byte ray-list arguments leave no room for the probe's header: the
+    unmutated plan fails, so mutate says why and exits 1 (it ran 120 mutants, each 'caught' by
+    the same runtime error, and exited 0 until session 21)."""
+    from locations import ROOT
+
+    out = tmp_path / "m.json"
+    run = subprocess.run([sys.executable, "-m", "rgraph", "mutate", "rt_hybrid", "--scene",
+                          str(ROOT / "graphs" / "scenes" / "rt_tiny.yaml"), "--size", "16x16", "--oracles", "syncval",
+                          "--json", str(out), "-q"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 1, run.stderr
+    assert "the unmutated plan fails, so no mutant was run" in run.stderr and "too small for the probe" in run.stderr
+    assert "Traceback" not in run.stderr and not out.exists()

@@ -173,15 +173,22 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
     return doc
 
 
-def _plan_from_file(args: argparse.Namespace) -> dict:
-    given = [flag for flag, value in (("--size", not isinstance(args.size, DefaultSize)), ("--scene", args.scene),
-                                      ("-p", args.param),
-                                      ("--policy", args.policy),
-                                      ("--schedule", args.schedule != "declaration")) if value]
+def refuse_compile_flags(args: argparse.Namespace, *, multi: bool = False) -> None:
+    """Flags that only shape a compile are errors with a plan file (it was compiled with its
+    own); a multi-device plan also has its own split and synchronization."""
+    flags = [("--size", not isinstance(args.size, DefaultSize)), ("--scene", args.scene), ("-p", args.param),
+             ("--policy", args.policy), ("--schedule", args.schedule != "declaration"), ("--camera", args.camera)]
+    if multi:
+        flags += [("--split", args.split), ("--balance", args.balance != "static"), ("--sync", args.sync != "normal")]
+    given = [flag for flag, value in flags if value]
     if given:
         verb = "applies" if len(given) == 1 else "apply"
         raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only {verb} when compiling a graph, not to "
                                                 f"a plan file (its size is {_plan_size(args.graph)})")
+
+
+def _plan_from_file(args: argparse.Namespace) -> dict:
+    refuse_compile_flags(args)
     plan = load_checked_plan(Path(args.graph), unchecked=args.unchecked)
     if args.sync == "naive" and plan.get("stats", {}).get("sync") != "naive":
         from rgraph.compiler.pipeline import apply_sync_mode
@@ -309,6 +316,9 @@ def run(args: argparse.Namespace) -> int:
     if devices is not None and (len(devices) > 1 or _is_multi_plan(args.graph)):
         from rgraph.commands.run_multi import run_multi
 
+        if is_plan_file(args.graph):  # as a one-device plan file: its own compile, checked first
+            refuse_compile_flags(args, multi=True)
+            load_checked_plan(Path(args.graph), unchecked=args.unchecked)
         return run_multi(args, devices, default_size_text())
     if devices is not None and args.device is None:
         args.device = devices[0]

@@ -38,6 +38,7 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
         else:
             options = dict(scene_path=args.scene, params=parse_params(args.param),
                            size=parse_size(args.size or default_size), policy=args.policy,
+                           camera=args.camera, sync=args.sync, schedule=args.schedule,
                            memory=gpus[0].memory_requirements())
             split = split_from_args(args, indices=True)
             plan = compile_graph_plan(args.graph, split=split, **options)

@@ -192,11 +192,13 @@ def plan_for_frontend(
             raise RGraphError.in_file("<command line>", "--sync naive applies to one-device plans only")
         if schedule != DEFAULT_SCHEDULE:
             raise RGraphError.in_file("<command line>", f"--schedule {schedule} applies to one-device plans only")
-        return compile_split(spec, split, policy=chosen, memory_provider=provider, profile_name=profile_name)
-    plan = compile_plan(spec, policy=chosen, memory_provider=provider, profile_name=profile_name, schedule=schedule)
-    if camera:
+        plan = compile_split(spec, split, policy=chosen, memory_provider=provider, profile_name=profile_name)
+    else:
+        plan = apply_sync_mode(compile_plan(spec, policy=chosen, memory_provider=provider,
+                                            profile_name=profile_name, schedule=schedule), sync)
+    if camera:  # every device's projection of a multi-device plan keeps it
         plan = replace(plan, camera=check_camera(front.scene, camera))
-    return apply_sync_mode(plan, sync)
+    return plan
 
 
 def check_camera(scene: Scene | None, camera: int) -> int:

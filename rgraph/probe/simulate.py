@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from rgraph.probe.semantics import accel_value, analyze, subresources, trace_value
+from rgraph.probe.semantics import accel_value, analyze, raster_read_stages, subresources, trace_value
 from rgraph.probe.values import UINT32, codec, initial_value, modulus
 
 Key = tuple[str, int | None, int | None]  # (resource, mip, layer); buffers: (name, None, None)
@@ -74,9 +74,10 @@ class Simulation:
                 total = (total + value * len(read.stages)) & UINT32
         if p["kind"] != "transfer":  # the probe's rays (ray queries outside raytrace passes) per accel read
             for a in accesses:
-                if a["usage"] == "accel_read":
+                if a["usage"] == "accel_read":  # once per raster stage that queries, like reads
                     value = self._get(a["resource"], None)
-                    total = None if value is None or total is None else (total + trace_value(value)) & UINT32
+                    times = 1 if p["kind"] != "raster" else len(raster_read_stages(a["stages"]))
+                    total = None if value is None or total is None else (total + times * trace_value(value)) & UINT32
         for a in accesses:
             if a["usage"] == "accel_build":
                 known = probe_known(self.resources[a["resource"]])

@@ -4,9 +4,9 @@ Bindings (set 0), in order: one combined image sampler per ``sampled`` access (a
 view of its range), one storage image per (storage access, mip) (a 2D-array view of its
 layers), one storage buffer per storage buffer access, one uniform buffer per ``uniform``
 access, then one acceleration structure per ``accel_read`` access (compute and raster passes:
-ray queries, the probe's rays of ``rgraph.vk.probe_rt_glsl`` in the compute shader or the
-fragment shader). Vertex buffers feed one ``uint`` attribute each (stride 0). See
-``rgraph.probe.semantics`` for what is computed.
+ray queries, the probe's rays of ``rgraph.vk.probe_rt_glsl`` in the compute shader or in each
+raster stage the access declares, like reads). Vertex buffers feed one ``uint`` attribute each
+(stride 0). See ``rgraph.probe.semantics`` for what is computed.
 """
 
 from __future__ import annotations
@@ -296,6 +296,12 @@ def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, 
             vert_reads.append(f"    s += {read_expr(r.access, r.sub, 'vertex', 'p')};")
         if "fragment" in stages:
             frag_reads.append(f"    s += {read_expr(r.access, r.sub, 'fragment', 'p')};")
+    for b in accels:  # ray queries in the stages the access declares (default: the fragment shader)
+        stages = raster_read_stages(accesses[bindings[b].access]["stages"])
+        if "vertex" in stages:
+            vert_reads += ray_query_lines(b, "    ")
+        if "fragment" in stages:
+            frag_reads += ray_query_lines(b, "    ")
     # vertex attribute reads count once per stage too: they are read in the vertex stage only
     vert = "\n".join([
         *header,
@@ -337,7 +343,6 @@ def generate(plan_pass: dict, resources: dict[str, dict], plan_size: tuple[int, 
         "    uvec2 p = uvec2(gl_FragCoord.xy);",
         "    uint s = v_sum;",
         *frag_reads,
-        *(line for b in accels for line in ray_query_lines(b, "    ")),
         *stores,
         "}",
     ]) + "\n"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from dataclasses import dataclass, field
 from typing import Any
@@ -100,6 +101,15 @@ class Device:
     @property
     def name(self) -> str:
         return self.physical.name
+
+    @property
+    def fence_timeout_ns(self) -> int:
+        """How long a fence wait may take before it fails with VK_TIMEOUT: 100 s, 30 minutes under
+        validation (GPU-assisted validation on lavapipe spent 115 s in the first frame of
+        rt_hybrid_raster with a cold shader cache); ``RGRAPH_FENCE_TIMEOUT_S`` overrides both."""
+        override = os.environ.get("RGRAPH_FENCE_TIMEOUT_S", "")
+        seconds = float(override) if override else (1800.0 if self.instance.validate else 100.0)
+        return int(seconds * 1e9)
 
     def fn(self, name: str) -> Any:
         """An extension command (debug-utils labels) through the instance."""

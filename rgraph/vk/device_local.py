@@ -128,7 +128,7 @@ def submit_and_wait(device: Device, cmd_pool: Any, queue: str, record: Callable[
     cb_info = v.VkCommandBufferSubmitInfo(commandBuffer=cb)
     submit = v.VkSubmitInfo2(commandBufferInfoCount=1, pCommandBufferInfos=[cb_info])
     v.vkQueueSubmit2(device.queues[queue], 1, [submit], fence)
-    v.vkWaitForFences(device.handle, 1, [fence], v.VK_TRUE, 10**11)
+    v.vkWaitForFences(device.handle, 1, [fence], v.VK_TRUE, device.fence_timeout_ns)
     v.vkDestroyFence(device.handle, fence, None)
     v.vkFreeCommandBuffers(device.handle, cmd_pool, 1, [cb])
 

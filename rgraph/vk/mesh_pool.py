@@ -449,7 +449,7 @@ class MeshPool:
         dev = self.device.handle
         v.vkQueueSubmit2(queue, 1, [v.VkSubmitInfo2(commandBufferInfoCount=1, pCommandBufferInfos=[
             v.VkCommandBufferSubmitInfo(commandBuffer=cb)])], fence)
-        v.vkWaitForFences(dev, 1, [fence], v.VK_TRUE, 10**11)
+        v.vkWaitForFences(dev, 1, [fence], v.VK_TRUE, self.device.fence_timeout_ns)
         v.vkResetFences(dev, 1, [fence])
         v.vkFreeCommandBuffers(dev, pool, 1, [cb])
 

@@ -41,7 +41,7 @@ def upload_static(device: Any, payload: bytes, usage: int) -> tuple[Any, Any, in
         v.vkEndCommandBuffer(cb)
         submit = v.VkSubmitInfo2(commandBufferInfoCount=1, pCommandBufferInfos=[v.VkCommandBufferSubmitInfo(commandBuffer=cb)])
         v.vkQueueSubmit2(device.queues["graphics"], 1, [submit], fence)
-        v.vkWaitForFences(dev, 1, [fence], v.VK_TRUE, 10**11)
+        v.vkWaitForFences(dev, 1, [fence], v.VK_TRUE, device.fence_timeout_ns)
     finally:
         v.vkDestroyFence(dev, fence, None)
         v.vkDestroyCommandPool(dev, pool, None)

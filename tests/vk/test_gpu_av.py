@@ -22,7 +22,11 @@ def _run(capsys, monkeypatch, argv: list[str]) -> tuple[int, str]:
     return rc, capsys.readouterr().err
 
 
-@pytest.mark.parametrize("argv", [["surgery"], ["clustered"], ["rt_hybrid", "--scene", RT_TINY],
+SLOW = pytest.mark.slow  # a cold shader cache: 43-98 s each on lavapipe (rt_standalone: 24 s)
+
+
+@pytest.mark.parametrize("argv", [pytest.param(["surgery"], marks=SLOW), pytest.param(["clustered"], marks=SLOW),
+                                  pytest.param(["rt_hybrid", "--scene", RT_TINY], marks=SLOW),
                                   ["rt_standalone", "--scene", RT_TINY]], ids=lambda a: a[0])
 def test_bundled_graphs_are_clean_under_gpu_assisted_validation(argv, capsys, monkeypatch) -> None:
     from locations import ROOT

@@ -90,7 +90,7 @@ def run_frames(ex: Any, frames: int, marks: list[float] | None = None) -> dict[s
     calls_of = [[(c.queue, c.count, c.infos, c.fence, c.context) for c in ex.submit_calls[k]]
                 for k in range(FRAMES_IN_FLIGHT)]
     slots_of = ex.value_slots
-    timeout = 10**11
+    timeout = dev.fence_timeout_ns
     poll, not_yet = fence_wait() == "poll", v.VK_TIMEOUT
     perf = time.perf_counter
     timed = marks is not None

@@ -69,7 +69,7 @@ def choose_physical_device(devices: list[PhysicalDeviceInfo], index: int | None)
     if index is not None:
         if not 0 <= index < len(devices):
             names = ", ".join(f"{d.index}: {d.name}" for d in devices)
-            raise VulkanUnavailable(f"--device {index} out of range; devices are {names}")
+            raise VulkanUnavailable(f"device index {index} (--device / --devices) is out of range; devices are {names}")
         return devices[index]
     usable = [d for d in devices if d.api_version >= (1, 3, 0)] or devices
     for kind in ("discrete", "cpu", "integrated"):

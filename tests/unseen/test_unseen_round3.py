@@ -121,3 +121,10 @@ def test_bundled_graphs_on_round3_scenes_run_clean_under_validation(case: str, c
     graph, scene, extra = BUNDLED[case]
     rc, err = _run(capsys, [graph, "--scene", _s(scene), "--size", "16x12", "--validate", *extra])
     assert rc == 0 and "0 validation message(s)" in err, err
+
+
+@pytest.mark.vulkan
+def test_a_device_index_out_of_range_names_both_flags(capsys) -> None:
+    """``--devices 0,5`` on a one-device machine: the error said ``--device 5``, a flag not given."""
+    rc, err = _run(capsys, ["surgery", "--devices", "0,99", "--split", "sort-first", "--size", "16x16"])
+    assert rc == 2 and "device index 99 (--device / --devices) is out of range" in err, err

@@ -183,9 +183,8 @@ def refuse_compile_flags(args: argparse.Namespace, *, multi: bool = False) -> No
     given = [flag for flag, value in flags if value]
     if given:
         verb = "applies" if len(given) == 1 else "apply"
-        size = f" (its size is {_plan_size(args.graph)})" if "--size" in given else ""
         raise RGraphError.in_file(COMMAND_LINE, f"{', '.join(given)} only {verb} when compiling a graph, not to "
-                                                f"a plan file{size}")
+                                                f"a plan file (its size is {_plan_size(args.graph)})")
 
 
 def _plan_from_file(args: argparse.Namespace) -> dict:

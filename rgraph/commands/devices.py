@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
@@ -38,6 +39,19 @@ def run(args: argparse.Namespace) -> int:
             print(f"{d.index}: {d.name} ({d.device_type}, Vulkan {api}, {HOST_IMPORT}: {host})")
         if not devices:
             print("rgraph: no Vulkan physical devices", file=sys.stderr)
+        print(_validation_layer_line(), file=sys.stderr)
     finally:
         instance.destroy()
     return 0 if devices else 2
+
+
+def _validation_layer_line() -> str:
+    """Which Khronos validation layer ``--validate`` would load, and from where."""
+    from rgraph.vk.bundled_layer import bundled_layer_dir
+    from rgraph.vk.instance import validation_layer_version
+
+    version = validation_layer_version()
+    if version is None:
+        return "rgraph: --validate: no Khronos validation layer found (apt-get install vulkan-validationlayers)"
+    where = os.environ.get("VK_LAYER_PATH") or str(bundled_layer_dir() or "the system's layer directories")
+    return f"rgraph: --validate uses Khronos validation layer {'.'.join(map(str, version))} ({where})"

@@ -37,3 +37,12 @@ def test_the_layer_reports_a_wrong_ray_tracing_structure_type(monkeypatch) -> No
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
     assert any("VUID-VkRayTracingPipelineCreateInfoKHR-sType-sType" in m.id_name for m in result.messages)
+
+
+def test_devices_names_the_layer_validate_uses(capsys) -> None:
+    from rgraph.cli import main
+    from rgraph.vk.bundled_layer import bundled_layer_dir
+
+    assert main(["devices"]) == 0
+    err = capsys.readouterr().err
+    assert "--validate uses Khronos validation layer 1.4." in err and str(bundled_layer_dir()) in err, err

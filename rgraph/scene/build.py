@@ -262,7 +262,8 @@ def pick_camera(model: SceneFile, camera: int) -> SceneFile:
     0 is ``camera`` when there is no list)."""
     if not model.cameras:
         if camera != 0:
-            raise ValueError(f"camera {camera}: the scene has no 'cameras' list (only camera 0)")
+            what = "an empty 'cameras' list" if "cameras" in model.model_fields_set else "no 'cameras' list"
+            raise ValueError(f"camera {camera}: the scene has {what} (only camera 0, its 'camera')")
         return model
     if not 0 <= camera < len(model.cameras):
         raise ValueError(f"camera {camera} out of range: the scene has {len(model.cameras)} cameras")

@@ -30,6 +30,14 @@ def test_presets_pick_the_camera():
         load_scene_data(SCENES / "rt_tiny.yaml", camera=1)
 
 
+def test_an_empty_cameras_list_is_named_as_such(tmp_path):
+    """``cameras: []`` is allowed (camera 0 is ``camera``); --camera 1 said it had no list."""
+    scene = tmp_path / "empty.yaml"
+    scene.write_text((SCENES / "rt_tiny.yaml").read_text() + "\ncameras: []\n")
+    with pytest.raises(ValueError, match="an empty 'cameras' list"):
+        load_scene_data(scene, camera=1)
+
+
 def test_plan_records_the_camera_and_rejects_bad_indices():
     plan = compile_graph("rt_standalone", scene_path=SCENES / "rt_gallery.yaml", size=(16, 16), camera=3)
     assert plan["camera"] == 3

@@ -128,3 +128,12 @@ def test_a_device_index_out_of_range_names_both_flags(capsys) -> None:
     """``--devices 0,5`` on a one-device machine: the error said ``--device 5``, a flag not given."""
     rc, err = _run(capsys, ["surgery", "--devices", "0,99", "--split", "sort-first", "--size", "16x16"])
     assert rc == 2 and "device index 99 (--device / --devices) is out of range" in err, err
+
+
+@pytest.mark.vulkan
+def test_a_multi_device_plan_run_on_one_device_suggests_devices(tmp_path: Path, capsys) -> None:
+    plan = tmp_path / "split.json"
+    assert main(["compile", "surgery", "--size", "16x16", "--devices", "2", "--split", "sort-first",
+                 "-o", str(plan)]) == 0
+    rc, err = _run(capsys, [str(plan)])
+    assert rc == 2 and "run a multi-device plan with one device per plan device (--devices 0,0)" in err, err

@@ -31,7 +31,9 @@ def create(ex: Any) -> None:
     dev = ex.device
     for p in ex.plan["passes"]:
         if p.get("device", 0) != 0:
-            raise ExecutionError(f"pass {p['name']!r}: multi-device plans are not supported")
+            devices = ex.plan.get("multi_device", {}).get("devices", 2)
+            raise ExecutionError(f"pass {p['name']!r} runs on plan device {p['device']}: run a multi-device plan "
+                                 f"with one device per plan device (--devices {','.join(['0'] * devices)})")
     ex.log.context = "creating resources"
     ex.resources = ResourceSet(dev, ex.plan, FRAMES_IN_FLIGHT, external=ex.external)
     ex.log.context = "initialising persistent resources"

@@ -14,8 +14,9 @@ deb.debian.org, checks its SHA-256, and makes it load on Debian 12:
 
 It then checks that the Vulkan loader lists the layer at its version. rgraph's ``--validate``
 uses this layer when it is there (``rgraph.vk.bundled_layer``), the system one otherwise.
-Idempotent; on any failure it removes what it made and exits 1 (setup goes on with the system
-layer). Run by ``scripts/setup.sh``: ``.venv/bin/python scripts/validation_layer.py``.
+Idempotent; on any failure (no network, say) it removes what it made, writes the reason to
+``vulkan-layers.unavailable`` beside it and exits 1: setup goes on, ``--validate`` uses the
+system layer, and the tests run ray tracing unvalidated as before (``tests/rt_helpers.py``). Run by ``scripts/setup.sh``: ``.venv/bin/python scripts/validation_layer.py``.
 """
 
 from __future__ import annotations
@@ -188,17 +189,26 @@ def install(directory: Path) -> str:
         return version
 
 
+def unavailable_marker(directory: Path) -> Path:
+    """Written when the install failed, with the reason (tests/vk/test_bundled_layer.py reports it)."""
+    return directory.with_name(directory.name + ".unavailable")
+
+
 def main() -> int:
     directory = target_dir()
     if (directory / MANIFEST).exists() and layer_version_listed(directory):
         return 0
+    marker = unavailable_marker(directory)
     try:
         version = install(directory)
     except (OSError, RuntimeError, subprocess.SubprocessError, StopIteration, KeyError) as exc:
         shutil.rmtree(directory, ignore_errors=True)
+        marker.parent.mkdir(parents=True, exist_ok=True)
+        marker.write_text(f"{type(exc).__name__}: {exc}\n")
         print(f"validation_layer.py: no bundled validation layer ({exc}); --validate uses the system layer",
               file=sys.stderr)
         return 1
+    marker.unlink(missing_ok=True)
     print(f"validation_layer.py: Khronos validation layer {version} in {directory}", file=sys.stderr)
     return 0
 

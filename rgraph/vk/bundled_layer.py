@@ -16,10 +16,18 @@ from pathlib import Path
 MANIFEST = "VkLayer_khronos_validation.json"
 
 
+LAYER_DIR = Path(sys.prefix) / "share" / "rgraph" / "vulkan-layers"
+
+
 def bundled_layer_dir() -> Path | None:
     """The venv's layer directory, when it holds the layer's manifest."""
-    directory = Path(sys.prefix) / "share" / "rgraph" / "vulkan-layers"
-    return directory if (directory / MANIFEST).is_file() else None
+    return LAYER_DIR if (LAYER_DIR / MANIFEST).is_file() else None
+
+
+def why_unavailable() -> str | None:
+    """Why setup could not install the layer (its note), or None."""
+    marker = LAYER_DIR.with_name(LAYER_DIR.name + ".unavailable")
+    return marker.read_text().strip() if marker.is_file() else None
 
 
 def point_loader_at_bundled_layer() -> None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from locations import TESTS
+from rt_helpers import rt_validates
 
 from rgraph.compiler.pipeline import compile_graph
 from rgraph.resources import builtin_passes
@@ -51,7 +52,7 @@ def psnr(a: np.ndarray, b: np.ndarray) -> float:
     return float("inf") if mse == 0 else 10 * np.log10(1.0 / mse)
 
 
-def _run(graph, frame: int, extra=(), params=None, validate: bool = True, refit: bool = True) -> dict:
+def _run(graph, frame: int, extra=(), params=None, validate: bool | None = None, refit: bool = True) -> dict:
     """Outputs of content frame ``frame`` (the last of ``frame + 1`` frames); ``refit``: the
     plan's accel is persistent and refitted."""
     from rgraph.vk.executor import execute_plan
@@ -59,7 +60,8 @@ def _run(graph, frame: int, extra=(), params=None, validate: bool = True, refit:
     plan = compile_graph(str(graph), scene_path=SCENE, size=SIZE, extra_outputs=list(extra), params=params or {})
     assert any(r["kind"] == "accel" and r["accel"]["refit"] for r in plan["resources"]) == refit
     try:
-        result = execute_plan(plan, validate=validate, frames=frame + 1, read_outputs=True)
+        result = execute_plan(plan, validate=rt_validates() if validate is None else validate, frames=frame + 1,
+                              read_outputs=True)
     except VulkanUnavailable as exc:  # pragma: no cover
         pytest.skip(str(exc))
     assert [m.text for m in result.messages] == []
@@ -201,7 +203,7 @@ def test_a_scene_without_deformable_meshes_keeps_the_static_tables(tmp_path):
     for scene, deformed in ((static, False), (SCENE, True)):
         plan = compile_graph("rt_standalone", scene_path=scene, size=SIZE)
         try:
-            with open_device(validate=True, verbose=False, ray_tracing=True) as gpu:
+            with open_device(validate=rt_validates(), verbose=False, ray_tracing=True) as gpu:
                 accels = gpu.load(plan).executor.accels
                 assert (accels.deformed is not None) == deformed
                 assert accels.deforming == ({"scene_as"} if deformed else set())

@@ -30,7 +30,10 @@ SLOW = pytest.mark.slow  # a cold shader cache: 43-98 s each on lavapipe (rt_sta
                                   ["rt_standalone", "--scene", RT_TINY]], ids=lambda a: a[0])
 def test_bundled_graphs_are_clean_under_gpu_assisted_validation(argv, capsys, monkeypatch) -> None:
     from locations import ROOT
+    from rt_helpers import rt_validates
 
+    if argv[0].startswith("rt_") and not rt_validates():
+        pytest.skip("the validation layer here crashes on ray tracing pipelines (tests/vk/test_bundled_layer.py)")
     argv = [str(ROOT / a) if a.endswith(".yaml") else a for a in argv]
     rc, err = _run(capsys, monkeypatch, argv)
     assert rc == 0 and "rgraph: 0 validation message(s)" in err, err

@@ -14,6 +14,7 @@ import importlib
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rgraph.commands.common import (
     add_graph_arguments,
@@ -32,6 +33,9 @@ from rgraph.commands.outputs import (
 )
 from rgraph.errors import RGraphError
 from rgraph.vk.instance import validation_summary
+
+if TYPE_CHECKING:
+    from rgraph.plan import Plan
 
 COMMAND_LINE = "<command line>"
 
@@ -150,6 +154,13 @@ def is_plan_file(target: str) -> bool:
 
 
 def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
+    """:func:`load_checked_model` as a plan document."""
+    from rgraph.plan import to_json_dict
+
+    return to_json_dict(load_checked_model(path, unchecked=unchecked))
+
+
+def load_checked_model(path: Path, *, unchecked: bool = False) -> Plan:
     """A plan file through the typed loader (malformed: ``RGraphError``, one located line),
     then replayed by ``rgraph.check``: hazards are refused (``RGraphError``) unless ``unchecked``."""
     from rgraph.plan import load, to_json_dict
@@ -157,10 +168,9 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
     model = load(path)
     if model.format != "rgraph-plan/1":
         raise RGraphError.in_file(path, "not an rgraph plan (format != rgraph-plan/1)")
-    doc = to_json_dict(model)
     from rgraph.spec.paths import check_plan_scene
 
-    check_plan_scene(doc, Path(path))
+    check_plan_scene(to_json_dict(model), Path(path))
     if not unchecked:
         from rgraph.check import check_file
 
@@ -170,7 +180,7 @@ def load_checked_plan(path: Path, *, unchecked: bool = False) -> dict:
             raise RGraphError.in_file(
                 path, f"rgraph check finds {len(hazards)} hazard{'s' if len(hazards) != 1 else ''} in this plan "
                       f"(first: {first}); see 'rgraph check {path}', or pass --unchecked to run it anyway")
-    return doc
+    return model
 
 
 def refuse_compile_flags(args: argparse.Namespace, *, multi: bool = False) -> None:
@@ -316,10 +326,11 @@ def run(args: argparse.Namespace) -> int:
     if devices is not None and (len(devices) > 1 or _is_multi_plan(args.graph)):
         from rgraph.commands.run_multi import run_multi
 
+        checked = None
         if is_plan_file(args.graph):  # as a one-device plan file: its own compile, checked first
             refuse_compile_flags(args, multi=True)
-            load_checked_plan(Path(args.graph), unchecked=args.unchecked)
-        return run_multi(args, devices, default_size_text())
+            checked = load_checked_model(Path(args.graph), unchecked=args.unchecked)
+        return run_multi(args, devices, default_size_text(), checked)
     if devices is not None and args.device is None:
         args.device = devices[0]
     plan = _plan_from_file(args) if is_plan_file(args.graph) else None

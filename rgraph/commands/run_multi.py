@@ -10,17 +10,22 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgraph.commands.common import parse_params, parse_size
 from rgraph.vk.instance import validation_summary
+
+if TYPE_CHECKING:
+    from rgraph.plan import Plan
 
 
 def _runtime_options(args: argparse.Namespace) -> dict[str, Any]:
     return {"transfer": getattr(args, "transfer", "auto") or "auto", "pipelined": bool(getattr(args, "pipelined", False))}
 
 
-def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -> int:
+def run_multi(args: argparse.Namespace, devices: list[int], default_size: str, plan_file: Plan | None = None) -> int:
+    """Run a graph (compiled here, split) or a plan file (``plan_file``: its model, loaded and
+    checked by the caller) on ``devices``."""
     from rgraph.api import open_device
     from rgraph.commands.multi_args import split_from_args
     from rgraph.compiler.pipeline import compile_graph, compile_graph_plan
@@ -34,7 +39,7 @@ def run_multi(args: argparse.Namespace, devices: list[int], default_size: str) -
         for index in devices:
             gpus.append(open_device(validate=args.validate, device=index))
         if args.graph.endswith(".json"):
-            plan, reference = load(args.graph), None
+            plan, reference = plan_file if plan_file is not None else load(args.graph), None
         else:
             options = dict(scene_path=args.scene, params=parse_params(args.param),
                            size=parse_size(args.size or default_size), policy=args.policy,
